@@ -1,0 +1,2 @@
+// Out-of-line anchor for the accelerator interface's vtable.
+#include "accel/accelerator.hpp"

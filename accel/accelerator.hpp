@@ -1,0 +1,50 @@
+// The world's query interface: every accelerator answers closest-hit and any-hit for a
+// range of a ray batch and reports what it costs in memory and build time.
+#pragma once
+
+#include <cstddef>
+#include <map>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "memory/ray_batch.hpp"
+
+namespace wavetrace {
+
+// Bytes by part, as the papers split them.
+struct MemoryReport {
+  std::size_t hierarchy = 0;  // nodes of the acceleration structure
+  std::size_t geometry = 0;   // vertices, indices, triangle data
+  std::size_t other = 0;      // everything else the structure keeps alive
+  std::size_t total() const { return hierarchy + geometry + other; }
+};
+
+struct BuildReport {
+  double seconds = 0.0;
+  std::size_t peak_bytes = 0;  // highest memory the build held at once, result included
+};
+
+class Accelerator {
+ public:
+  virtual ~Accelerator() = default;
+
+  virtual std::string name() const = 0;
+
+  // For each ray in range: the nearest hit in [tmin, tmax] into hits (t, primitive, u, v),
+  // or primitive = kInvalidPrimitive and t = +inf on a miss. Rays whose alive flag is clear
+  // are skipped and their hit slot marked as a miss.
+  virtual void intersect_closest(const RayBatch& rays, HitBatch& hits, RayRange range) const = 0;
+
+  // For each ray in range: whether anything lies in [tmin, tmax]; an occluded ray gets a
+  // valid primitive (any one it found), a free ray kInvalidPrimitive.
+  virtual void intersect_any(const RayBatch& rays, HitBatch& hits, RayRange range) const = 0;
+
+  virtual MemoryReport memory() const = 0;
+  virtual BuildReport build() const = 0;
+
+  // The byte ranges traversal reads, for the pager; empty where memory cannot be observed.
+  virtual std::vector<std::span<const std::byte>> memory_spans() const { return {}; }
+};
+
+}  // namespace wavetrace

@@ -1,0 +1,193 @@
+// Embree 3 wrapper: one triangle geometry with shared buffers, rtcIntersect1/rtcOccluded1
+// per ray (the configuration the papers and PLATFORM.md measure).
+#include "accel/embree/embree_accelerator.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <limits>
+#include <stdexcept>
+
+#include <embree3/rtcore.h>
+#include <fmt/format.h>
+#include <pmmintrin.h>
+#include <xmmintrin.h>
+
+namespace wavetrace {
+namespace {
+
+// Embree reports every allocation and free here; we keep the live total and its peak.
+struct MemoryMonitor {
+  std::atomic<std::int64_t> current{0};
+  std::atomic<std::int64_t> peak{0};
+
+  static bool callback(void* self, ssize_t bytes, bool /*post*/) {
+    auto* monitor = static_cast<MemoryMonitor*>(self);
+    const std::int64_t now = monitor->current.fetch_add(bytes, std::memory_order_relaxed) + bytes;
+    std::int64_t seen = monitor->peak.load(std::memory_order_relaxed);
+    while (now > seen && !monitor->peak.compare_exchange_weak(seen, now, std::memory_order_relaxed)) {
+    }
+    return true;
+  }
+};
+
+void raise_embree_error(RTCDevice device, const char* what) {
+  const RTCError code = rtcGetDeviceError(device);
+  if (code != RTC_ERROR_NONE) throw std::runtime_error(fmt::format("embree: {} failed (error {})", what, int(code)));
+}
+
+class EmbreeAccelerator final : public Accelerator {
+ public:
+  EmbreeAccelerator(const TriangleMesh& mesh, const EmbreeOptions& options) : mesh_(mesh), options_(options) {
+    const auto start = std::chrono::steady_clock::now();
+    const std::string config = options.threads > 0 ? fmt::format("threads={}", options.threads) : std::string();
+    device_ = rtcNewDevice(config.empty() ? nullptr : config.c_str());
+    if (device_ == nullptr) throw std::runtime_error("embree: could not create a device");
+    rtcSetDeviceMemoryMonitorFunction(device_, &MemoryMonitor::callback, &monitor_);
+
+    scene_ = rtcNewScene(device_);
+    RTCSceneFlags flags = RTC_SCENE_FLAG_NONE;
+    if (options.mode == EmbreeMode::compact) flags = RTC_SCENE_FLAG_COMPACT;
+    if (options.mode == EmbreeMode::robust) flags = RTC_SCENE_FLAG_ROBUST;
+    rtcSetSceneFlags(scene_, flags);
+
+    RTCGeometry geometry = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+    // Embree may read 16 bytes at the last vertex; validate_and_clean reserves that slack.
+    const glm::vec3* vertices = mesh.positions.data();
+    if (mesh.positions.capacity() <= mesh.positions.size()) {
+      padded_vertices_.reserve(mesh.positions.size() + 1);
+      padded_vertices_.assign(mesh.positions.begin(), mesh.positions.end());
+      vertices = padded_vertices_.data();
+    }
+    rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, vertices, 0,
+                               sizeof(glm::vec3), mesh.positions.size());
+    rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, mesh.triangles.data(), 0,
+                               sizeof(glm::uvec3), mesh.triangles.size());
+    rtcSetGeometryMask(geometry, 0xFFFFFFFFu);
+    rtcCommitGeometry(geometry);
+    rtcAttachGeometry(scene_, geometry);
+    rtcReleaseGeometry(geometry);
+    rtcCommitScene(scene_);
+    raise_embree_error(device_, "building the scene");
+    build_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    build_.peak_bytes = static_cast<std::size_t>(monitor_.peak.load()) + mesh_bytes();
+  }
+
+  ~EmbreeAccelerator() override {
+    rtcReleaseScene(scene_);
+    rtcReleaseDevice(device_);
+  }
+
+  std::string name() const override {
+    return options_.mode == EmbreeMode::standard ? "embree" : "embree-" + to_string(options_.mode);
+  }
+
+  void intersect_closest(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    for (std::uint32_t i = range.begin; i < range.end; ++i) {
+      if (!(rays.flags[i] & ray_flags::alive)) {
+        mark_miss(hits, i);
+        continue;
+      }
+      RTCRayHit query;
+      fill_ray(rays, i, query.ray);
+      query.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+      query.hit.primID = RTC_INVALID_GEOMETRY_ID;
+      rtcIntersect1(scene_, &context, &query);
+      if (query.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+        mark_miss(hits, i);
+      } else {
+        hits.t[i] = query.ray.tfar;
+        hits.primitive[i] = query.hit.primID;
+        hits.u[i] = query.hit.u;
+        hits.v[i] = query.hit.v;
+      }
+    }
+  }
+
+  void intersect_any(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    for (std::uint32_t i = range.begin; i < range.end; ++i) {
+      mark_miss(hits, i);
+      if (!(rays.flags[i] & ray_flags::alive)) continue;
+      RTCRay query;
+      fill_ray(rays, i, query);
+      rtcOccluded1(scene_, &context, &query);
+      // Embree says which ray was blocked, not by what: report primitive 0 as "occluded".
+      if (query.tfar == -std::numeric_limits<float>::infinity()) hits.primitive[i] = 0;
+    }
+  }
+
+  MemoryReport memory() const override {
+    MemoryReport report;
+    report.hierarchy = static_cast<std::size_t>(monitor_.current.load());
+    report.geometry = mesh_bytes();
+    return report;
+  }
+
+  BuildReport build() const override { return build_; }
+
+ private:
+  static void mark_miss(HitBatch& hits, std::uint32_t i) {
+    hits.t[i] = std::numeric_limits<float>::infinity();
+    hits.primitive[i] = kInvalidPrimitive;
+    hits.u[i] = 0.0f;
+    hits.v[i] = 0.0f;
+  }
+
+  static void fill_ray(const RayBatch& rays, std::uint32_t i, RTCRay& ray) {
+    ray.org_x = rays.origin_x[i];
+    ray.org_y = rays.origin_y[i];
+    ray.org_z = rays.origin_z[i];
+    ray.dir_x = rays.direction_x[i];
+    ray.dir_y = rays.direction_y[i];
+    ray.dir_z = rays.direction_z[i];
+    ray.tnear = rays.tmin[i];
+    ray.tfar = rays.tmax[i];
+    ray.time = 0.0f;
+    ray.mask = 0xFFFFFFFFu;
+    ray.id = i;
+    ray.flags = 0;
+  }
+
+  std::size_t mesh_bytes() const {
+    return mesh_.positions.size() * sizeof(glm::vec3) + mesh_.triangles.size() * sizeof(glm::uvec3);
+  }
+
+  const TriangleMesh& mesh_;
+  EmbreeOptions options_;
+  std::vector<glm::vec3> padded_vertices_;
+  MemoryMonitor monitor_;
+  RTCDevice device_ = nullptr;
+  RTCScene scene_ = nullptr;
+  BuildReport build_;
+};
+
+}  // namespace
+
+EmbreeMode parse_embree_mode(const std::string& text) {
+  if (text == "default") return EmbreeMode::standard;
+  if (text == "compact") return EmbreeMode::compact;
+  if (text == "robust") return EmbreeMode::robust;
+  throw std::invalid_argument(fmt::format("unknown embree mode '{}' (default, compact, robust)", text));
+}
+
+std::string to_string(EmbreeMode mode) {
+  switch (mode) {
+    case EmbreeMode::compact: return "compact";
+    case EmbreeMode::robust: return "robust";
+    default: return "default";
+  }
+}
+
+std::unique_ptr<Accelerator> make_embree_accelerator(const TriangleMesh& mesh, const EmbreeOptions& options) {
+  return std::make_unique<EmbreeAccelerator>(mesh, options);
+}
+
+void set_embree_thread_float_mode() {
+  _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+  _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+}
+
+}  // namespace wavetrace

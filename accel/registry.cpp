@@ -1,0 +1,19 @@
+// Name-to-builder table of the accelerators that exist today.
+#include "accel/registry.hpp"
+
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+namespace wavetrace {
+
+std::vector<std::string> accelerator_names() { return {"embree"}; }
+
+std::unique_ptr<Accelerator> make_accelerator(const TriangleMesh& mesh, const AcceleratorOptions& options) {
+  if (options.type == "embree") return make_embree_accelerator(mesh, options.embree);
+  std::string known;
+  for (const std::string& name : accelerator_names()) known += (known.empty() ? "" : ", ") + name;
+  throw std::invalid_argument(fmt::format("unknown accelerator '{}' (available: {})", options.type, known));
+}
+
+}  // namespace wavetrace

@@ -1,0 +1,24 @@
+// Accelerators by name, as config files, --accel and the bench harness name them.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "accel/accelerator.hpp"
+#include "accel/embree/embree_accelerator.hpp"
+#include "scene/triangle_mesh.hpp"
+
+namespace wavetrace {
+
+struct AcceleratorOptions {
+  std::string type = "embree";
+  EmbreeOptions embree;
+};
+
+std::vector<std::string> accelerator_names();
+
+// Throws std::invalid_argument naming an unknown type.
+std::unique_ptr<Accelerator> make_accelerator(const TriangleMesh& mesh, const AcceleratorOptions& options);
+
+}  // namespace wavetrace

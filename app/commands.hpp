@@ -1,0 +1,12 @@
+// The subcommands of the `wavetrace` command line.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace wavetrace {
+
+// Each adds its subcommand to the app; the callback runs it and sets `exit_code`.
+void add_render_command(CLI::App& app, int& exit_code);
+void add_info_command(CLI::App& app, int& exit_code);
+
+}  // namespace wavetrace

@@ -1,0 +1,25 @@
+// The `wavetrace` command line: render, info (bench arrives with the BVH baseline).
+#include <cstdio>
+#include <exception>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "app/commands.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app("wavetrace: a CPU wavefront ray tracer for very large triangle meshes");
+  app.require_subcommand(1);
+  int exit_code = 0;
+  wavetrace::add_render_command(app, exit_code);
+  wavetrace::add_info_command(app, exit_code);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& error) {
+    return app.exit(error);
+  } catch (const std::exception& error) {
+    fmt::print(stderr, "wavetrace: error: {}\n", error.what());
+    return 1;
+  }
+  return exit_code;
+}

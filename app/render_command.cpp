@@ -1,0 +1,99 @@
+// `wavetrace render`: config and flags to a plan, scene and accelerator to an image.
+#include <cstdio>
+#include <fstream>
+#include <memory>
+
+#include <fmt/format.h>
+
+#include "accel/registry.hpp"
+#include "app/commands.hpp"
+#include "app/image_output.hpp"
+#include "app/progress_line.hpp"
+#include "app/render_report.hpp"
+#include "scene/lights.hpp"
+#include "stages/render_setup.hpp"
+
+namespace wavetrace {
+namespace {
+
+struct RenderArguments {
+  std::string scene;
+  std::string accel;
+  int spp = 0;
+  std::string size;
+  int threads = -1;
+  std::string config_file;
+  std::vector<std::string> assignments;
+  std::string out = "out/render.exr";
+  std::string stats;
+};
+
+Config build_config(const RenderArguments& args) {
+  Config config;
+  if (!args.config_file.empty()) config.load_file(args.config_file);
+  if (!args.scene.empty()) config.set_value("scene.source", args.scene);
+  if (!args.accel.empty()) config.set_value("accel.type", args.accel);
+  if (args.spp != 0) config.set_value("render.spp", std::int64_t{args.spp});
+  if (args.threads >= 0) config.set_value("render.threads", std::int64_t{args.threads});
+  if (!args.size.empty()) {
+    const std::size_t x = args.size.find('x');
+    if (x == std::string::npos) throw ConfigError(fmt::format("--size '{}': expected WIDTHxHEIGHT", args.size));
+    config.set("render.width=" + args.size.substr(0, x));
+    config.set("render.height=" + args.size.substr(x + 1));
+  }
+  for (const std::string& assignment : args.assignments) config.set(assignment);
+  return config;
+}
+
+int run_render(const RenderArguments& args) {
+  const Config config = build_config(args);
+  const RenderPlan plan = plan_render(config);
+
+  const Scene scene = load_scene(plan.scene);
+  const Camera camera = resolve_camera(plan.camera, scene);
+  const std::unique_ptr<Accelerator> accelerator = make_accelerator(scene.mesh, plan.accelerator);
+  const LightSampler lights(scene);
+  const World world{scene, *accelerator, lights};
+
+  ProgressLine progress(stderr);
+  const RenderOutput output =
+      render_image(plan, world, camera, progress.enabled() ? [&](const Progress& p) { progress.update(p); }
+                                                          : std::function<void(const Progress&)>());
+  progress.finish();
+
+  write_exr(args.out, plan.image.width, plan.image.height, output.image);
+  const std::string preview = preview_path_for(args.out);
+  write_png_preview(preview, plan.image.width, plan.image.height, output.image);
+
+  const RenderFacts facts{scene, *accelerator, plan, output, args.out};
+  fmt::print("{}: {} triangles, {} vertices{}\n", scene.name, scene.mesh.triangle_count(), scene.mesh.vertex_count(),
+             scene.cleanup.degenerate_dropped ? fmt::format(", {} degenerate dropped", scene.cleanup.degenerate_dropped)
+                                              : std::string());
+  fmt::print("{}", render_table(facts));
+  fmt::print("wrote {} and {}\n", args.out, preview);
+  if (!args.stats.empty()) {
+    std::ofstream file(args.stats);
+    file << render_stats_json(facts).dump(2) << "\n";
+    if (!file) throw std::runtime_error(fmt::format("{}: could not write stats", args.stats));
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_render_command(CLI::App& app, int& exit_code) {
+  auto args = std::make_shared<RenderArguments>();
+  CLI::App* command = app.add_subcommand("render", "path-trace an image through the stage pipeline");
+  command->add_option("scene", args->scene, "mesh file or builtin:NAME[:TRIANGLES] (default builtin:default)");
+  command->add_option("--accel", args->accel, "accelerator (accel.type)");
+  command->add_option("--spp", args->spp, "samples per pixel (render.spp)");
+  command->add_option("--size", args->size, "image size as WIDTHxHEIGHT");
+  command->add_option("--threads", args->threads, "worker threads, 0 = all cores (render.threads)");
+  command->add_option("--config", args->config_file, "TOML config file");
+  command->add_option("--set", args->assignments, "override a config key: section.key=value")->expected(1)->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  command->add_option("--out", args->out, "OpenEXR output; a PNG preview is written beside it");
+  command->add_option("--stats", args->stats, "write run statistics as JSON");
+  command->callback([args, &exit_code] { exit_code = run_render(*args); });
+}
+
+}  // namespace wavetrace

@@ -1,0 +1,34 @@
+// Procedural scenes named builtin:NAME[:TRIANGLES]; deterministic and generated in parallel.
+//   sphere   a closed, fractally displaced icosphere (20 triangles and up)
+//   terrain  a fractal heightfield
+//   soup     the sphere's triangles with no shared vertices (no connectivity at all)
+//   stadium  a small dense sphere inside a huge, sparse box (the grids' failure case)
+//   fur      many thin disconnected strands on a small sphere (the proxy's failure case)
+//   default  a displaced sphere on a ground plane under an area light, framed by the camera
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "scene/scene.hpp"
+
+namespace wavetrace {
+
+bool is_builtin_scene(std::string_view source);
+std::vector<std::string> builtin_scene_names();
+
+// Parses "builtin:NAME[:COUNT]" (COUNT with an optional k, M or G suffix) and builds it.
+// The triangle count is met as closely as the generator's structure allows.
+Scene make_builtin_scene(std::string_view source);
+
+// Parses a count such as "8M", "250k" or "1000"; throws SceneError naming `what`.
+std::size_t parse_triangle_count(std::string_view text, std::string_view what);
+
+// The closed displaced sphere on its own, for composing scenes: about `triangles`
+// triangles (20 n^2 for the nearest n), radius about `radius`, centred at `center`.
+TriangleMesh make_displaced_sphere(std::size_t triangles, const glm::vec3& center, float radius,
+                                   std::uint32_t seed);
+
+}  // namespace wavetrace

@@ -1,0 +1,21 @@
+// Mesh files in: OFF, PLY, OBJ and STL through OpenMesh's readers.
+#pragma once
+
+#include <string>
+
+#include "scene/triangle_mesh.hpp"
+
+namespace wavetrace {
+
+struct LoadedMesh {
+  TriangleMesh mesh;
+  std::size_t polygons_triangulated = 0;  // faces of more than 3 corners, fanned into triangles
+  MeshCleanup cleanup;
+};
+
+// Reads every face of the file as written (non-manifold faces included, which OpenMesh's
+// own mesh kernels would drop), fans polygons into triangles, then validates and cleans.
+// Throws SceneError naming the file on a missing, unreadable or malformed file.
+LoadedMesh load_mesh_file(const std::string& path);
+
+}  // namespace wavetrace

@@ -1,0 +1,69 @@
+// The run configuration: one TOML file plus `--set section.key=value` overrides, checked
+// against a schema so that an unknown key or an out-of-range value is an error naming it.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+namespace wavetrace {
+
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+enum class ConfigType { boolean, integer, real, text, vector3, text_list };
+
+using ConfigValue = std::variant<bool, std::int64_t, double, std::string, glm::vec3, std::vector<std::string>>;
+
+struct ConfigKey {
+  std::string name;  // "section.key" or "section.sub.key"
+  ConfigType type;
+  std::optional<ConfigValue> default_value;  // none: unset unless given
+  double min = 0.0, max = 0.0;               // integer and real keys
+  std::vector<std::string> choices;          // text keys (and list items) limited to these
+  std::string help;
+};
+
+// Every key wavetrace knows, with its type, default and limits (config_schema.cpp).
+const std::vector<ConfigKey>& config_schema();
+// The top-level sections of DESIGN.md; a section with no keys yet rejects every key.
+const std::vector<std::string>& config_sections();
+
+class Config {
+ public:
+  Config();  // every key at its default
+
+  void load_file(const std::string& path);
+  void load_string(std::string_view toml, std::string_view origin = "config");
+  // "section.key=value"; the value is parsed as the key's type.
+  void set(std::string_view assignment);
+  void set_value(std::string_view key, ConfigValue value);
+
+  bool has(std::string_view key) const;
+  bool boolean(std::string_view key) const;
+  std::int64_t integer(std::string_view key) const;
+  double real(std::string_view key) const;
+  const std::string& text(std::string_view key) const;
+  glm::vec3 vector3(std::string_view key) const;
+  const std::vector<std::string>& text_list(std::string_view key) const;
+
+  // The keys that were given explicitly (file or --set), for reports.
+  const std::map<std::string, ConfigValue, std::less<>>& values() const { return values_; }
+
+ private:
+  const ConfigValue& value(std::string_view key, ConfigType type) const;
+  std::map<std::string, ConfigValue, std::less<>> values_;
+};
+
+std::string to_string(const ConfigValue& value);
+
+}  // namespace wavetrace

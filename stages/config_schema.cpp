@@ -1,0 +1,49 @@
+// The schema: every configuration key, its type, default and valid range. Adding a
+// feature's option means adding one line here.
+#include "stages/config.hpp"
+
+namespace wavetrace {
+
+const std::vector<std::string>& config_sections() {
+  static const std::vector<std::string> sections = {"scene", "camera", "render", "accel",
+                                                    "proxy", "reorder", "memory", "pipeline"};
+  return sections;
+}
+
+const std::vector<ConfigKey>& config_schema() {
+  using T = ConfigType;
+  static const std::vector<ConfigKey> schema = {
+      {"scene.source", T::text, std::string("builtin:default"), 0, 0, {},
+       "mesh file (.off .ply .obj .stl) or builtin:NAME[:TRIANGLES]"},
+      {"scene.subdivide", T::integer, std::int64_t{0}, 0, 6, {}, "levels of Loop subdivision after loading"},
+
+      {"camera.position", T::vector3, std::nullopt, 0, 0, {}, "eye point (default: the scene's or framed)"},
+      {"camera.look_at", T::vector3, std::nullopt, 0, 0, {}, "point looked at"},
+      {"camera.up", T::vector3, glm::vec3(0.0f, 1.0f, 0.0f), 0, 0, {}, "up direction"},
+      {"camera.fov", T::real, std::nullopt, 1, 179, {}, "vertical field of view in degrees"},
+
+      {"render.width", T::integer, std::int64_t{640}, 1, 16384, {}, "image width in pixels"},
+      {"render.height", T::integer, std::int64_t{480}, 1, 16384, {}, "image height in pixels"},
+      {"render.spp", T::integer, std::int64_t{8}, 1, 65536, {}, "samples per pixel"},
+      {"render.max_depth", T::integer, std::int64_t{5}, 0, 64, {},
+       "most bounces of a path (0: direct light only)"},
+      {"render.russian_roulette_depth", T::integer, std::int64_t{3}, 0, 64, {},
+       "bounce depth from which Russian roulette may end a path"},
+      {"render.threads", T::integer, std::int64_t{0}, 0, 1024, {}, "worker threads (0: all cores)"},
+      {"render.batch_size", T::integer, std::int64_t{4096}, 16, 1 << 20, {}, "rays per batch"},
+      {"render.rays_in_flight", T::integer, std::int64_t{1} << 20, 1024, std::int64_t{1} << 30, {},
+       "most rays alive in the pipeline at once (bounds memory)"},
+      {"render.pixel_order", T::text, std::string("scanline"), 0, 0, {"scanline", "zcurve"},
+       "order in which camera rays are generated"},
+
+      {"accel.type", T::text, std::string("embree"), 0, 0, {"embree"}, "main accelerator"},
+      {"accel.embree.mode", T::text, std::string("default"), 0, 0, {"default", "compact", "robust"},
+       "Embree scene flags"},
+
+      {"pipeline.stages", T::text_list, std::vector<std::string>{"generate", "trace", "shade", "spawn"}, 0, 0,
+       {"generate", "trace", "shade", "spawn"}, "the stage chain; spawn at the end loops back"},
+  };
+  return schema;
+}
+
+}  // namespace wavetrace

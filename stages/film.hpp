@@ -1,0 +1,39 @@
+// The film: per-pixel radiance sums in 64-bit fixed point, so that accumulation is
+// exact and order-independent (an image is bit-identical for any thread count, batch
+// size or ray order).
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace wavetrace {
+
+class Film {
+ public:
+  Film(std::uint32_t width, std::uint32_t height);
+
+  std::uint32_t width() const { return width_; }
+  std::uint32_t height() const { return height_; }
+
+  // Adds radiance to a pixel; thread-safe. Non-finite or negative contributions are
+  // dropped and counted (a correct tracer makes none).
+  void add(std::uint32_t pixel, float r, float g, float b);
+
+  // Linear RGB, rows top to bottom, averaged over `samples_per_pixel`.
+  std::vector<float> resolve(std::uint32_t samples_per_pixel) const;
+
+  std::uint64_t rejected_contributions() const { return rejected_.load(std::memory_order_relaxed); }
+
+  // 2^-24 resolution; sums up to about 5e11 per pixel and channel before overflow.
+  static constexpr double kScale = 16777216.0;
+  static constexpr float kMaxContribution = 1e9f;
+
+ private:
+  std::uint32_t width_, height_;
+  std::unique_ptr<std::int64_t[]> sums_;  // r, g, b per pixel
+  std::atomic<std::uint64_t> rejected_{0};
+};
+
+}  // namespace wavetrace

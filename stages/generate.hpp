@@ -1,0 +1,46 @@
+// generate: camera rays for every (pixel, sample) of the image, in scanline or Z-curve
+// pixel order, a batch at a time.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "memory/ray_batch.hpp"
+#include "scene/camera.hpp"
+
+namespace wavetrace {
+
+enum class PixelOrder { scanline, zcurve };
+PixelOrder parse_pixel_order(const std::string& text);
+
+struct ImageSpec {
+  std::uint32_t width = 640;
+  std::uint32_t height = 480;
+  std::uint32_t samples_per_pixel = 8;
+  std::uint32_t pixel_count() const { return width * height; }
+};
+
+class GenerateStage {
+ public:
+  GenerateStage(const Camera& camera, const ImageSpec& image, PixelOrder order);
+
+  std::string name() const { return "generate"; }
+  std::uint64_t total_rays() const { return total_; }
+  std::uint64_t generated() const { return next_.load(std::memory_order_relaxed); }
+  bool exhausted() const { return generated() >= total_; }
+
+  // Fills `rays` with the next camera rays (up to its capacity); returns how many.
+  // Not reentrant: the pipeline calls it from one serial node.
+  std::size_t fill(RayBatch& rays);
+
+ private:
+  CameraFrame frame_;
+  ImageSpec image_;
+  std::vector<std::uint32_t> pixel_order_;  // empty: scanline
+  std::uint64_t total_;
+  std::atomic<std::uint64_t> next_{0};
+};
+
+}  // namespace wavetrace

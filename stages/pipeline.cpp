@@ -1,0 +1,180 @@
+// Flow-graph nodes around stages, ray accounting, and the threaded run.
+#include "stages/pipeline.hpp"
+
+#include <condition_variable>
+#include <mutex>
+#include <thread>
+
+#include <tbb/info.h>
+#include <tbb/task_arena.h>
+#include <tbb/task_scheduler_observer.h>
+
+#include "accel/embree/embree_accelerator.hpp"
+
+namespace wavetrace {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::uint64_t nanoseconds_since(Clock::time_point start) {
+  return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - start).count());
+}
+
+// Routes a stage's output into its node's port, counting rays as they enter the graph
+// before they can be seen (and retired) downstream.
+class PortOutput final : public StageOutput {
+ public:
+  PortOutput(PipelineContext& context, BatchNode::output_ports_type& ports) : context_(context), ports_(ports) {}
+  void emit(Batch* batch) override {
+    emitted_rays += batch->rays.count;
+    context_.add_rays(batch->rays.count);
+    std::get<0>(ports_).try_put(batch);
+  }
+  Batch* acquire() override { return context_.pool().acquire(); }
+  void release(Batch* batch) override { context_.pool().release(batch); }
+  std::size_t emitted_rays = 0;
+
+ private:
+  PipelineContext& context_;
+  BatchNode::output_ports_type& ports_;
+};
+
+// Every thread of the arena traces: give each the float mode Embree asks for.
+class FloatModeObserver final : public tbb::task_scheduler_observer {
+ public:
+  explicit FloatModeObserver(tbb::task_arena& arena) : tbb::task_scheduler_observer(arena) { observe(true); }
+  ~FloatModeObserver() override { observe(false); }
+  void on_scheduler_entry(bool) override { set_embree_thread_float_mode(); }
+};
+
+}  // namespace
+
+PipelineContext::PipelineContext(std::size_t batch_capacity, std::size_t rays_in_flight)
+    : pool_(batch_capacity), budget_(std::max(rays_in_flight, 2 * batch_capacity)) {}
+
+void PipelineContext::retire_rays(std::size_t count) {
+  const std::int64_t now = live_rays_.fetch_sub(std::int64_t(count), std::memory_order_acq_rel) - std::int64_t(count);
+  if (generator_node_ != nullptr && !generator_stage_->exhausted() &&
+      now + std::int64_t(pool_.batch_capacity()) <= std::int64_t(budget_)) {
+    generator_node_->try_put(tbb::flow::continue_msg());
+  }
+}
+
+std::unique_ptr<GenerateNode> make_generate_node(tbb::flow::graph& graph, GenerateStage& stage,
+                                                 PipelineContext& context, StageCounters& counters) {
+  auto node = std::make_unique<GenerateNode>(
+      graph, tbb::flow::serial, [&stage, &context, &counters](tbb::flow::continue_msg, GenerateNode::output_ports_type& ports) {
+        const std::int64_t capacity = std::int64_t(context.pool().batch_capacity());
+        while (!stage.exhausted() && context.live_rays() + capacity <= std::int64_t(context.budget())) {
+          const Clock::time_point start = Clock::now();
+          Batch* batch = context.pool().acquire();
+          const std::size_t made = stage.fill(batch->rays);
+          counters.record(0, made, nanoseconds_since(start));
+          context.add_rays(made);
+          std::get<0>(ports).try_put(batch);
+        }
+      });
+  context.attach_generator(node.get(), &stage);
+  return node;
+}
+
+std::unique_ptr<BatchNode> make_stage_node(tbb::flow::graph& graph, const Stage& stage, PipelineContext& context,
+                                           StageCounters& counters) {
+  return std::make_unique<BatchNode>(
+      graph, tbb::flow::unlimited, [&stage, &context, &counters](Batch* batch, BatchNode::output_ports_type& ports) {
+        const Clock::time_point start = Clock::now();
+        const std::size_t rays_in = batch->rays.count;
+        PortOutput out(context, ports);
+        stage.process(batch, out);
+        counters.record(rays_in, out.emitted_rays, nanoseconds_since(start));
+        context.retire_rays(rays_in);
+      });
+}
+
+std::unique_ptr<tbb::flow::function_node<Batch*>> make_retire_node(tbb::flow::graph& graph, PipelineContext& context) {
+  return std::make_unique<tbb::flow::function_node<Batch*>>(graph, tbb::flow::unlimited, [&context](Batch* batch) {
+    const std::size_t count = batch->rays.count;
+    context.pool().release(batch);
+    context.retire_rays(count);
+    return tbb::flow::continue_msg();
+  });
+}
+
+Pipeline::Pipeline(GenerateStage& generate, std::vector<const Stage*> chain, bool loops, const PipelineOptions& options)
+    : generate_(generate), chain_(std::move(chain)), loops_(loops), options_(options) {}
+
+PipelineRun Pipeline::run(const std::function<void(const Progress&)>& on_progress, std::chrono::milliseconds interval) {
+  const int threads = options_.threads > 0 ? options_.threads : tbb::info::default_concurrency();
+  tbb::task_arena arena(threads);
+  FloatModeObserver float_mode(arena);
+
+  StageCounters generate_counters(generate_.name());
+  std::vector<std::unique_ptr<StageCounters>> counters;
+  for (const Stage* stage : chain_) counters.push_back(std::make_unique<StageCounters>(stage->name()));
+  const StageCounters* trace_counters = nullptr;
+  for (const auto& c : counters) {
+    if (c->snapshot().name == "trace") trace_counters = c.get();
+  }
+
+  PipelineContext context(options_.batch_size, options_.rays_in_flight);
+  const Clock::time_point start = Clock::now();
+
+  // Progress reporting runs beside the graph and stops when it drains.
+  std::mutex done_mutex;
+  std::condition_variable done_signal;
+  bool done = false;
+  std::thread reporter;
+  if (on_progress) {
+    reporter = std::thread([&] {
+      std::unique_lock lock(done_mutex);
+      while (!done_signal.wait_for(lock, interval, [&] { return done; })) {
+        on_progress({generate_.generated(), generate_.total_rays(), trace_counters ? trace_counters->rays_in() : 0,
+                     std::chrono::duration<double>(Clock::now() - start).count()});
+      }
+    });
+  }
+
+  arena.execute([&] {
+    set_embree_thread_float_mode();
+    tbb::flow::graph graph;
+    auto generate_node = make_generate_node(graph, generate_, context, generate_counters);
+    std::vector<std::unique_ptr<BatchNode>> nodes;
+    for (std::size_t i = 0; i < chain_.size(); ++i) nodes.push_back(make_stage_node(graph, *chain_[i], context, *counters[i]));
+    std::unique_ptr<tbb::flow::function_node<Batch*>> retire;
+    if (nodes.empty()) {
+      retire = make_retire_node(graph, context);
+      tbb::flow::make_edge(tbb::flow::output_port<0>(*generate_node), *retire);
+    } else {
+      tbb::flow::make_edge(tbb::flow::output_port<0>(*generate_node), *nodes.front());
+      for (std::size_t i = 0; i + 1 < nodes.size(); ++i) {
+        tbb::flow::make_edge(tbb::flow::output_port<0>(*nodes[i]), *nodes[i + 1]);
+      }
+      if (loops_) {
+        tbb::flow::make_edge(tbb::flow::output_port<0>(*nodes.back()), *nodes.front());
+      } else {
+        retire = make_retire_node(graph, context);
+        tbb::flow::make_edge(tbb::flow::output_port<0>(*nodes.back()), *retire);
+      }
+    }
+    generate_node->try_put(tbb::flow::continue_msg());
+    graph.wait_for_all();
+  });
+
+  PipelineRun result;
+  result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  if (reporter.joinable()) {
+    {
+      std::lock_guard lock(done_mutex);
+      done = true;
+    }
+    done_signal.notify_all();
+    reporter.join();
+  }
+  result.threads = threads;
+  result.stages.push_back(generate_counters.snapshot());
+  for (const auto& c : counters) result.stages.push_back(c->snapshot());
+  result.batches_allocated = context.pool().allocated();
+  return result;
+}
+
+}  // namespace wavetrace

@@ -1,0 +1,113 @@
+// Config to plan, plan to stages, stages to image.
+#include "stages/render_setup.hpp"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+
+#include "stages/shade.hpp"
+#include "stages/spawn.hpp"
+#include "stages/trace.hpp"
+
+namespace wavetrace {
+namespace {
+
+void check_stage_order(const std::vector<std::string>& names) {
+  const auto position = [&](std::string_view name) {
+    return std::find(names.begin(), names.end(), name) - names.begin();
+  };
+  const auto present = [&](std::string_view name) { return position(name) < std::ptrdiff_t(names.size()); };
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (std::count(names.begin(), names.end(), names[i]) > 1) {
+      throw ConfigError(fmt::format("pipeline.stages: '{}' appears more than once", names[i]));
+    }
+  }
+  if (names.empty() || names.front() != "generate") {
+    throw ConfigError("pipeline.stages: must start with 'generate'");
+  }
+  if (present("shade") && (!present("trace") || position("trace") > position("shade"))) {
+    throw ConfigError("pipeline.stages: 'shade' needs 'trace' before it");
+  }
+  if (present("spawn") && (!present("shade") || position("shade") > position("spawn"))) {
+    throw ConfigError("pipeline.stages: 'spawn' needs 'shade' before it");
+  }
+  if (present("spawn") && names.back() != "spawn") {
+    throw ConfigError("pipeline.stages: 'spawn' must be last (its rays go back to the start of the chain)");
+  }
+}
+
+}  // namespace
+
+RenderPlan plan_render(const Config& config) {
+  RenderPlan plan;
+  plan.scene.source = config.text("scene.source");
+  plan.scene.subdivide = static_cast<int>(config.integer("scene.subdivide"));
+  if (config.has("camera.position")) plan.camera.position = config.vector3("camera.position");
+  if (config.has("camera.look_at")) plan.camera.look_at = config.vector3("camera.look_at");
+  plan.camera.up = config.vector3("camera.up");
+  if (config.has("camera.fov")) plan.camera.vertical_fov_degrees = static_cast<float>(config.real("camera.fov"));
+
+  plan.image.width = static_cast<std::uint32_t>(config.integer("render.width"));
+  plan.image.height = static_cast<std::uint32_t>(config.integer("render.height"));
+  plan.image.samples_per_pixel = static_cast<std::uint32_t>(config.integer("render.spp"));
+  if (std::uint64_t(plan.image.width) * plan.image.height * plan.image.samples_per_pixel > (std::uint64_t{1} << 40)) {
+    throw ConfigError("render: width x height x spp is over 2^40 rays");
+  }
+  plan.pixel_order = parse_pixel_order(config.text("render.pixel_order"));
+  plan.rules.max_depth = static_cast<std::uint32_t>(config.integer("render.max_depth"));
+  plan.rules.russian_roulette_depth = static_cast<std::uint32_t>(config.integer("render.russian_roulette_depth"));
+  plan.pipeline.batch_size = static_cast<std::size_t>(config.integer("render.batch_size"));
+  plan.pipeline.rays_in_flight = static_cast<std::size_t>(config.integer("render.rays_in_flight"));
+  plan.pipeline.threads = static_cast<int>(config.integer("render.threads"));
+
+  plan.accelerator.type = config.text("accel.type");
+  plan.accelerator.embree.mode = parse_embree_mode(config.text("accel.embree.mode"));
+  plan.accelerator.embree.threads = plan.pipeline.threads;
+
+  plan.stages = config.text_list("pipeline.stages");
+  check_stage_order(plan.stages);
+  return plan;
+}
+
+Camera resolve_camera(const CameraOverride& override, const Scene& scene) {
+  Camera camera = scene.camera.value_or(frame_bounds(scene.mesh.bounds()));
+  if (override.position) camera.position = *override.position;
+  if (override.look_at) camera.look_at = *override.look_at;
+  camera.up = override.up;
+  if (override.vertical_fov_degrees) camera.vertical_fov_degrees = *override.vertical_fov_degrees;
+  validate_camera(camera);
+  return camera;
+}
+
+StageChain::StageChain(const std::vector<std::string>& names, const World& world, Film& film, const PathRules& rules) {
+  for (const std::string& name : names) {
+    if (name == "generate") continue;
+    if (name == "trace") owned_.push_back(std::make_unique<TraceStage>(world.accelerator));
+    if (name == "shade") owned_.push_back(std::make_unique<ShadeStage>(world, film, rules));
+    if (name == "spawn") {
+      owned_.push_back(std::make_unique<SpawnStage>(world, rules));
+      loops_ = true;
+    }
+  }
+}
+
+std::vector<const Stage*> StageChain::stages() const {
+  std::vector<const Stage*> stages;
+  for (const auto& stage : owned_) stages.push_back(stage.get());
+  return stages;
+}
+
+RenderOutput render_image(const RenderPlan& plan, const World& world, const Camera& camera,
+                          const std::function<void(const Progress&)>& on_progress) {
+  Film film(plan.image.width, plan.image.height);
+  GenerateStage generate(camera, plan.image, plan.pixel_order);
+  const StageChain chain(plan.stages, world, film, plan.rules);
+  Pipeline pipeline(generate, chain.stages(), chain.loops(), plan.pipeline);
+  RenderOutput output;
+  output.run = pipeline.run(on_progress);
+  output.image = film.resolve(plan.image.samples_per_pixel);
+  output.rejected_contributions = film.rejected_contributions();
+  return output;
+}
+
+}  // namespace wavetrace

@@ -1,0 +1,66 @@
+// From a checked config to a running render: the plan (every setting, typed), the stage
+// chain it names, and one call that renders an image through the pipeline.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "accel/registry.hpp"
+#include "scene/scene.hpp"
+#include "stages/config.hpp"
+#include "stages/film.hpp"
+#include "stages/generate.hpp"
+#include "stages/path_rules.hpp"
+#include "stages/pipeline.hpp"
+#include "stages/world.hpp"
+
+namespace wavetrace {
+
+struct CameraOverride {
+  std::optional<glm::vec3> position, look_at;
+  glm::vec3 up{0.0f, 1.0f, 0.0f};
+  std::optional<float> vertical_fov_degrees;
+};
+
+struct RenderPlan {
+  SceneRequest scene;
+  CameraOverride camera;
+  ImageSpec image;
+  PixelOrder pixel_order = PixelOrder::scanline;
+  PathRules rules;
+  PipelineOptions pipeline;
+  AcceleratorOptions accelerator;
+  std::vector<std::string> stages;
+};
+
+// Reads every key; throws ConfigError for a stage list that cannot run.
+RenderPlan plan_render(const Config& config);
+
+// The camera: the config's keys over the scene's own camera over one framing the bounds.
+Camera resolve_camera(const CameraOverride& override, const Scene& scene);
+
+// Owns the stage objects a plan names, in chain order (generate excluded).
+class StageChain {
+ public:
+  StageChain(const std::vector<std::string>& names, const World& world, Film& film, const PathRules& rules);
+  std::vector<const Stage*> stages() const;
+  bool loops() const { return loops_; }
+
+ private:
+  std::vector<std::unique_ptr<Stage>> owned_;
+  bool loops_ = false;
+};
+
+struct RenderOutput {
+  PipelineRun run;
+  std::vector<float> image;  // linear RGB, top row first
+  std::uint64_t rejected_contributions = 0;
+};
+
+RenderOutput render_image(const RenderPlan& plan, const World& world, const Camera& camera,
+                          const std::function<void(const Progress&)>& on_progress = {});
+
+}  // namespace wavetrace

@@ -1,0 +1,61 @@
+// Film contributions and Russian roulette, one pass over the batch.
+#include "stages/shade.hpp"
+
+#include <glm/geometric.hpp>
+
+#include "kernels/random.hpp"
+
+namespace wavetrace {
+
+void ShadeStage::process(Batch* batch, StageOutput& out) const {
+  RayBatch& rays = batch->rays;
+  const HitBatch& hits = batch->hits;
+  const Scene& scene = world_.scene;
+  std::size_t survivors = 0;
+  for (std::size_t i = 0; i < rays.count; ++i) {
+    if (!(rays.flags[i] & ray_flags::alive)) continue;
+    const glm::vec3 throughput(rays.throughput_r[i], rays.throughput_g[i], rays.throughput_b[i]);
+    if (rays.kind[i] == RayKind::shadow) {
+      if (!hits.is_hit(i)) film_.add(rays.pixel[i], throughput.r, throughput.g, throughput.b);
+      rays.flags[i] = 0;
+      continue;
+    }
+    if (!hits.is_hit(i)) {
+      const glm::vec3 sky = throughput * scene.background;
+      film_.add(rays.pixel[i], sky.r, sky.g, sky.b);
+      rays.flags[i] = 0;
+      continue;
+    }
+    const std::uint32_t triangle = hits.primitive[i];
+    const Material& material = scene.materials[scene.mesh.material(triangle)];
+    if (material.emissive() && rays.kind[i] == RayKind::camera) {
+      // Bounce rays do not count emission: next-event estimation already sampled the lights.
+      const glm::uvec3& corners = scene.mesh.triangles[triangle];
+      const glm::vec3& a = scene.mesh.positions[corners.x];
+      const glm::vec3 normal = glm::cross(scene.mesh.positions[corners.y] - a, scene.mesh.positions[corners.z] - a);
+      const glm::vec3 direction(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]);
+      if (glm::dot(normal, direction) < 0.0f) {
+        const glm::vec3 light = throughput * material.emission;
+        film_.add(rays.pixel[i], light.r, light.g, light.b);
+      }
+    }
+    if (material.albedo == glm::vec3(0.0f)) {
+      rays.flags[i] = 0;
+      continue;
+    }
+    bool continues = rules_.may_bounce(rays.depth[i]);
+    if (continues && rules_.roulette_applies(rays.depth[i])) {
+      const float u = unit_float(random_bits(rays.pixel[i], rays.sample[i], rays.depth[i], RandomPurpose::russian_roulette));
+      continues = u < survival_probability(material.albedo);
+    }
+    rays.flags[i] = continues ? std::uint8_t(ray_flags::alive | ray_flags::continues) : ray_flags::alive;
+    ++survivors;
+  }
+  if (survivors == 0) {
+    out.release(batch);
+  } else {
+    out.emit(batch);
+  }
+}
+
+}  // namespace wavetrace

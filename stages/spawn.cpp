@@ -1,0 +1,105 @@
+// Next-event estimation and bounce sampling for a diffuse path tracer.
+#include "stages/spawn.hpp"
+
+#include <limits>
+
+#include <glm/geometric.hpp>
+
+#include "kernels/random.hpp"
+#include "kernels/ray_offset.hpp"
+#include "kernels/sampling.hpp"
+
+namespace wavetrace {
+namespace {
+
+// Shadow rays stop this fraction short of the light so they do not hit the light itself.
+constexpr float kShadowRayShortening = 1e-4f;
+
+void write_ray(RayBatch& to, std::size_t slot, const RayBatch& parent, std::size_t i, const glm::vec3& origin,
+               const glm::vec3& direction, float tmax, RayKind kind, std::uint16_t depth, const glm::vec3& throughput) {
+  to.origin_x[slot] = origin.x;
+  to.origin_y[slot] = origin.y;
+  to.origin_z[slot] = origin.z;
+  to.direction_x[slot] = direction.x;
+  to.direction_y[slot] = direction.y;
+  to.direction_z[slot] = direction.z;
+  to.tmin[slot] = 0.0f;
+  to.tmax[slot] = tmax;
+  to.pixel[slot] = parent.pixel[i];
+  to.sample[slot] = parent.sample[i];
+  to.depth[slot] = depth;
+  to.kind[slot] = kind;
+  to.throughput_r[slot] = throughput.r;
+  to.throughput_g[slot] = throughput.g;
+  to.throughput_b[slot] = throughput.b;
+  to.flags[slot] = ray_flags::alive;
+}
+
+}  // namespace
+
+void SpawnStage::process(Batch* batch, StageOutput& out) const {
+  const RayBatch& rays = batch->rays;
+  const HitBatch& hits = batch->hits;
+  const TriangleMesh& mesh = world_.scene.mesh;
+  const bool has_lights = !world_.lights.empty();
+  Batch* bounces = out.acquire();
+  Batch* shadows = has_lights ? out.acquire() : nullptr;
+
+  for (std::size_t i = 0; i < rays.count; ++i) {
+    if (!(rays.flags[i] & ray_flags::alive)) continue;
+    const std::uint32_t triangle = hits.primitive[i];
+    const glm::uvec3& corners = mesh.triangles[triangle];
+    const glm::vec3 a = mesh.positions[corners.x], b = mesh.positions[corners.y], c = mesh.positions[corners.z];
+    // From barycentrics rather than origin + t * direction: exact to the triangle's plane.
+    const glm::vec3 point = a + (b - a) * hits.u[i] + (c - a) * hits.v[i];
+    const glm::vec3 direction(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]);
+    glm::vec3 normal = glm::normalize(glm::cross(b - a, c - a));
+    if (glm::dot(normal, direction) > 0.0f) normal = -normal;  // two-sided: face the incoming ray
+    const glm::vec3 origin = offset_ray_origin(point, normal);
+    const glm::vec3 albedo = world_.scene.materials[mesh.material(triangle)].albedo;
+    const glm::vec3 throughput(rays.throughput_r[i], rays.throughput_g[i], rays.throughput_b[i]);
+    const std::uint32_t depth = rays.depth[i];
+
+    if (has_lights) {
+      const float choice = unit_float(random_bits(rays.pixel[i], rays.sample[i], depth, RandomPurpose::light_choice));
+      const UnitPair uv = unit_pair(random_bits(rays.pixel[i], rays.sample[i], depth, RandomPurpose::light_point));
+      const LightSample light = world_.lights.sample(choice, uv.first, uv.second);
+      const glm::vec3 to_light = light.point - origin;
+      const float distance_squared = glm::dot(to_light, to_light);
+      const float distance = std::sqrt(distance_squared);
+      const glm::vec3 toward = to_light / distance;
+      const float cos_surface = glm::dot(normal, toward);
+      const float cos_light = -glm::dot(light.normal, toward);
+      if (cos_surface > 0.0f && cos_light > 0.0f && distance_squared > 0.0f) {
+        const glm::vec3 carried = throughput * albedo * (1.0f / kPi) * light.emission *
+                                  (cos_surface * cos_light / (distance_squared * light.pdf_area));
+        RayBatch& to = shadows->rays;
+        write_ray(to, to.count++, rays, i, origin, toward, distance * (1.0f - kShadowRayShortening),
+                  RayKind::shadow, static_cast<std::uint16_t>(depth), carried);
+      }
+    }
+
+    if (rays.flags[i] & ray_flags::continues) {
+      const UnitPair uv = unit_pair(random_bits(rays.pixel[i], rays.sample[i], depth, RandomPurpose::bounce_direction));
+      const glm::vec3 bounce = cosine_hemisphere(normal, uv.first, uv.second);
+      // Cosine-weighted sampling of a Lambertian surface: f cos / pdf = albedo.
+      glm::vec3 next = throughput * albedo;
+      if (rules_.roulette_applies(depth)) next /= survival_probability(albedo);
+      RayBatch& to = bounces->rays;
+      write_ray(to, to.count++, rays, i, origin, bounce, std::numeric_limits<float>::infinity(), RayKind::bounce,
+                static_cast<std::uint16_t>(depth + 1), next);
+    }
+  }
+
+  out.release(batch);
+  for (Batch* made : {bounces, shadows}) {
+    if (made == nullptr) continue;
+    if (made->rays.count == 0) {
+      out.release(made);
+    } else {
+      out.emit(made);
+    }
+  }
+}
+
+}  // namespace wavetrace

@@ -1,0 +1,23 @@
+// spawn: from each surviving hit, a shadow ray toward a light sample (carrying the light
+// it would deliver) and, if the path continues, a cosine-weighted bounce ray; each kind
+// goes out in its own batch.
+#pragma once
+
+#include "stages/path_rules.hpp"
+#include "stages/stage.hpp"
+#include "stages/world.hpp"
+
+namespace wavetrace {
+
+class SpawnStage final : public Stage {
+ public:
+  SpawnStage(const World& world, const PathRules& rules) : world_(world), rules_(rules) {}
+  std::string name() const override { return "spawn"; }
+  void process(Batch* batch, StageOutput& out) const override;
+
+ private:
+  const World& world_;
+  PathRules rules_;
+};
+
+}  // namespace wavetrace
