@@ -24,8 +24,15 @@ SubdivisionResult loop_subdivide(const TriangleMesh& mesh, int levels) {
       ++result.non_manifold_faces_dropped;
     }
   }
+  // Unused vertices have no neighbours for Loop's averaging; remove them first.
+  kernel.request_vertex_status();
+  kernel.request_edge_status();
+  kernel.request_face_status();
   kernel.delete_isolated_vertices();
   kernel.garbage_collection();
+  kernel.release_vertex_status();
+  kernel.release_edge_status();
+  kernel.release_face_status();
 
   OpenMesh::Subdivider::Uniform::LoopT<OpenMeshTriangles> loop;
   loop.attach(kernel);

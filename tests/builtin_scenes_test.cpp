@@ -1,0 +1,120 @@
+// Procedural scenes: triangle counts, closedness where promised, orientation, determinism.
+#include <gtest/gtest.h>
+
+#include <glm/geometric.hpp>
+
+#include "scene/builtin_scenes.hpp"
+#include "scene/mesh_report.hpp"
+#include "scene/subdivide.hpp"
+
+namespace wavetrace {
+namespace {
+
+double signed_volume(const TriangleMesh& mesh) {
+  double volume = 0.0;
+  for (const glm::uvec3& t : mesh.triangles) {
+    volume += glm::dot(glm::dvec3(mesh.positions[t.x]),
+                       glm::cross(glm::dvec3(mesh.positions[t.y]), glm::dvec3(mesh.positions[t.z]))) / 6.0;
+  }
+  return volume;
+}
+
+TEST(BuiltinScenes, SphereCountsFollowTheIcosphereLattice) {
+  EXPECT_EQ(make_builtin_scene("builtin:sphere:20").mesh.triangle_count(), 20u);
+  const Scene sphere = make_builtin_scene("builtin:sphere:100k");
+  const std::size_t n = 71;  // round(sqrt(100000 / 20))
+  EXPECT_EQ(sphere.mesh.triangle_count(), 20 * n * n);
+  EXPECT_EQ(sphere.mesh.vertex_count(), 10 * n * n + 2);
+}
+
+TEST(BuiltinScenes, SphereIsClosedManifoldAndFacesOutward) {
+  for (const char* source : {"builtin:sphere:20", "builtin:sphere:80", "builtin:sphere:50k"}) {
+    const Scene sphere = make_builtin_scene(source);
+    const MeshReport report = analyze_mesh(sphere.mesh);
+    EXPECT_TRUE(report.closed()) << source;
+    EXPECT_EQ(report.connected_components, 1u) << source;
+    EXPECT_EQ(report.degenerate_triangles, 0u) << source;
+    EXPECT_GT(signed_volume(sphere.mesh), 2.0) << source;  // about 4/3 pi for radius ~1
+  }
+}
+
+TEST(BuiltinScenes, SoupSharesNoVertex) {
+  const Scene soup = make_builtin_scene("builtin:soup:2000");
+  const MeshReport report = analyze_mesh(soup.mesh);
+  EXPECT_EQ(report.connected_components, soup.mesh.triangle_count());
+  EXPECT_EQ(report.boundary_edges, 3 * soup.mesh.triangle_count());
+  EXPECT_EQ(soup.mesh.triangle_count(), make_builtin_scene("builtin:sphere:2000").mesh.triangle_count());
+}
+
+TEST(BuiltinScenes, TerrainIsOneOpenSheet) {
+  const Scene terrain = make_builtin_scene("builtin:terrain:20000");
+  const MeshReport report = analyze_mesh(terrain.mesh);
+  EXPECT_EQ(terrain.mesh.triangle_count(), 2u * 100 * 100);
+  EXPECT_EQ(report.connected_components, 1u);
+  EXPECT_EQ(report.boundary_edges, 4u * 100);
+  EXPECT_EQ(report.non_manifold_edges, 0u);
+}
+
+TEST(BuiltinScenes, StadiumIsASmallSphereInAHugeClosedBox) {
+  const Scene stadium = make_builtin_scene("builtin:stadium:10k");
+  const MeshReport report = analyze_mesh(stadium.mesh);
+  EXPECT_TRUE(report.closed());
+  EXPECT_EQ(report.connected_components, 2u);
+  EXPECT_GT(report.bounds.extent().x, 900.0f);
+  EXPECT_GT(signed_volume(stadium.mesh), -1e9 * 1.01);
+  EXPECT_LT(signed_volume(stadium.mesh), 0.0);  // the box faces inward
+}
+
+TEST(BuiltinScenes, FurIsManyDisconnectedStrands) {
+  const Scene fur = make_builtin_scene("builtin:fur:24000");
+  const MeshReport report = analyze_mesh(fur.mesh);
+  EXPECT_GT(report.connected_components, 800u);
+  EXPECT_EQ(report.degenerate_triangles, 0u);
+}
+
+TEST(BuiltinScenes, DefaultHasALightAndACamera) {
+  const Scene scene = make_builtin_scene("builtin:default");
+  EXPECT_TRUE(scene.camera.has_value());
+  bool emissive = false;
+  for (std::size_t t = 0; t < scene.mesh.triangle_count(); ++t) emissive |= scene.materials[scene.mesh.material(t)].emissive();
+  EXPECT_TRUE(emissive);
+}
+
+TEST(BuiltinScenes, GenerationIsDeterministic) {
+  const Scene a = make_builtin_scene("builtin:fur:5000");
+  const Scene b = make_builtin_scene("builtin:fur:5000");
+  ASSERT_EQ(a.mesh.vertex_count(), b.mesh.vertex_count());
+  for (std::size_t i = 0; i < a.mesh.vertex_count(); ++i) ASSERT_EQ(a.mesh.positions[i], b.mesh.positions[i]);
+  for (std::size_t t = 0; t < a.mesh.triangle_count(); ++t) ASSERT_EQ(a.mesh.triangles[t], b.mesh.triangles[t]);
+}
+
+TEST(BuiltinScenes, BadNamesAndCountsAreErrors) {
+  EXPECT_THROW(make_builtin_scene("builtin:teapot"), SceneError);
+  EXPECT_THROW(make_builtin_scene("builtin:sphere:lots"), SceneError);
+  EXPECT_THROW(make_builtin_scene("builtin:sphere:0"), SceneError);
+  EXPECT_THROW(make_builtin_scene("builtin:sphere:-5"), SceneError);
+  EXPECT_EQ(parse_triangle_count("8M", "x"), 8000000u);
+  EXPECT_EQ(parse_triangle_count("250k", "x"), 250000u);
+  EXPECT_EQ(parse_triangle_count("1.5M", "x"), 1500000u);
+}
+
+TEST(Subdivision, LoopQuadruplesAndKeepsClosed) {
+  const Scene sphere = make_builtin_scene("builtin:sphere:320");
+  const SubdivisionResult once = loop_subdivide(sphere.mesh, 1);
+  const SubdivisionResult twice = loop_subdivide(sphere.mesh, 2);
+  EXPECT_EQ(once.mesh.triangle_count(), 4 * sphere.mesh.triangle_count());
+  EXPECT_EQ(twice.mesh.triangle_count(), 16 * sphere.mesh.triangle_count());
+  EXPECT_EQ(twice.non_manifold_faces_dropped, 0u);
+  EXPECT_TRUE(analyze_mesh(twice.mesh).closed());
+  EXPECT_GT(signed_volume(twice.mesh), 2.0);
+}
+
+TEST(Subdivision, SceneRequestSubdividesRealMeshes) {
+  const Scene scene = load_scene({std::string(WAVETRACE_DATA_DIR) + "/bunny00.off", 1});
+  EXPECT_EQ(scene.mesh.triangle_count(), 4u * 75408);
+  EXPECT_EQ(scene.subdivision_levels, 1u);
+  EXPECT_THROW(load_scene({"builtin:sphere:20", 9}), SceneError);
+}
+
+}  // namespace
+}  // namespace wavetrace

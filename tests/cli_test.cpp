@@ -1,0 +1,109 @@
+// The command line end to end: render writes images and stats; bad input exits non-zero
+// with a one-line error naming the problem.
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "test_support.hpp"
+
+namespace wavetrace {
+namespace {
+
+using testing::run_wavetrace;
+
+std::string temp_dir() {
+  const auto dir = std::filesystem::temp_directory_path() / "wavetrace_cli_tests";
+  std::filesystem::create_directories(dir);
+  return dir.string();
+}
+
+TEST(Cli, RenderWritesExrPngAndStats) {
+  const std::string dir = temp_dir();
+  const auto result = run_wavetrace("render builtin:default:2000 --size 32x24 --spp 1 --threads 2 --out " + dir +
+                                    "/image.exr --stats " + dir + "/stats.json");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_TRUE(std::filesystem::file_size(dir + "/image.exr") > 0);
+  EXPECT_TRUE(std::filesystem::file_size(dir + "/image.png") > 0);
+  EXPECT_NE(result.output.find("trace"), std::string::npos);
+  std::ifstream file(dir + "/stats.json");
+  const nlohmann::json stats = nlohmann::json::parse(file);
+  EXPECT_EQ(stats["scene"]["triangles"].get<std::size_t>(), 2000u + 4);
+  for (const char* key : {"vertices", "bounds", "degenerate_dropped"}) EXPECT_TRUE(stats["scene"].contains(key)) << key;
+  for (const char* key : {"type", "bytes", "bytes_per_triangle", "parts", "build_seconds", "build_peak_bytes"}) {
+    EXPECT_TRUE(stats["accel"].contains(key)) << key;
+  }
+  EXPECT_EQ(stats["accel"]["type"], "embree");
+  ASSERT_EQ(stats["stages"].size(), 4u);
+  for (const auto& stage : stats["stages"]) {
+    for (const char* key : {"name", "rays_in", "rays_out", "seconds", "mrays_per_s"}) EXPECT_TRUE(stage.contains(key));
+  }
+  EXPECT_EQ(stats["stages"][0]["rays_out"].get<std::size_t>(), 32u * 24);
+  EXPECT_EQ(stats["image"]["width"], 32);
+  EXPECT_EQ(stats["image"]["spp"], 1);
+  EXPECT_EQ(stats["image"]["path"], dir + "/image.exr");
+}
+
+TEST(Cli, RenderReadsConfigFileAndOverrides) {
+  const std::string dir = temp_dir();
+  const std::string config = testing::write_temp_file(
+      "render.toml", "[scene]\nsource = \"builtin:sphere:500\"\n[render]\nwidth = 16\nheight = 8\nspp = 1\n");
+  const auto result = run_wavetrace("render --config " + config + " --set render.width=20 --set accel.embree.mode=robust --out " +
+                                    dir + "/config.exr --stats " + dir + "/config.json");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  std::ifstream file(dir + "/config.json");
+  const nlohmann::json stats = nlohmann::json::parse(file);
+  EXPECT_EQ(stats["image"]["width"], 20);
+  EXPECT_EQ(stats["image"]["height"], 8);
+  EXPECT_EQ(stats["accel"]["type"], "embree-robust");
+  EXPECT_EQ(stats["scene"]["source"], "builtin:sphere:500");
+}
+
+struct BadInput {
+  std::string arguments;
+  std::string message;
+};
+
+class CliBadInput : public ::testing::TestWithParam<BadInput> {};
+
+TEST_P(CliBadInput, FailsWithOneLineNamingTheProblem) {
+  const auto result = run_wavetrace(GetParam().arguments + " --out " + temp_dir() + "/never.exr");
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find(GetParam().message), std::string::npos) << result.output;
+  EXPECT_EQ(result.output.find('\n'), result.output.size() - 1) << "one line: " << result.output;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, CliBadInput,
+    ::testing::Values(BadInput{"render /nonexistent.off", "/nonexistent.off: no such mesh file"},
+                      BadInput{"render builtin:teapot", "unknown builtin scene 'teapot'"},
+                      BadInput{"render --accel octree", "accel.type = 'octree' is not one of"},
+                      BadInput{"render --set render.nope=1", "unknown config key 'render.nope'"},
+                      BadInput{"render --set render.spp=-1", "render.spp = -1 is out of range"},
+                      BadInput{"render --size 10by10", "--size '10by10'"},
+                      BadInput{"render --set pipeline.stages=generate,shade", "'shade' needs 'trace'"},
+                      BadInput{"render --set camera.look_at=0,2.4,5.8", "look_at equals position"},
+                      BadInput{"render --config /nonexistent.toml", "/nonexistent.toml"}),
+    [](const ::testing::TestParamInfo<BadInput>& info) { return "case" + std::to_string(info.index); });
+
+TEST(Cli, InfoReportsTopology) {
+  const auto result = run_wavetrace("info builtin:sphere:80 --json");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const nlohmann::json info = nlohmann::json::parse(result.output);
+  EXPECT_EQ(info["triangles"], 80);
+  EXPECT_EQ(info["closed"], true);
+  EXPECT_EQ(info["connected_components"], 1);
+  EXPECT_EQ(info["degenerate_dropped"], 0);
+}
+
+TEST(Cli, InfoCountsDroppedDegenerates) {
+  const std::string path =
+      testing::write_temp_file("cli_degenerate.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 3\nf 1 2 4\n");
+  const auto result = run_wavetrace("info " + path + " --json");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_EQ(nlohmann::json::parse(result.output)["degenerate_dropped"], 1);
+}
+
+}  // namespace
+}  // namespace wavetrace

@@ -1,0 +1,113 @@
+// Config: defaults, TOML files, --set overrides, and every kind of bad input naming its key.
+#include <gtest/gtest.h>
+
+#include "stages/config.hpp"
+#include "stages/render_setup.hpp"
+#include "test_support.hpp"
+
+namespace wavetrace {
+namespace {
+
+void expect_config_error(const std::function<void()>& action, const std::string& fragment) {
+  try {
+    action();
+    FAIL() << "no error; expected one mentioning " << fragment;
+  } catch (const ConfigError& error) {
+    EXPECT_NE(std::string(error.what()).find(fragment), std::string::npos) << error.what();
+  }
+}
+
+TEST(Config, DefaultsCoverEveryKeyWithADefault) {
+  const Config config;
+  EXPECT_EQ(config.text("scene.source"), "builtin:default");
+  EXPECT_EQ(config.integer("render.spp"), 8);
+  EXPECT_EQ(config.text("accel.type"), "embree");
+  EXPECT_FALSE(config.has("camera.position"));
+  EXPECT_EQ(config.text_list("pipeline.stages").size(), 4u);
+}
+
+TEST(Config, LoadsTomlWithNestedTables) {
+  Config config;
+  config.load_string(R"(
+[scene]
+source = "builtin:sphere:1k"
+[camera]
+position = [1, 2, 3.5]
+fov = 55
+[render]
+spp = 3
+pixel_order = "zcurve"
+[accel.embree]
+mode = "robust"
+[pipeline]
+stages = ["generate", "trace"]
+)");
+  EXPECT_EQ(config.text("scene.source"), "builtin:sphere:1k");
+  EXPECT_EQ(config.vector3("camera.position"), glm::vec3(1.0f, 2.0f, 3.5f));
+  EXPECT_DOUBLE_EQ(config.real("camera.fov"), 55.0);
+  EXPECT_EQ(config.integer("render.spp"), 3);
+  EXPECT_EQ(config.text("accel.embree.mode"), "robust");
+  EXPECT_EQ(config.text_list("pipeline.stages"), (std::vector<std::string>{"generate", "trace"}));
+}
+
+TEST(Config, SetParsesByType) {
+  Config config;
+  config.set("render.spp=16");
+  config.set("camera.look_at=0,1,2");
+  config.set("camera.up=[0, 0, 1]");
+  config.set("camera.fov=30.5");
+  config.set("pipeline.stages=generate,trace,shade");
+  config.set("accel.embree.mode=compact");
+  EXPECT_EQ(config.integer("render.spp"), 16);
+  EXPECT_EQ(config.vector3("camera.look_at"), glm::vec3(0, 1, 2));
+  EXPECT_EQ(config.vector3("camera.up"), glm::vec3(0, 0, 1));
+  EXPECT_DOUBLE_EQ(config.real("camera.fov"), 30.5);
+  EXPECT_EQ(config.text_list("pipeline.stages").size(), 3u);
+  EXPECT_EQ(config.text("accel.embree.mode"), "compact");
+}
+
+TEST(Config, BadInputNamesTheKey) {
+  Config config;
+  expect_config_error([&] { config.set("render.sppp=4"); }, "unknown config key 'render.sppp'");
+  expect_config_error([&] { config.set("rendr.spp=4"); }, "unknown config section 'rendr'");
+  expect_config_error([&] { config.set("reorder.heuristic=hph"); }, "reorder.heuristic");
+  expect_config_error([&] { config.set("render.spp=0"); }, "render.spp = 0 is out of range");
+  expect_config_error([&] { config.set("render.spp=many"); }, "render.spp");
+  expect_config_error([&] { config.set("render.width=64.5"); }, "render.width");
+  expect_config_error([&] { config.set("camera.fov=400"); }, "camera.fov");
+  expect_config_error([&] { config.set("camera.position=1,2"); }, "camera.position");
+  expect_config_error([&] { config.set("camera.position=1,nan,2"); }, "camera.position");
+  expect_config_error([&] { config.set("accel.type=octree"); }, "accel.type = 'octree' is not one of");
+  expect_config_error([&] { config.set("pipeline.stages=generate,teleport"); }, "teleport");
+  expect_config_error([&] { config.set("render.spp"); }, "section.key=value");
+  expect_config_error([&] { config.load_string("[render]\nspp = \"eight\"\n"); }, "render.spp");
+  expect_config_error([&] { config.load_string("[render]\nbogus = 1\n"); }, "render.bogus");
+  expect_config_error([&] { config.load_string("spp = 1\n"); }, "inside a section");
+  expect_config_error([&] { config.load_string("[render\nspp = 1\n"); }, "config:");
+  expect_config_error([&] { config.load_file("/nonexistent/config.toml"); }, "/nonexistent/config.toml");
+}
+
+TEST(Config, FileErrorsNameTheFile) {
+  const std::string path = testing::write_temp_file("bad.toml", "[render]\nmax_depth = -3\n");
+  Config config;
+  expect_config_error([&] { config.load_file(path); }, path);
+  expect_config_error([&] { config.load_file(path); }, "render.max_depth");
+}
+
+TEST(Config, StageListsThatCannotRunAreRejected) {
+  const auto plan_with = [](const std::string& stages) {
+    Config config;
+    config.set("pipeline.stages=" + stages);
+    plan_render(config);
+  };
+  plan_with("generate,trace");
+  plan_with("generate,trace,shade");
+  expect_config_error([&] { plan_with("trace,generate"); }, "must start with 'generate'");
+  expect_config_error([&] { plan_with("generate,shade,trace"); }, "'shade' needs 'trace'");
+  expect_config_error([&] { plan_with("generate,trace,spawn"); }, "'spawn' needs 'shade'");
+  expect_config_error([&] { plan_with("generate,trace,trace,shade"); }, "more than once");
+  expect_config_error([&] { plan_with("generate,trace,shade,spawn,shade"); }, "more than once");
+}
+
+}  // namespace
+}  // namespace wavetrace

@@ -1,0 +1,147 @@
+// The Embree reference against analytic answers: distances, primitives, barycentrics,
+// ray intervals, any-hit, memory accounting.
+#include <cmath>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "accel/registry.hpp"
+#include "scene/builtin_scenes.hpp"
+
+namespace wavetrace {
+namespace {
+
+// Two triangles forming the unit square [0,1]^2 at z = 0.
+TriangleMesh unit_square() {
+  TriangleMesh mesh;
+  mesh.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+  validate_and_clean(mesh, "square");
+  return mesh;
+}
+
+void set_ray(RayBatch& rays, std::size_t i, glm::vec3 origin, glm::vec3 direction, float tmin = 0.0f,
+             float tmax = std::numeric_limits<float>::infinity()) {
+  rays.origin_x[i] = origin.x;
+  rays.origin_y[i] = origin.y;
+  rays.origin_z[i] = origin.z;
+  rays.direction_x[i] = direction.x;
+  rays.direction_y[i] = direction.y;
+  rays.direction_z[i] = direction.z;
+  rays.tmin[i] = tmin;
+  rays.tmax[i] = tmax;
+  rays.flags[i] = ray_flags::alive;
+  rays.kind[i] = RayKind::camera;
+}
+
+class EmbreeModes : public ::testing::TestWithParam<EmbreeMode> {};
+
+TEST_P(EmbreeModes, HitsTheSquareWhereGeometrySays) {
+  const TriangleMesh mesh = unit_square();
+  AcceleratorOptions options;
+  options.embree.mode = GetParam();
+  const auto accel = make_accelerator(mesh, options);
+  RayBatch rays(8);
+  HitBatch hits(8);
+  set_ray(rays, 0, {0.75f, 0.25f, 2.0f}, {0, 0, -1});         // lower-right triangle, t = 2
+  set_ray(rays, 1, {0.25f, 0.75f, -3.0f}, {0, 0, 1});         // upper-left triangle from below, t = 3
+  set_ray(rays, 2, {1.5f, 0.5f, 1.0f}, {0, 0, -1});           // beside the square: miss
+  set_ray(rays, 3, {0.5f, 0.25f, 2.0f}, {0, 0, -1}, 0.0f, 1.5f);  // stops short: miss
+  set_ray(rays, 4, {0.5f, 0.25f, 2.0f}, {0, 0, -1}, 2.5f);    // starts past it: miss
+  set_ray(rays, 5, {0.5f, 0.25f, 1.0f}, {0.0f, 0.0f, -2.0f}); // unnormalized direction: t = 0.5
+  set_ray(rays, 6, {0.75f, 0.25f, 2.0f}, {0, 0, -1});
+  rays.flags[6] = 0;  // dead rays are skipped
+  rays.count = 7;
+  accel->intersect_closest(rays, hits, rays.all());
+
+  EXPECT_FLOAT_EQ(hits.t[0], 2.0f);
+  EXPECT_EQ(hits.primitive[0], 0u);
+  // Embree's u, v weight the second and third vertex: (0.75, 0.25) = 0.5 v1 + 0.25 v2 + 0.25 v0.
+  EXPECT_NEAR(hits.u[0], 0.5f, 1e-6f);
+  EXPECT_NEAR(hits.v[0], 0.25f, 1e-6f);
+  EXPECT_FLOAT_EQ(hits.t[1], 3.0f);
+  EXPECT_EQ(hits.primitive[1], 1u);
+  for (int miss : {2, 3, 4, 6}) {
+    EXPECT_EQ(hits.primitive[miss], kInvalidPrimitive) << miss;
+    EXPECT_TRUE(std::isinf(hits.t[miss])) << miss;
+  }
+  EXPECT_FLOAT_EQ(hits.t[5], 0.5f);
+
+  accel->intersect_any(rays, hits, rays.all());
+  EXPECT_TRUE(hits.is_hit(0));
+  EXPECT_TRUE(hits.is_hit(1));
+  EXPECT_FALSE(hits.is_hit(2));
+  EXPECT_FALSE(hits.is_hit(3));
+  EXPECT_FALSE(hits.is_hit(4));
+  EXPECT_TRUE(hits.is_hit(5));
+  EXPECT_FALSE(hits.is_hit(6));
+}
+
+INSTANTIATE_TEST_SUITE_P(AllModes, EmbreeModes,
+                         ::testing::Values(EmbreeMode::standard, EmbreeMode::compact, EmbreeMode::robust),
+                         [](const ::testing::TestParamInfo<EmbreeMode>& info) { return to_string(info.param); });
+
+TEST(Embree, RangesTouchOnlyTheirRays) {
+  const TriangleMesh mesh = unit_square();
+  const auto accel = make_accelerator(mesh, {});
+  RayBatch rays(4);
+  HitBatch hits(4);
+  for (std::size_t i = 0; i < 4; ++i) set_ray(rays, i, {0.75f, 0.25f, 1.0f}, {0, 0, -1});
+  rays.count = 4;
+  hits.primitive[0] = hits.primitive[3] = 1234;
+  accel->intersect_closest(rays, hits, {1, 3});
+  EXPECT_EQ(hits.primitive[0], 1234u);
+  EXPECT_EQ(hits.primitive[1], 0u);
+  EXPECT_EQ(hits.primitive[2], 0u);
+  EXPECT_EQ(hits.primitive[3], 1234u);
+}
+
+TEST(Embree, RaysFromTheCenterOfASphereHitAtTheRadius) {
+  // Undisplaced distance check on the closed sphere: every ray from inside hits.
+  const Scene sphere = make_builtin_scene("builtin:sphere:20k");
+  const auto accel = make_accelerator(sphere.mesh, {});
+  RayBatch rays(512);
+  HitBatch hits(512);
+  for (std::size_t i = 0; i < 512; ++i) {
+    const float z = 1.0f - 2.0f * (float(i) + 0.5f) / 512.0f, phi = 2.39996f * float(i);
+    const float r = std::sqrt(1.0f - z * z);
+    set_ray(rays, i, {0, 0, 0}, {r * std::cos(phi), r * std::sin(phi), z});
+  }
+  rays.count = 512;
+  accel->intersect_closest(rays, hits, rays.all());
+  for (std::size_t i = 0; i < 512; ++i) {
+    ASSERT_TRUE(hits.is_hit(i)) << i;
+    EXPECT_GT(hits.t[i], 0.75f);  // radius 1 displaced by at most 12% (of 0.5 noise amplitude ~ 1)
+    EXPECT_LT(hits.t[i], 1.25f);
+  }
+}
+
+TEST(Embree, MemoryCountsHierarchyAndMeshBuffers) {
+  const Scene sphere = make_builtin_scene("builtin:sphere:20k");
+  AcceleratorOptions standard, compact;
+  compact.embree.mode = EmbreeMode::compact;
+  const auto a = make_accelerator(sphere.mesh, standard);
+  const auto b = make_accelerator(sphere.mesh, compact);
+  EXPECT_EQ(a->memory().geometry, sphere.mesh.vertex_count() * 12 + sphere.mesh.triangle_count() * 12);
+  EXPECT_GT(a->memory().hierarchy, 0u);
+  EXPECT_LT(b->memory().hierarchy, a->memory().hierarchy);
+  EXPECT_GE(a->build().peak_bytes, a->memory().total());
+  EXPECT_GT(a->build().seconds, 0.0);
+  EXPECT_EQ(a->name(), "embree");
+  EXPECT_EQ(b->name(), "embree-compact");
+}
+
+TEST(Embree, UnknownAcceleratorIsAnError) {
+  const TriangleMesh mesh = unit_square();
+  AcceleratorOptions options;
+  options.type = "octree";
+  try {
+    make_accelerator(mesh, options);
+    FAIL();
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("octree"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace wavetrace

@@ -1,0 +1,40 @@
+// Helpers shared by the tests: temporary files and running the wavetrace binary.
+#pragma once
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace wavetrace::testing {
+
+inline std::string data_path(const std::string& name) { return std::string(WAVETRACE_DATA_DIR) + "/" + name; }
+
+// A file under a fresh per-test temporary directory, holding `contents`.
+inline std::string write_temp_file(const std::string& name, const std::string& contents) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "wavetrace_tests";
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path path = dir / name;
+  std::ofstream(path, std::ios::binary) << contents;
+  return path.string();
+}
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+// Runs the wavetrace binary with `arguments` (shell syntax).
+inline CommandResult run_wavetrace(const std::string& arguments) {
+  CommandResult result;
+  const std::string command = std::string(WAVETRACE_BINARY) + " " + arguments + " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return result;
+  char buffer[4096];
+  while (std::size_t read = std::fread(buffer, 1, sizeof buffer, pipe)) result.output.append(buffer, read);
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+}  // namespace wavetrace::testing
