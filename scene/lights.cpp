@@ -9,26 +9,32 @@
 
 namespace wavetrace {
 
-LightSampler::LightSampler(const Scene& scene) : scene_(&scene) {
+LightSampler::LightSampler(const Scene& scene) {
   const TriangleMesh& mesh = scene.mesh;
-  double total = 0.0;
   std::vector<double> power;
+  double total = 0.0;
   for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
     const Material& material = scene.materials[mesh.material(t)];
     if (!material.emissive()) continue;
     const glm::uvec3& tri = mesh.triangles[t];
-    const float area = 0.5f * glm::length(glm::cross(mesh.positions[tri.y] - mesh.positions[tri.x],
-                                                     mesh.positions[tri.z] - mesh.positions[tri.x]));
-    const double weight = double(area) * std::max({material.emission.x, material.emission.y, material.emission.z});
-    triangles_.push_back(static_cast<std::uint32_t>(t));
+    EmissiveTriangle light;
+    light.corner = mesh.positions[tri.x];
+    light.edge1 = mesh.positions[tri.y] - light.corner;
+    light.edge2 = mesh.positions[tri.z] - light.corner;
+    const glm::vec3 cross = glm::cross(light.edge1, light.edge2);
+    light.normal = glm::normalize(cross);
+    light.emission = material.emission;
+    light.pdf_area = 0.5f * glm::length(cross);  // the area, until divided below
+    triangles_.push_back(light);
+    const double weight = double(light.pdf_area) * std::max({material.emission.x, material.emission.y, material.emission.z});
     power.push_back(weight);
     total += weight;
   }
   double running = 0.0;
-  for (double weight : power) {
-    running += weight;
+  for (std::size_t i = 0; i < triangles_.size(); ++i) {
+    running += power[i];
     cumulative_.push_back(static_cast<float>(running / total));
-    probability_.push_back(static_cast<float>(weight / total));
+    triangles_[i].pdf_area = static_cast<float>(power[i] / total) / triangles_[i].pdf_area;
   }
   if (!cumulative_.empty()) cumulative_.back() = 1.0f;
 }
@@ -37,19 +43,9 @@ LightSample LightSampler::sample(float u_choice, float u1, float u2) const {
   const std::size_t index = std::min<std::size_t>(
       std::upper_bound(cumulative_.begin(), cumulative_.end(), u_choice) - cumulative_.begin(),
       triangles_.size() - 1);
-  const TriangleMesh& mesh = scene_->mesh;
-  const std::uint32_t triangle = triangles_[index];
-  const glm::uvec3& tri = mesh.triangles[triangle];
-  const glm::vec3 a = mesh.positions[tri.x], b = mesh.positions[tri.y], c = mesh.positions[tri.z];
-  const glm::vec3 cross = glm::cross(b - a, c - a);
-  const float area = 0.5f * glm::length(cross);
+  const EmissiveTriangle& light = triangles_[index];
   const Barycentrics bary = uniform_triangle(u1, u2);
-  LightSample sample;
-  sample.point = a + (b - a) * bary.b1 + (c - a) * bary.b2;
-  sample.normal = glm::normalize(cross);
-  sample.emission = scene_->materials[mesh.material(triangle)].emission;
-  sample.pdf_area = probability_[index] / area;
-  return sample;
+  return {light.corner + light.edge1 * bary.b1 + light.edge2 * bary.b2, light.normal, light.emission, light.pdf_area};
 }
 
 }  // namespace wavetrace

@@ -28,10 +28,15 @@ class LightSampler {
   LightSample sample(float u_choice, float u1, float u2) const;
 
  private:
-  const Scene* scene_;
-  std::vector<std::uint32_t> triangles_;
+  // Everything sampling needs, precomputed per emissive triangle so a sample is arithmetic only.
+  struct EmissiveTriangle {
+    glm::vec3 corner, edge1, edge2;
+    glm::vec3 normal;
+    glm::vec3 emission;
+    float pdf_area;  // choice probability / area
+  };
+  std::vector<EmissiveTriangle> triangles_;
   std::vector<float> cumulative_;  // normalized running sum of power
-  std::vector<float> probability_;
 };
 
 }  // namespace wavetrace

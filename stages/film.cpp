@@ -18,7 +18,8 @@ void Film::add(std::uint32_t pixel, float r, float g, float b) {
   }
   for (int c = 0; c < 3; ++c) {
     if (channels[c] == 0.0f) continue;
-    const auto fixed = static_cast<std::int64_t>(std::llround(double(std::fmin(channels[c], kMaxContribution)) * kScale));
+    // Round half up by hand: non-negative input, and llround is a library call per channel.
+    const auto fixed = static_cast<std::int64_t>(double(std::fmin(channels[c], kMaxContribution)) * kScale + 0.5);
     std::atomic_ref<std::int64_t>(sums_[std::size_t(pixel) * 3 + c]).fetch_add(fixed, std::memory_order_relaxed);
   }
 }

@@ -68,7 +68,7 @@ std::unique_ptr<tbb::flow::function_node<Batch*>> make_retire_node(tbb::flow::gr
 
 struct PipelineOptions {
   std::size_t batch_size = kDefaultBatchCapacity;
-  std::size_t rays_in_flight = std::size_t{1} << 20;
+  std::size_t rays_in_flight = std::size_t{1} << 18;
   int threads = 0;  // 0: all cores
 };
 
