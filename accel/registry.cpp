@@ -7,10 +7,11 @@
 
 namespace wavetrace {
 
-std::vector<std::string> accelerator_names() { return {"embree"}; }
+std::vector<std::string> accelerator_names() { return {"embree", "bvh"}; }
 
 std::unique_ptr<Accelerator> make_accelerator(const TriangleMesh& mesh, const AcceleratorOptions& options) {
   if (options.type == "embree") return make_embree_accelerator(mesh, options.embree);
+  if (options.type == "bvh") return make_bvh_accelerator(mesh, options.bvh);
   std::string known;
   for (const std::string& name : accelerator_names()) known += (known.empty() ? "" : ", ") + name;
   throw std::invalid_argument(fmt::format("unknown accelerator '{}' (available: {})", options.type, known));

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "accel/accelerator.hpp"
+#include "accel/bvh/bvh_accelerator.hpp"
 #include "accel/embree/embree_accelerator.hpp"
 #include "scene/triangle_mesh.hpp"
 
@@ -14,6 +15,7 @@ namespace wavetrace {
 struct AcceleratorOptions {
   std::string type = "embree";
   EmbreeOptions embree;
+  BvhOptions bvh;
 };
 
 std::vector<std::string> accelerator_names();

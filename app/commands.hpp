@@ -8,5 +8,6 @@ namespace wavetrace {
 // Each adds its subcommand to the app; the callback runs it and sets `exit_code`.
 void add_render_command(CLI::App& app, int& exit_code);
 void add_info_command(CLI::App& app, int& exit_code);
+void add_bench_command(CLI::App& app, int& exit_code);
 
 }  // namespace wavetrace

@@ -1,4 +1,4 @@
-// The `wavetrace` command line: render, info (bench arrives with the BVH baseline).
+// The `wavetrace` command line: render, info, bench.
 #include <cstdio>
 #include <exception>
 
@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   int exit_code = 0;
   wavetrace::add_render_command(app, exit_code);
   wavetrace::add_info_command(app, exit_code);
+  wavetrace::add_bench_command(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {

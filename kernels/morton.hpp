@@ -40,4 +40,19 @@ inline Point2u morton2d_decode(std::uint64_t code) {
 #endif
 }
 
+// 3D codes: up to 21 bits per axis, x in the lowest bit of each triple.
+constexpr std::uint64_t kMortonMask3dX = 0x1249249249249249ull;
+
+inline std::uint64_t morton3d_encode(std::uint64_t x, std::uint64_t y, std::uint64_t z) {
+#if defined(__BMI2__)
+  return _pdep_u64(x, kMortonMask3dX) | _pdep_u64(y, kMortonMask3dX << 1) | _pdep_u64(z, kMortonMask3dX << 2);
+#else
+  std::uint64_t code = 0;
+  for (int bit = 0; bit < 21; ++bit) {
+    code |= (((x >> bit) & 1u) << (3 * bit)) | (((y >> bit) & 1u) << (3 * bit + 1)) | (((z >> bit) & 1u) << (3 * bit + 2));
+  }
+  return code;
+#endif
+}
+
 }  // namespace wavetrace

@@ -1,6 +1,7 @@
 // Pinhole camera set-up and validation.
 #include "scene/camera.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -25,8 +26,11 @@ void validate_camera(const Camera& camera) {
 Camera frame_bounds(const Bounds3& bounds) {
   Camera camera;
   const glm::vec3 center = bounds.center();
-  const float radius = std::max(0.5f * bounds.diagonal(), 1e-6f);
-  const float distance = radius / std::tan(0.5f * camera.vertical_fov_degrees * kPi / 180.0f);
+  // Fit the largest extent to the image height with a 10% margin: the bounding sphere
+  // would leave most of the image empty (and most benchmark rays missing).
+  const glm::vec3 extent = bounds.extent();
+  const float radius = std::max(0.55f * std::max({extent.x, extent.y, extent.z}), 1e-6f);
+  const float distance = radius / std::tan(0.5f * camera.vertical_fov_degrees * kPi / 180.0f) + 0.5f * extent.z;
   camera.look_at = center;
   camera.position = center + glm::normalize(glm::vec3(0.0f, 0.35f, 1.0f)) * distance;
   return camera;

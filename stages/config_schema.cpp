@@ -36,9 +36,15 @@ const std::vector<ConfigKey>& config_schema() {
       {"render.pixel_order", T::text, std::string("scanline"), 0, 0, {"scanline", "zcurve"},
        "order in which camera rays are generated"},
 
-      {"accel.type", T::text, std::string("embree"), 0, 0, {"embree"}, "main accelerator"},
+      {"accel.type", T::text, std::string("embree"), 0, 0, {"embree", "bvh"}, "main accelerator"},
       {"accel.embree.mode", T::text, std::string("default"), 0, 0, {"default", "compact", "robust"},
        "Embree scene flags"},
+      {"accel.bvh.leaf_size", T::integer, std::int64_t{4}, 1, 16, {}, "most triangles per BVH leaf"},
+      {"accel.bvh.layout", T::text, std::string("depth_first"), 0, 0, {"depth_first", "breadth_first", "veb"},
+       "BVH node order in memory"},
+      {"accel.bvh.triangle_order", T::text, std::string("input"), 0, 0, {"input", "morton"},
+       "triangle and vertex order of the BVH's indexed face set"},
+      {"accel.bvh.bins", T::integer, std::int64_t{16}, 2, 64, {}, "SAH bins per axis"},
 
       {"pipeline.stages", T::text_list, std::vector<std::string>{"generate", "trace", "shade", "spawn"}, 0, 0,
        {"generate", "trace", "shade", "spawn"}, "the stage chain; spawn at the end loops back"},

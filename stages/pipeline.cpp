@@ -5,11 +5,7 @@
 #include <mutex>
 #include <thread>
 
-#include <tbb/info.h>
-#include <tbb/task_arena.h>
-#include <tbb/task_scheduler_observer.h>
-
-#include "accel/embree/embree_accelerator.hpp"
+#include "stages/tracing_arena.hpp"
 
 namespace wavetrace {
 namespace {
@@ -37,14 +33,6 @@ class PortOutput final : public StageOutput {
  private:
   PipelineContext& context_;
   BatchNode::output_ports_type& ports_;
-};
-
-// Every thread of the arena traces: give each the float mode Embree asks for.
-class FloatModeObserver final : public tbb::task_scheduler_observer {
- public:
-  explicit FloatModeObserver(tbb::task_arena& arena) : tbb::task_scheduler_observer(arena) { observe(true); }
-  ~FloatModeObserver() override { observe(false); }
-  void on_scheduler_entry(bool) override { set_embree_thread_float_mode(); }
 };
 
 }  // namespace
@@ -104,9 +92,8 @@ Pipeline::Pipeline(GenerateStage& generate, std::vector<const Stage*> chain, boo
     : generate_(generate), chain_(std::move(chain)), loops_(loops), options_(options) {}
 
 PipelineRun Pipeline::run(const std::function<void(const Progress&)>& on_progress, std::chrono::milliseconds interval) {
-  const int threads = options_.threads > 0 ? options_.threads : tbb::info::default_concurrency();
-  tbb::task_arena arena(threads);
-  FloatModeObserver float_mode(arena);
+  TracingArena arena(options_.threads);
+  const int threads = arena.threads();
 
   StageCounters generate_counters(generate_.name());
   std::vector<std::unique_ptr<StageCounters>> counters;
@@ -135,7 +122,6 @@ PipelineRun Pipeline::run(const std::function<void(const Progress&)>& on_progres
   }
 
   arena.execute([&] {
-    set_embree_thread_float_mode();
     tbb::flow::graph graph;
     auto generate_node = make_generate_node(graph, generate_, context, generate_counters);
     std::vector<std::unique_ptr<BatchNode>> nodes;

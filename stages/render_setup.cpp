@@ -38,6 +38,18 @@ void check_stage_order(const std::vector<std::string>& names) {
 
 }  // namespace
 
+AcceleratorOptions accelerator_options(const Config& config) {
+  AcceleratorOptions options;
+  options.type = config.text("accel.type");
+  options.embree.mode = parse_embree_mode(config.text("accel.embree.mode"));
+  options.embree.threads = static_cast<int>(config.integer("render.threads"));
+  options.bvh.max_leaf_size = static_cast<std::uint32_t>(config.integer("accel.bvh.leaf_size"));
+  options.bvh.layout = parse_node_layout(config.text("accel.bvh.layout"));
+  options.bvh.triangle_order = parse_triangle_order(config.text("accel.bvh.triangle_order"));
+  options.bvh.bins = static_cast<std::uint32_t>(config.integer("accel.bvh.bins"));
+  return options;
+}
+
 RenderPlan plan_render(const Config& config) {
   RenderPlan plan;
   plan.scene.source = config.text("scene.source");
@@ -60,9 +72,7 @@ RenderPlan plan_render(const Config& config) {
   plan.pipeline.rays_in_flight = static_cast<std::size_t>(config.integer("render.rays_in_flight"));
   plan.pipeline.threads = static_cast<int>(config.integer("render.threads"));
 
-  plan.accelerator.type = config.text("accel.type");
-  plan.accelerator.embree.mode = parse_embree_mode(config.text("accel.embree.mode"));
-  plan.accelerator.embree.threads = plan.pipeline.threads;
+  plan.accelerator = accelerator_options(config);
 
   plan.stages = config.text_list("pipeline.stages");
   check_stage_order(plan.stages);

@@ -36,6 +36,9 @@ struct RenderPlan {
   std::vector<std::string> stages;
 };
 
+// The accel.* keys as options for make_accelerator.
+AcceleratorOptions accelerator_options(const Config& config);
+
 // Reads every key; throws ConfigError for a stage list that cannot run.
 RenderPlan plan_render(const Config& config);
 

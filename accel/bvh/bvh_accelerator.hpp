@@ -1,0 +1,32 @@
+// `bvh`: the papers' uncompressed baseline, a binned-SAH binary BVH of 32-byte nodes over
+// an indexed face set (32-bit indices, float vertices), with watertight triangle tests.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "accel/accelerator.hpp"
+#include "accel/bvh/node_layout.hpp"
+#include "accel/bvh/sah_builder.hpp"
+#include "scene/triangle_mesh.hpp"
+
+namespace wavetrace {
+
+enum class TriangleOrder { input, morton };
+TriangleOrder parse_triangle_order(const std::string& text);  // "input" | "morton"
+std::string to_string(TriangleOrder order);
+
+struct BvhOptions {
+  std::uint32_t max_leaf_size = 4;  // 1..16
+  NodeLayout layout = NodeLayout::depth_first;
+  // input: leaves index the mesh's own triangles; morton: the BVH keeps a copy of the
+  // indexed face set with triangles sorted along a Morton curve and vertices renumbered in
+  // first-use order, so a leaf's triangles and vertices sit close together in memory.
+  TriangleOrder triangle_order = TriangleOrder::input;
+  std::uint32_t bins = 16;
+};
+
+// `mesh` must outlive the accelerator (with input order its buffers are read in place).
+std::unique_ptr<Accelerator> make_bvh_accelerator(const TriangleMesh& mesh, const BvhOptions& options);
+
+}  // namespace wavetrace

@@ -1,0 +1,124 @@
+// `wavetrace bench accel` and `wavetrace bench leak`.
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "app/commands.hpp"
+#include "bench/accel_bench.hpp"
+#include "bench/leak_bench.hpp"
+#include "stages/render_setup.hpp"
+
+namespace wavetrace {
+namespace {
+
+struct BenchArguments {
+  std::string scene = "builtin:sphere:1M";
+  std::string accel = "embree,bvh";
+  std::string rays = "primary";
+  std::size_t count = 1 << 20;
+  int threads = 0;
+  int repeat = 3;
+  std::string json;
+  std::vector<std::string> assignments;
+};
+
+std::vector<std::string> split_commas(const std::string& text) {
+  std::vector<std::string> parts;
+  std::stringstream stream(text);
+  for (std::string part; std::getline(stream, part, ',');) {
+    if (!part.empty()) parts.push_back(part);
+  }
+  return parts;
+}
+
+struct BenchSetup {
+  Config config;
+  Scene scene;
+  std::vector<AcceleratorSpec> accelerators;
+};
+
+BenchSetup prepare(const BenchArguments& args) {
+  BenchSetup setup;
+  for (const std::string& assignment : args.assignments) setup.config.set(assignment);
+  setup.config.set_value("scene.source", args.scene);
+  if (args.threads < 0) throw ConfigError("--threads must be 0 (all cores) or more");
+  if (args.count == 0) throw ConfigError("--count must be at least 1");
+  for (const std::string& spec : split_commas(args.accel)) setup.accelerators.push_back(parse_accelerator_spec(spec, setup.config));
+  if (setup.accelerators.empty()) throw ConfigError("--accel names no accelerator");
+  setup.scene = load_scene(plan_render(setup.config).scene);
+  return setup;
+}
+
+void write_text(const std::string& path, const std::string& text) {
+  std::ofstream file(path);
+  file << text;
+  if (!file) throw std::runtime_error(fmt::format("{}: could not write", path));
+}
+
+std::string csv_path_for(const std::string& json_path) {
+  const std::size_t dot = json_path.rfind('.');
+  return (dot == std::string::npos ? json_path : json_path.substr(0, dot)) + ".csv";
+}
+
+int run_accel(const BenchArguments& args) {
+  BenchSetup setup = prepare(args);
+  AccelBenchRequest request;
+  request.accelerators = setup.accelerators;
+  request.rays = parse_ray_set_kind(args.rays);
+  request.count = args.count;
+  request.threads = args.threads;
+  request.repeats = args.repeat;
+  if (args.repeat < 1) throw ConfigError("--repeat must be at least 1");
+  const AccelBenchReport report = run_accel_bench(setup.scene, request);
+  fmt::print("{}", to_table(report));
+  if (!args.json.empty()) {
+    write_text(args.json, to_json(report).dump(2) + "\n");
+    write_text(csv_path_for(args.json), to_csv(report));
+  }
+  return 0;
+}
+
+int run_leak(const BenchArguments& args) {
+  BenchSetup setup = prepare(args);
+  const LeakReport report = run_leak_bench(setup.scene, setup.accelerators, args.count, args.threads);
+  fmt::print("{}", to_table(report));
+  if (!args.json.empty()) write_text(args.json, to_json(report).dump(2) + "\n");
+  return 0;
+}
+
+void add_common_options(CLI::App* command, BenchArguments& args) {
+  command->add_option("--scene", args.scene, "mesh file or builtin:NAME[:TRIANGLES]");
+  command->add_option("--accel", args.accel,
+                      "comma-separated accelerators, each TYPE[:key=value]..., e.g. bvh:layout=veb,embree:mode=robust");
+  command->add_option("--count", args.count, "number of rays");
+  command->add_option("--threads", args.threads, "worker threads (0: all cores)");
+  command->add_option("--json", args.json, "write results as JSON (and CSV beside it for bench accel)");
+  command->add_option("--set", args.assignments, "config override section.key=value (e.g. scene.subdivide=2)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+}
+
+}  // namespace
+
+void add_bench_command(CLI::App& app, int& exit_code) {
+  CLI::App* bench = app.add_subcommand("bench", "measure accelerators side by side with Embree");
+  bench->require_subcommand(1);
+
+  auto accel_args = std::make_shared<BenchArguments>();
+  CLI::App* accel = bench->add_subcommand("accel", "build and trace the same rays with each accelerator");
+  add_common_options(accel, *accel_args);
+  accel->add_option("--rays", accel_args->rays, "primary, diffuse, shadow or random");
+  accel->add_option("--repeat", accel_args->repeat, "timed runs per accelerator (the median is reported)");
+  accel->callback([accel_args, &exit_code] { exit_code = run_accel(*accel_args); });
+
+  auto leak_args = std::make_shared<BenchArguments>();
+  leak_args->accel = "embree,embree:mode=robust,bvh";
+  leak_args->count = 1000000;
+  CLI::App* leak = bench->add_subcommand("leak", "count rays escaping a closed mesh from inside");
+  add_common_options(leak, *leak_args);
+  leak->callback([leak_args, &exit_code] { exit_code = run_leak(*leak_args); });
+}
+
+}  // namespace wavetrace

@@ -1,0 +1,171 @@
+// Builds, times and checks each accelerator against the Embree reference.
+#include "bench/accel_bench.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "stages/render_setup.hpp"
+#include "stages/tracing_arena.hpp"
+
+namespace wavetrace {
+namespace {
+
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  const std::size_t n = values.size();
+  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+void compare(const RaySet& rays, const std::vector<std::unique_ptr<HitBatch>>& hits,
+             const std::vector<std::unique_ptr<HitBatch>>& reference, float diagonal, AccelBenchResult& result) {
+  std::size_t agree = 0, both = 0, same_primitive = 0, total = 0;
+  double error_sum = 0.0, error_max = 0.0;
+  for (std::size_t b = 0; b < rays.batches.size(); ++b) {
+    for (std::size_t i = 0; i < rays.batches[b]->count; ++i) {
+      ++total;
+      const bool hit = hits[b]->is_hit(i), expected = reference[b]->is_hit(i);
+      agree += hit == expected;
+      if (!hit || !expected || rays.any_hit()) continue;
+      ++both;
+      same_primitive += hits[b]->primitive[i] == reference[b]->primitive[i];
+      const double error = std::fabs(double(hits[b]->t[i]) - double(reference[b]->t[i])) / diagonal;
+      error_sum += error;
+      error_max = std::max(error_max, error);
+    }
+  }
+  result.hit_agreement = total ? double(agree) / double(total) : 1.0;
+  if (!rays.any_hit()) {
+    result.prim_agreement = both ? double(same_primitive) / double(both) : 1.0;
+    result.t_error_max = error_max;
+    result.t_error_mean = both ? error_sum / double(both) : 0.0;
+  }
+}
+
+}  // namespace
+
+AcceleratorSpec parse_accelerator_spec(const std::string& text, const Config& base) {
+  Config config = base;
+  std::size_t colon = text.find(':');
+  const std::string type = text.substr(0, colon);
+  config.set("accel.type=" + type);
+  while (colon != std::string::npos) {
+    const std::size_t next = text.find(':', colon + 1);
+    const std::string option = text.substr(colon + 1, next == std::string::npos ? std::string::npos : next - colon - 1);
+    if (option.find('=') == std::string::npos) {
+      throw ConfigError(fmt::format("--accel '{}': '{}' is not key=value", text, option));
+    }
+    config.set("accel." + type + "." + option);
+    colon = next;
+  }
+  return {text, accelerator_options(config)};
+}
+
+AccelBenchReport run_accel_bench(const Scene& scene, const AccelBenchRequest& request) {
+  TracingArena arena(request.threads);
+  AccelBenchReport report;
+  report.scene = scene.name;
+  report.triangles = scene.mesh.triangle_count();
+  report.rays = to_string(request.rays);
+  report.threads = arena.threads();
+  report.repeats = request.repeats;
+  const float diagonal = scene.mesh.bounds().diagonal();
+
+  arena.execute([&] {
+    const auto reference = make_accelerator(scene.mesh, AcceleratorOptions{});
+    const RaySet rays = make_ray_set(request.rays, scene, *reference, request.count);
+    report.ray_count = rays.count();
+    const auto reference_hits = trace_ray_set(*reference, rays);
+    std::size_t reference_hit_count = 0;
+    for (std::size_t b = 0; b < rays.batches.size(); ++b) {
+      for (std::size_t i = 0; i < rays.batches[b]->count; ++i) reference_hit_count += reference_hits[b]->is_hit(i);
+    }
+    report.reference_hit_rate = double(reference_hit_count) / double(std::max<std::size_t>(1, report.ray_count));
+
+    for (const AcceleratorSpec& spec : request.accelerators) {
+      AccelBenchResult result;
+      result.label = spec.label;
+      const auto accelerator = make_accelerator(scene.mesh, spec.options);
+      result.memory = accelerator->memory();
+      result.bytes_per_triangle = double(result.memory.total()) / double(scene.mesh.triangle_count());
+      result.build = accelerator->build();
+      std::vector<std::unique_ptr<HitBatch>> hits;
+      for (int run = 0; run < std::max(1, request.repeats); ++run) {
+        const auto start = std::chrono::steady_clock::now();
+        hits = trace_ray_set(*accelerator, rays);
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        result.mrays_per_s_runs.push_back(double(report.ray_count) / seconds * 1e-6);
+      }
+      result.mrays_per_s = median(result.mrays_per_s_runs);
+      compare(rays, hits, reference_hits, diagonal, result);
+      report.results.push_back(std::move(result));
+    }
+  });
+  return report;
+}
+
+nlohmann::json to_json(const AccelBenchReport& report) {
+  nlohmann::json results = nlohmann::json::array();
+  for (const AccelBenchResult& r : report.results) {
+    const auto optional = [](const std::optional<double>& value) {
+      return value ? nlohmann::json(*value) : nlohmann::json(nullptr);
+    };
+    results.push_back({{"accel", r.label},
+                       {"bytes", r.memory.total()},
+                       {"bytes_per_triangle", r.bytes_per_triangle},
+                       {"parts", {{"hierarchy", r.memory.hierarchy}, {"geometry", r.memory.geometry}, {"other", r.memory.other}}},
+                       {"build_seconds", r.build.seconds},
+                       {"build_peak_bytes", r.build.peak_bytes},
+                       {"mrays_per_s", r.mrays_per_s},
+                       {"mrays_per_s_runs", r.mrays_per_s_runs},
+                       {"hit_agreement", r.hit_agreement},
+                       {"prim_agreement", optional(r.prim_agreement)},
+                       {"t_error_max", optional(r.t_error_max)},
+                       {"t_error_mean", optional(r.t_error_mean)}});
+  }
+  return {{"scene", {{"source", report.scene}, {"triangles", report.triangles}}},
+          {"rays", {{"kind", report.rays}, {"count", report.ray_count}, {"reference_hit_rate", report.reference_hit_rate}}},
+          {"threads", report.threads},
+          {"repeats", report.repeats},
+          {"results", results}};
+}
+
+std::string to_csv(const AccelBenchReport& report) {
+  std::string csv =
+      "scene,triangles,rays,count,threads,accel,bytes,bytes_per_triangle,hierarchy,geometry,other,build_seconds,"
+      "build_peak_bytes,mrays_per_s,hit_agreement,prim_agreement,t_error_max,t_error_mean\n";
+  const auto optional = [](const std::optional<double>& v) { return v ? fmt::format("{:.9g}", *v) : std::string(); };
+  for (const AccelBenchResult& r : report.results) {
+    csv += fmt::format("{},{},{},{},{},{},{},{:.3f},{},{},{},{:.4f},{},{:.4f},{:.9g},{},{},{}\n", report.scene,
+                       report.triangles, report.rays, report.ray_count, report.threads, r.label, r.memory.total(),
+                       r.bytes_per_triangle, r.memory.hierarchy, r.memory.geometry, r.memory.other, r.build.seconds,
+                       r.build.peak_bytes, r.mrays_per_s, r.hit_agreement, optional(r.prim_agreement),
+                       optional(r.t_error_max), optional(r.t_error_mean));
+  }
+  return csv;
+}
+
+std::string to_table(const AccelBenchReport& report) {
+  std::string table = fmt::format(
+      "{}: {} triangles; {} {} rays ({:.1f}% hit the reference); {} threads; median of {} runs\n", report.scene,
+      report.triangles, report.ray_count, report.rays, 100.0 * report.reference_hit_rate, report.threads, report.repeats);
+  table += fmt::format("{:<24} {:>9} {:>8} {:>8} {:>8} {:>9} {:>10} {:>8} {:>10} {:>10} {:>10} {:>10}\n", "accel",
+                       "MB", "B/tri", "hier", "geom", "build s", "peak MB", "Mrays/s", "vs first", "hit agr", "prim agr",
+                       "t err max");
+  const double first = report.results.empty() ? 0.0 : report.results.front().mrays_per_s;
+  const double triangles = double(report.triangles);
+  for (const AccelBenchResult& r : report.results) {
+    table += fmt::format("{:<24} {:>9.1f} {:>8.1f} {:>8.1f} {:>8.1f} {:>9.3f} {:>10.1f} {:>8.2f} {:>9.2f}x {:>9.4f}% {:>9} {:>10}\n",
+                         r.label, double(r.memory.total()) * 1e-6, r.bytes_per_triangle,
+                         double(r.memory.hierarchy) / triangles, double(r.memory.geometry) / triangles, r.build.seconds,
+                         double(r.build.peak_bytes) * 1e-6, r.mrays_per_s, first > 0 ? r.mrays_per_s / first : 0.0,
+                         100.0 * r.hit_agreement,
+                         r.prim_agreement ? fmt::format("{:.4f}%", 100.0 * *r.prim_agreement) : std::string("-"),
+                         r.t_error_max ? fmt::format("{:.2e}", *r.t_error_max) : std::string("-"));
+  }
+  return table;
+}
+
+}  // namespace wavetrace

@@ -1,0 +1,64 @@
+// `wavetrace bench accel`: every accelerator built and timed on the same rays in one run,
+// with its accuracy measured against Embree on those rays.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "accel/registry.hpp"
+#include "bench/ray_sets.hpp"
+#include "scene/scene.hpp"
+#include "stages/config.hpp"
+
+namespace wavetrace {
+
+// "TYPE[:key=value]..." where each key is accel.TYPE.key, e.g. "bvh:layout=veb:leaf_size=8",
+// "embree:mode=robust"; other keys come from `base`. Throws ConfigError naming bad parts.
+struct AcceleratorSpec {
+  std::string label;
+  AcceleratorOptions options;
+};
+AcceleratorSpec parse_accelerator_spec(const std::string& text, const Config& base);
+
+struct AccelBenchResult {
+  std::string label;
+  MemoryReport memory;
+  double bytes_per_triangle = 0.0;
+  BuildReport build;
+  std::vector<double> mrays_per_s_runs;
+  double mrays_per_s = 0.0;      // median of the runs
+  double hit_agreement = 0.0;    // same hit / miss as the reference
+  std::optional<double> prim_agreement;  // same primitive where both hit (closest-hit sets only)
+  std::optional<double> t_error_max;     // |t - t_ref| / scene diagonal where both hit
+  std::optional<double> t_error_mean;
+};
+
+struct AccelBenchReport {
+  std::string scene;
+  std::size_t triangles = 0;
+  std::string rays;
+  std::size_t ray_count = 0;
+  int threads = 0;
+  int repeats = 0;
+  double reference_hit_rate = 0.0;  // share of rays Embree finds a hit (occluded, for shadow rays)
+  std::vector<AccelBenchResult> results;
+};
+
+struct AccelBenchRequest {
+  std::vector<AcceleratorSpec> accelerators;
+  RaySetKind rays = RaySetKind::primary;
+  std::size_t count = 1 << 20;
+  int threads = 0;
+  int repeats = 3;
+};
+
+AccelBenchReport run_accel_bench(const Scene& scene, const AccelBenchRequest& request);
+
+nlohmann::json to_json(const AccelBenchReport& report);
+std::string to_csv(const AccelBenchReport& report);
+std::string to_table(const AccelBenchReport& report);
+
+}  // namespace wavetrace

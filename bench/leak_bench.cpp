@@ -1,0 +1,152 @@
+// Inside points by unanimous ray parity along three skew directions (robust Embree),
+// then the same rays traced by every accelerator.
+#include "bench/leak_bench.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include <fmt/format.h>
+#include <glm/geometric.hpp>
+#include <tbb/parallel_for.h>
+
+#include "kernels/random.hpp"
+#include "kernels/sampling.hpp"
+#include "scene/mesh_report.hpp"
+#include "stages/tracing_arena.hpp"
+
+namespace wavetrace {
+namespace {
+
+constexpr std::size_t kBatch = kDefaultBatchCapacity;
+
+// Crossings of the surface along a ray from `origin`, counted one hit at a time.
+std::size_t crossings(const Accelerator& reference, const glm::vec3& origin, const glm::vec3& direction, float step) {
+  RayBatch ray(1);
+  HitBatch hit(1);
+  ray.count = 1;
+  ray.origin_x[0] = origin.x;
+  ray.origin_y[0] = origin.y;
+  ray.origin_z[0] = origin.z;
+  ray.direction_x[0] = direction.x;
+  ray.direction_y[0] = direction.y;
+  ray.direction_z[0] = direction.z;
+  ray.tmax[0] = std::numeric_limits<float>::infinity();
+  ray.flags[0] = ray_flags::alive;
+  ray.kind[0] = RayKind::camera;
+  float tmin = 0.0f;
+  std::size_t count = 0;
+  for (; count < 10000; ++count) {
+    ray.tmin[0] = tmin;
+    reference.intersect_closest(ray, hit, ray.all());
+    if (!hit.is_hit(0)) break;
+    tmin = hit.t[0] + step;
+  }
+  return count;
+}
+
+std::vector<glm::vec3> inside_points(const Scene& scene, const Accelerator& reference, std::size_t wanted) {
+  const Bounds3 bounds = scene.mesh.bounds();
+  const float step = 1e-6f * bounds.diagonal();
+  const glm::vec3 directions[3] = {glm::normalize(glm::vec3(1.0f, 0.1234f, 0.0567f)),
+                                   glm::normalize(glm::vec3(-0.0789f, 1.0f, 0.1357f)),
+                                   glm::normalize(glm::vec3(0.0246f, -0.1593f, 1.0f))};
+  std::vector<glm::vec3> points;
+  const std::size_t candidates_per_round = 4 * wanted;
+  for (std::uint32_t round = 0; points.size() < wanted && round < 16; ++round) {
+    std::vector<char> inside(candidates_per_round, 0);
+    std::vector<glm::vec3> candidates(candidates_per_round);
+    tbb::parallel_for(std::size_t{0}, candidates_per_round, [&](std::size_t c) {
+      const auto id = static_cast<std::uint32_t>(c);
+      const UnitPair xy = unit_pair(random_bits(id, round, 0, RandomPurpose::benchmark));
+      const float z = unit_float(random_bits(id, round, 1, RandomPurpose::benchmark));
+      candidates[c] = bounds.lower + bounds.extent() * glm::vec3(xy.first, xy.second, z);
+      bool odd_everywhere = true;
+      for (const glm::vec3& direction : directions) odd_everywhere &= crossings(reference, candidates[c], direction, step) % 2 == 1;
+      inside[c] = odd_everywhere;
+    });
+    for (std::size_t c = 0; c < candidates_per_round && points.size() < wanted; ++c) {
+      if (inside[c]) points.push_back(candidates[c]);
+    }
+  }
+  if (points.empty()) throw std::runtime_error(scene.name + ": found no point inside the mesh");
+  return points;
+}
+
+}  // namespace
+
+LeakReport run_leak_bench(const Scene& scene, const std::vector<AcceleratorSpec>& accelerators, std::size_t count,
+                          int threads) {
+  const MeshReport topology = analyze_mesh(scene.mesh);
+  if (!topology.closed()) {
+    throw std::runtime_error(fmt::format("{}: the leak test needs a closed mesh, and this one has {} boundary and {} "
+                                         "non-manifold edges",
+                                         scene.name, topology.boundary_edges, topology.non_manifold_edges));
+  }
+  LeakReport report;
+  report.scene = scene.name;
+  report.triangles = scene.mesh.triangle_count();
+  TracingArena arena(threads);
+  arena.execute([&] {
+    AcceleratorOptions robust;
+    robust.embree.mode = EmbreeMode::robust;
+    const auto reference = make_accelerator(scene.mesh, robust);
+    const std::vector<glm::vec3> points = inside_points(scene, *reference, std::min<std::size_t>(count, 4096));
+    report.inside_points = points.size();
+
+    std::vector<std::unique_ptr<RayBatch>> batches((count + kBatch - 1) / kBatch);
+    tbb::parallel_for(std::size_t{0}, batches.size(), [&](std::size_t b) {
+      batches[b] = std::make_unique<RayBatch>(kBatch);
+      RayBatch& rays = *batches[b];
+      rays.count = std::min(kBatch, count - b * kBatch);
+      for (std::size_t i = 0; i < rays.count; ++i) {
+        const auto id = static_cast<std::uint32_t>(b * kBatch + i);
+        const glm::vec3& origin = points[id % points.size()];
+        const UnitPair u = unit_pair(random_bits(id, 0, 3, RandomPurpose::benchmark));
+        const float z = 1.0f - 2.0f * u.first, phi = 2.0f * kPi * u.second;
+        const float ring = std::sqrt(std::max(0.0f, 1.0f - z * z));
+        rays.origin_x[i] = origin.x;
+        rays.origin_y[i] = origin.y;
+        rays.origin_z[i] = origin.z;
+        rays.direction_x[i] = ring * std::cos(phi);
+        rays.direction_y[i] = ring * std::sin(phi);
+        rays.direction_z[i] = z;
+        rays.tmin[i] = 0.0f;
+        rays.tmax[i] = std::numeric_limits<float>::infinity();
+        rays.flags[i] = ray_flags::alive;
+        rays.kind[i] = RayKind::camera;
+      }
+    });
+
+    for (const AcceleratorSpec& spec : accelerators) {
+      const auto accelerator = make_accelerator(scene.mesh, spec.options);
+      std::vector<std::size_t> escaped(batches.size(), 0);
+      tbb::parallel_for(std::size_t{0}, batches.size(), [&](std::size_t b) {
+        HitBatch hits(kBatch);
+        accelerator->intersect_closest(*batches[b], hits, batches[b]->all());
+        for (std::size_t i = 0; i < batches[b]->count; ++i) escaped[b] += !hits.is_hit(i);
+      });
+      LeakResult result{spec.label, count, 0};
+      for (std::size_t e : escaped) result.escaped += e;
+      report.results.push_back(result);
+    }
+  });
+  return report;
+}
+
+nlohmann::json to_json(const LeakReport& report) {
+  nlohmann::json results = nlohmann::json::array();
+  for (const LeakResult& r : report.results) results.push_back({{"accel", r.label}, {"rays", r.rays}, {"escaped", r.escaped}});
+  return {{"scene", {{"source", report.scene}, {"triangles", report.triangles}}},
+          {"inside_points", report.inside_points},
+          {"results", results}};
+}
+
+std::string to_table(const LeakReport& report) {
+  std::string table = fmt::format("{}: {} triangles; rays from {} points inside\n", report.scene, report.triangles,
+                                  report.inside_points);
+  table += fmt::format("{:<24} {:>12} {:>10}\n", "accel", "rays", "escaped");
+  for (const LeakResult& r : report.results) table += fmt::format("{:<24} {:>12} {:>10}\n", r.label, r.rays, r.escaped);
+  return table;
+}
+
+}  // namespace wavetrace

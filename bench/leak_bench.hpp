@@ -1,0 +1,37 @@
+// `wavetrace bench leak`: rays from random points strictly inside a closed mesh, in random
+// directions. Every such ray must hit the surface; one that finds nothing has slipped
+// through a crack between triangles (a watertightness failure).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "bench/accel_bench.hpp"
+#include "scene/scene.hpp"
+
+namespace wavetrace {
+
+struct LeakResult {
+  std::string label;
+  std::size_t rays = 0;
+  std::size_t escaped = 0;
+};
+
+struct LeakReport {
+  std::string scene;
+  std::size_t triangles = 0;
+  std::size_t inside_points = 0;
+  std::vector<LeakResult> results;
+};
+
+// Throws std::runtime_error naming the reason when the scene is not closed, or when no
+// inside point is found.
+LeakReport run_leak_bench(const Scene& scene, const std::vector<AcceleratorSpec>& accelerators, std::size_t count,
+                          int threads);
+
+nlohmann::json to_json(const LeakReport& report);
+std::string to_table(const LeakReport& report);
+
+}  // namespace wavetrace

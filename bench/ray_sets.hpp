@@ -1,0 +1,37 @@
+// The benchmark's ray sets, made once and traced by every accelerator: primary (camera),
+// diffuse (first bounces off primary hits), shadow (primary hits toward light samples),
+// random (from a sphere around the scene to points inside it).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "accel/accelerator.hpp"
+#include "memory/ray_batch.hpp"
+#include "scene/scene.hpp"
+
+namespace wavetrace {
+
+enum class RaySetKind { primary, diffuse, shadow, random };
+RaySetKind parse_ray_set_kind(const std::string& text);
+std::string to_string(RaySetKind kind);
+
+struct RaySet {
+  RaySetKind kind;
+  std::vector<std::unique_ptr<RayBatch>> batches;
+  std::size_t count() const;
+  bool any_hit() const { return kind == RaySetKind::shadow; }
+};
+
+// `reference` supplies the primary hits that diffuse and shadow rays start from. A scene
+// without emissive triangles gets shadow rays toward a virtual square light above it.
+// Throws std::runtime_error if no primary ray hits the scene (diffuse, shadow).
+RaySet make_ray_set(RaySetKind kind, const Scene& scene, const Accelerator& reference, std::size_t count,
+                    std::size_t batch_size = kDefaultBatchCapacity);
+
+// Every ray of the set traced by `accelerator` into one HitBatch per ray batch.
+std::vector<std::unique_ptr<HitBatch>> trace_ray_set(const Accelerator& accelerator, const RaySet& rays);
+
+}  // namespace wavetrace
