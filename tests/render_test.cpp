@@ -117,5 +117,17 @@ TEST(Render, MaxDepthZeroIsDirectLightOnly) {
   EXPECT_LE(direct.output.run.stages[3].rays_out, direct.output.run.stages[0].rays_out);
 }
 
+TEST(Render, BvhAndEmbreeRenderTheSameImage) {
+  const Rendered embree = render(default_scene(), {"accel.type=embree"});
+  const Rendered bvh = render(default_scene(), {"accel.type=bvh", "accel.bvh.layout=veb"});
+  double embree_sum = 0.0, difference = 0.0;
+  for (std::size_t i = 0; i < embree.output.image.size(); ++i) {
+    embree_sum += embree.output.image[i];
+    difference += std::fabs(embree.output.image[i] - bvh.output.image[i]);
+  }
+  // Same rays, same randomness: only rays through shared edges may pick the other triangle.
+  EXPECT_LT(difference, 1e-3 * embree_sum);
+}
+
 }  // namespace
 }  // namespace wavetrace

@@ -1,0 +1,228 @@
+// The BVH baseline: builder invariants, agreement with Embree on the same rays, any-hit
+// against closest-hit, identical hits for every layout, and no leaks.
+#include <algorithm>
+
+#include <gtest/gtest.h>
+#include <glm/vector_relational.hpp>
+
+#include "accel/bvh/bvh_accelerator.hpp"
+#include "accel/bvh/sah_builder.hpp"
+#include "accel/registry.hpp"
+#include "bench/accel_bench.hpp"
+#include "bench/leak_bench.hpp"
+#include "bench/ray_sets.hpp"
+#include "scene/builtin_scenes.hpp"
+#include "scene/scene.hpp"
+#include "test_support.hpp"
+
+namespace wavetrace {
+namespace {
+
+std::vector<Bounds3> triangle_bounds(const TriangleMesh& mesh) {
+  std::vector<Bounds3> bounds(mesh.triangle_count());
+  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+    for (int k = 0; k < 3; ++k) bounds[t].extend(mesh.positions[mesh.triangles[t][k]]);
+  }
+  return bounds;
+}
+
+bool contains(const Bounds3& outer, const Bounds3& inner) {
+  return glm::all(glm::lessThanEqual(outer.lower, inner.lower)) && glm::all(glm::greaterThanEqual(outer.upper, inner.upper));
+}
+
+TEST(SahBuilder, EveryPrimitiveOnceLeavesSmallBoundsNested) {
+  const Scene scene = make_builtin_scene("builtin:sphere:20k");
+  const std::vector<Bounds3> bounds = triangle_bounds(scene.mesh);
+  for (std::uint32_t leaf_size : {1u, 4u, 16u}) {
+    SahOptions options;
+    options.max_leaf_size = leaf_size;
+    const BuildTree tree = build_sah_tree(bounds, options);
+    std::vector<int> seen(bounds.size(), 0);
+    std::size_t leaves = 0;
+    for (const BuildNode& node : tree.nodes) {
+      if (node.leaf()) {
+        ++leaves;
+        EXPECT_LE(node.count, leaf_size);
+        for (std::uint32_t k = 0; k < node.count; ++k) {
+          const std::uint32_t primitive = tree.primitive_order[node.first + k];
+          ++seen[primitive];
+          EXPECT_TRUE(contains(node.bounds, bounds[primitive]));
+        }
+      } else {
+        EXPECT_TRUE(contains(node.bounds, tree.nodes[node.left].bounds));
+        EXPECT_TRUE(contains(node.bounds, tree.nodes[node.right].bounds));
+      }
+    }
+    EXPECT_TRUE(std::all_of(seen.begin(), seen.end(), [](int n) { return n == 1; }));
+    EXPECT_EQ(tree.nodes.size(), 2 * leaves - 1);
+    EXPECT_LE(tree.depth(), kMaxTreeDepth);
+  }
+}
+
+TEST(SahBuilder, CoincidentCentroidsStillSplitAndBadOptionsAreErrors) {
+  std::vector<Bounds3> same(100);
+  for (Bounds3& b : same) {
+    b.extend(glm::vec3(-1.0f));
+    b.extend(glm::vec3(1.0f));
+  }
+  const BuildTree tree = build_sah_tree(same, SahOptions{});
+  for (const BuildNode& node : tree.nodes) {
+    if (node.leaf()) EXPECT_LE(node.count, 4u);
+  }
+  SahOptions bad;
+  bad.max_leaf_size = 17;
+  EXPECT_THROW(build_sah_tree(same, bad), std::invalid_argument);
+  EXPECT_THROW(build_sah_tree({}, SahOptions{}), std::invalid_argument);
+}
+
+struct Agreement {
+  double hit = 0.0;
+  std::size_t rays = 0;
+};
+
+Agreement agreement(const Scene& scene, const Accelerator& accelerator, RaySetKind kind, std::size_t count) {
+  AcceleratorOptions robust;
+  robust.embree.mode = EmbreeMode::robust;
+  const auto reference = make_accelerator(scene.mesh, robust);
+  const RaySet rays = make_ray_set(kind, scene, *reference, count);
+  const auto expected = trace_ray_set(*reference, rays);
+  const auto actual = trace_ray_set(accelerator, rays);
+  std::size_t same = 0;
+  for (std::size_t b = 0; b < rays.batches.size(); ++b) {
+    for (std::size_t i = 0; i < rays.batches[b]->count; ++i) same += expected[b]->is_hit(i) == actual[b]->is_hit(i);
+  }
+  return {double(same) / double(rays.count()), rays.count()};
+}
+
+class BvhAgreesWithEmbree : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(BvhAgreesWithEmbree, OnAtLeast9999PerMyriadOfRays) {
+  const Scene scene = load_scene({GetParam(), 0});
+  const auto bvh = make_bvh_accelerator(scene.mesh, BvhOptions{});
+  for (const RaySetKind kind : {RaySetKind::primary, RaySetKind::random, RaySetKind::diffuse, RaySetKind::shadow}) {
+    const Agreement result = agreement(scene, *bvh, kind, 20000);
+    EXPECT_GE(result.hit, 0.9999) << to_string(kind) << " on " << GetParam();
+    EXPECT_GT(result.rays, 10000u);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, BvhAgreesWithEmbree,
+                         ::testing::Values("builtin:sphere:100k", "builtin:soup:50k",
+                                           std::string(WAVETRACE_DATA_DIR) + "/bunny00.off"),
+                         [](const ::testing::TestParamInfo<std::string>& info) {
+                           return std::string(info.index == 0 ? "sphere" : info.index == 1 ? "soup" : "bunny");
+                         });
+
+TEST(Bvh, AnyHitAgreesWithClosestHitOnOcclusion) {
+  const Scene scene = make_builtin_scene("builtin:default:20000");
+  const auto bvh = make_bvh_accelerator(scene.mesh, BvhOptions{});
+  const auto reference = make_accelerator(scene.mesh, AcceleratorOptions{});
+  for (const RaySetKind kind : {RaySetKind::shadow, RaySetKind::random}) {
+    const RaySet rays = make_ray_set(kind, scene, *reference, 20000);
+    for (const auto& batch : rays.batches) {
+      HitBatch closest(batch->capacity()), any(batch->capacity());
+      bvh->intersect_closest(*batch, closest, batch->all());
+      bvh->intersect_any(*batch, any, batch->all());
+      for (std::size_t i = 0; i < batch->count; ++i) ASSERT_EQ(closest.is_hit(i), any.is_hit(i)) << i;
+    }
+  }
+}
+
+TEST(Bvh, EveryLayoutGivesIdenticalHits) {
+  const Scene scene = make_builtin_scene("builtin:sphere:50k");
+  const auto reference = make_accelerator(scene.mesh, AcceleratorOptions{});
+  const RaySet rays = make_ray_set(RaySetKind::random, scene, *reference, 20000);
+  const auto baseline = trace_ray_set(*make_bvh_accelerator(scene.mesh, BvhOptions{}), rays);
+  for (const NodeLayout layout : {NodeLayout::breadth_first, NodeLayout::van_emde_boas}) {
+    BvhOptions options;
+    options.layout = layout;
+    const auto hits = trace_ray_set(*make_bvh_accelerator(scene.mesh, options), rays);
+    for (std::size_t b = 0; b < rays.batches.size(); ++b) {
+      for (std::size_t i = 0; i < rays.batches[b]->count; ++i) {
+        ASSERT_EQ(hits[b]->primitive[i], baseline[b]->primitive[i]) << to_string(layout);
+        ASSERT_EQ(hits[b]->t[i], baseline[b]->t[i]) << to_string(layout);
+      }
+    }
+  }
+  // Morton order and other leaf sizes change the tree: same hits, the same distance up to
+  // rounding (a ray through a shared edge may report either triangle).
+  for (const auto& [order, leaf] : {std::pair{TriangleOrder::morton, 4u}, std::pair{TriangleOrder::input, 1u},
+                                    std::pair{TriangleOrder::input, 16u}}) {
+    BvhOptions options;
+    options.triangle_order = order;
+    options.max_leaf_size = leaf;
+    const auto hits = trace_ray_set(*make_bvh_accelerator(scene.mesh, options), rays);
+    for (std::size_t b = 0; b < rays.batches.size(); ++b) {
+      for (std::size_t i = 0; i < rays.batches[b]->count; ++i) {
+        ASSERT_EQ(hits[b]->is_hit(i), baseline[b]->is_hit(i));
+        if (hits[b]->is_hit(i)) ASSERT_NEAR(hits[b]->t[i], baseline[b]->t[i], 1e-5f);
+      }
+    }
+  }
+}
+
+TEST(Bvh, MemoryIsNodesIndicesAndTheIndexedFaceSet) {
+  const Scene scene = make_builtin_scene("builtin:sphere:20k");
+  const auto bvh = make_bvh_accelerator(scene.mesh, BvhOptions{});
+  const MemoryReport memory = bvh->memory();
+  const std::size_t triangles = scene.mesh.triangle_count();
+  EXPECT_EQ(memory.geometry, triangles * 12 + scene.mesh.vertex_count() * 12);
+  EXPECT_EQ((memory.hierarchy - triangles * 4) % 32, 0u);  // whole 32-byte nodes
+  EXPECT_LT(memory.hierarchy - triangles * 4, 2 * triangles * 32);
+  EXPECT_EQ(memory.other, 0u);
+  BvhOptions morton;
+  morton.triangle_order = TriangleOrder::morton;
+  EXPECT_EQ(make_bvh_accelerator(scene.mesh, morton)->memory().other, triangles * 4);  // the input-id map
+  EXPECT_GE(bvh->build().peak_bytes, memory.total());
+}
+
+TEST(Bvh, NoRayEscapesTheClosedSphere) {
+  const Scene scene = make_builtin_scene("builtin:sphere:200k");
+  const LeakReport report = run_leak_bench(scene, {parse_accelerator_spec("bvh", Config{})}, 200000, 0);
+  ASSERT_EQ(report.results.size(), 1u);
+  EXPECT_EQ(report.results[0].escaped, 0u);
+  EXPECT_GT(report.inside_points, 1000u);
+}
+
+TEST(LeakBench, RefusesAnOpenMesh) {
+  const Scene terrain = make_builtin_scene("builtin:terrain:2000");
+  try {
+    run_leak_bench(terrain, {parse_accelerator_spec("bvh", Config{})}, 1000, 1);
+    FAIL();
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find("boundary"), std::string::npos) << error.what();
+  }
+}
+
+TEST(AccelBench, ReportsEveryFieldAndEmbreeAgreesWithItself) {
+  const Scene scene = make_builtin_scene("builtin:sphere:5000");
+  AccelBenchRequest request;
+  request.accelerators = {parse_accelerator_spec("embree", Config{}), parse_accelerator_spec("bvh:layout=veb", Config{})};
+  request.count = 5000;
+  request.repeats = 3;
+  request.threads = 1;
+  const AccelBenchReport report = run_accel_bench(scene, request);
+  ASSERT_EQ(report.results.size(), 2u);
+  EXPECT_EQ(report.results[0].hit_agreement, 1.0);
+  EXPECT_EQ(*report.results[0].t_error_max, 0.0);
+  EXPECT_EQ(report.results[0].mrays_per_s_runs.size(), 3u);
+  EXPECT_GT(report.results[1].mrays_per_s, 0.0);
+  const nlohmann::json json = to_json(report);
+  for (const char* key : {"accel", "bytes", "bytes_per_triangle", "parts", "build_seconds", "build_peak_bytes",
+                          "mrays_per_s", "hit_agreement", "prim_agreement", "t_error_max", "t_error_mean"}) {
+    EXPECT_TRUE(json["results"][1].contains(key)) << key;
+  }
+  EXPECT_EQ(json["results"][1]["accel"], "bvh:layout=veb");
+  EXPECT_NE(to_csv(report).find("bvh:layout=veb"), std::string::npos);
+}
+
+TEST(AccelBench, BadSpecsNameTheProblem) {
+  EXPECT_THROW(parse_accelerator_spec("octree", Config{}), ConfigError);
+  EXPECT_THROW(parse_accelerator_spec("bvh:layout=spiral", Config{}), ConfigError);
+  EXPECT_THROW(parse_accelerator_spec("bvh:leaf_size=99", Config{}), ConfigError);
+  EXPECT_THROW(parse_accelerator_spec("bvh:veb", Config{}), ConfigError);
+  EXPECT_EQ(parse_accelerator_spec("bvh:leaf_size=8:layout=veb", Config{}).options.bvh.max_leaf_size, 8u);
+}
+
+}  // namespace
+}  // namespace wavetrace
