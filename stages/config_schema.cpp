@@ -45,6 +45,7 @@ const std::vector<ConfigKey>& config_schema() {
       {"accel.bvh.triangle_order", T::text, std::string("input"), 0, 0, {"input", "morton"},
        "triangle and vertex order of the BVH's indexed face set"},
       {"accel.bvh.bins", T::integer, std::int64_t{16}, 2, 64, {}, "SAH bins per axis"},
+      {"accel.bvh.width", T::integer, std::int64_t{2}, 2, 8, {}, "2: binary 32-byte nodes; 8: AVX2 8-wide nodes"},
 
       {"pipeline.stages", T::text_list, std::vector<std::string>{"generate", "trace", "shade", "spawn"}, 0, 0,
        {"generate", "trace", "shade", "spawn"}, "the stage chain; spawn at the end loops back"},

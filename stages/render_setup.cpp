@@ -47,6 +47,10 @@ AcceleratorOptions accelerator_options(const Config& config) {
   options.bvh.layout = parse_node_layout(config.text("accel.bvh.layout"));
   options.bvh.triangle_order = parse_triangle_order(config.text("accel.bvh.triangle_order"));
   options.bvh.bins = static_cast<std::uint32_t>(config.integer("accel.bvh.bins"));
+  options.bvh.width = static_cast<std::uint32_t>(config.integer("accel.bvh.width"));
+  if (options.bvh.width != 2 && options.bvh.width != 8) {
+    throw ConfigError(fmt::format("accel.bvh.width = {}: must be 2 or 8", options.bvh.width));
+  }
   return options;
 }
 

@@ -155,7 +155,9 @@ TEST(Bvh, EveryLayoutGivesIdenticalHits) {
     for (std::size_t b = 0; b < rays.batches.size(); ++b) {
       for (std::size_t i = 0; i < rays.batches[b]->count; ++i) {
         ASSERT_EQ(hits[b]->is_hit(i), baseline[b]->is_hit(i));
-        if (hits[b]->is_hit(i)) ASSERT_NEAR(hits[b]->t[i], baseline[b]->t[i], 1e-5f);
+        if (hits[b]->is_hit(i)) {
+          ASSERT_NEAR(hits[b]->t[i], baseline[b]->t[i], 1e-5f);
+        }
       }
     }
   }

@@ -7,11 +7,9 @@
 #include <numeric>
 #include <stdexcept>
 
-#include <tbb/parallel_for.h>
-#include <tbb/parallel_sort.h>
 
 #include "accel/bvh/bvh_node.hpp"
-#include "kernels/morton.hpp"
+#include "accel/bvh/wide_bvh_accelerator.hpp"
 #include "kernels/ray_box.hpp"
 #include "kernels/triangle_intersect.hpp"
 #include "memory/cache_aligned_allocator.hpp"
@@ -21,87 +19,27 @@ namespace {
 
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
 
-// The indexed face set in Morton order of triangle centroids, vertices renumbered by first use.
-struct ReorderedMesh {
-  std::vector<glm::vec3> positions;
-  std::vector<glm::uvec3> triangles;
-  std::vector<std::uint32_t> input_id;  // storage slot -> the mesh's triangle index
-};
-
-ReorderedMesh reorder_by_morton(const TriangleMesh& mesh) {
-  const Bounds3 bounds = mesh.bounds();
-  const glm::vec3 extent = glm::max(bounds.extent(), glm::vec3(1e-30f));
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> keys(mesh.triangle_count());
-  tbb::parallel_for(std::size_t{0}, mesh.triangle_count(), [&](std::size_t t) {
-    const glm::uvec3& tri = mesh.triangles[t];
-    const glm::vec3 centroid = (mesh.positions[tri.x] + mesh.positions[tri.y] + mesh.positions[tri.z]) / 3.0f;
-    const glm::vec3 unit = glm::clamp((centroid - bounds.lower) / extent, 0.0f, 1.0f);
-    const auto quantize = [](float x) { return static_cast<std::uint64_t>(x * 1048575.0f); };  // 20 bits per axis
-    keys[t] = {morton3d_encode(quantize(unit.x), quantize(unit.y), quantize(unit.z)), static_cast<std::uint32_t>(t)};
-  });
-  tbb::parallel_sort(keys.begin(), keys.end());
-
-  ReorderedMesh out;
-  out.triangles.resize(keys.size());
-  out.input_id.resize(keys.size());
-  std::vector<std::uint32_t> new_vertex(mesh.vertex_count(), std::numeric_limits<std::uint32_t>::max());
-  out.positions.reserve(mesh.vertex_count() + 1);
-  for (std::size_t slot = 0; slot < keys.size(); ++slot) {
-    const std::uint32_t t = keys[slot].second;
-    out.input_id[slot] = t;
-    glm::uvec3 tri = mesh.triangles[t];
-    for (int k = 0; k < 3; ++k) {
-      std::uint32_t& mapped = new_vertex[tri[k]];
-      if (mapped == std::numeric_limits<std::uint32_t>::max()) {
-        mapped = static_cast<std::uint32_t>(out.positions.size());
-        out.positions.push_back(mesh.positions[tri[k]]);
-      }
-      tri[k] = mapped;
-    }
-    out.triangles[slot] = tri;
-  }
-  return out;
-}
-
 class BvhAccelerator final : public Accelerator {
  public:
-  BvhAccelerator(const TriangleMesh& mesh, const BvhOptions& options) : options_(options) {
+  BvhAccelerator(const TriangleMesh& mesh, const BvhOptions& options)
+      : options_(options), geometry_(mesh, options.triangle_order) {
     const auto start = std::chrono::steady_clock::now();
-    std::size_t working_bytes = 0;
-    if (options.triangle_order == TriangleOrder::morton) {
-      reordered_ = reorder_by_morton(mesh);
-      positions_ = reordered_.positions.data();
-      triangles_ = reordered_.triangles.data();
-      vertex_count_ = reordered_.positions.size();
-      working_bytes += mesh.triangle_count() * (sizeof(std::pair<std::uint64_t, std::uint32_t>) + 4);
-    } else {
-      positions_ = mesh.positions.data();
-      triangles_ = mesh.triangles.data();
-      vertex_count_ = mesh.vertex_count();
-    }
-    triangle_count_ = mesh.triangle_count();
-
-    std::vector<Bounds3> bounds(triangle_count_);
-    tbb::parallel_for(std::size_t{0}, triangle_count_, [&](std::size_t t) {
-      const glm::uvec3& tri = triangles_[t];
-      Bounds3 b;
-      b.extend(positions_[tri.x]);
-      b.extend(positions_[tri.y]);
-      b.extend(positions_[tri.z]);
-      bounds[t] = b;
-    });
+    positions_ = geometry_.positions();
+    triangles_ = geometry_.triangles();
+    const std::vector<Bounds3> bounds = geometry_.triangle_bounds();
     SahOptions sah;
     sah.max_leaf_size = options.max_leaf_size;
     sah.bins = options.bins;
     const BuildTree tree = build_sah_tree(bounds, sah);
-    working_bytes = std::max(working_bytes, bounds.size() * sizeof(Bounds3) + tree.peak_bytes);
+    const std::size_t working_bytes =
+        std::max(geometry_.build_scratch_bytes(), bounds.size() * sizeof(Bounds3) + tree.peak_bytes);
 
     // Flatten in the chosen order: node i of the array is build node order[i].
     const std::vector<std::uint32_t> order = node_order(tree, options.layout);
     std::vector<std::uint32_t> position_of(tree.nodes.size());
     for (std::uint32_t i = 0; i < order.size(); ++i) position_of[order[i]] = i;
     nodes_.resize(order.size());
-    leaf_triangles_.resize(triangle_count_);
+    leaf_triangles_.resize(geometry_.triangle_count());
     std::uint32_t slot = 0;
     for (std::uint32_t i = 0; i < order.size(); ++i) {
       const BuildNode& built = tree.nodes[order[i]];
@@ -137,16 +75,18 @@ class BvhAccelerator final : public Accelerator {
   MemoryReport memory() const override {
     MemoryReport report;
     report.hierarchy = nodes_.size() * sizeof(BvhNode) + leaf_triangles_.size() * sizeof(std::uint32_t);
-    report.geometry = vertex_count_ * sizeof(glm::vec3) + triangle_count_ * sizeof(glm::uvec3);
-    report.other = reordered_.input_id.size() * sizeof(std::uint32_t);
+    report.geometry = geometry_.geometry_bytes();
+    report.other = geometry_.id_map_bytes();
     return report;
   }
 
   BuildReport build() const override { return build_; }
 
   std::vector<std::span<const std::byte>> memory_spans() const override {
-    return {std::as_bytes(std::span(nodes_)), std::as_bytes(std::span(leaf_triangles_)),
-            std::as_bytes(std::span(triangles_, triangle_count_)), std::as_bytes(std::span(positions_, vertex_count_))};
+    std::vector<std::span<const std::byte>> spans = {std::as_bytes(std::span(nodes_)),
+                                                     std::as_bytes(std::span(leaf_triangles_))};
+    for (const auto& span : geometry_.spans()) spans.push_back(span);
+    return spans;
   }
 
  private:
@@ -213,7 +153,7 @@ class BvhAccelerator final : public Accelerator {
       }
       if (found != kInvalidPrimitive) {
         hits.t[i] = best.t;
-        hits.primitive[i] = reordered_.input_id.empty() ? found : reordered_.input_id[found];
+        hits.primitive[i] = geometry_.input_id(found);
         hits.u[i] = best.u;
         hits.v[i] = best.v;
       }
@@ -221,11 +161,9 @@ class BvhAccelerator final : public Accelerator {
   }
 
   BvhOptions options_;
-  ReorderedMesh reordered_;
-  const glm::vec3* positions_ = nullptr;
+  IndexedFaceSet geometry_;
+  const glm::vec3* positions_ = nullptr;  // geometry_'s, cached for the hot loop
   const glm::uvec3* triangles_ = nullptr;
-  std::size_t vertex_count_ = 0;
-  std::size_t triangle_count_ = 0;
   std::vector<BvhNode, CacheAlignedAllocator<BvhNode>> nodes_;
   std::vector<std::uint32_t> leaf_triangles_;
   std::uint32_t depth_ = 0;
@@ -234,15 +172,9 @@ class BvhAccelerator final : public Accelerator {
 
 }  // namespace
 
-TriangleOrder parse_triangle_order(const std::string& text) {
-  if (text == "input") return TriangleOrder::input;
-  if (text == "morton") return TriangleOrder::morton;
-  throw std::invalid_argument("unknown triangle order '" + text + "' (input, morton)");
-}
-
-std::string to_string(TriangleOrder order) { return order == TriangleOrder::morton ? "morton" : "input"; }
-
 std::unique_ptr<Accelerator> make_bvh_accelerator(const TriangleMesh& mesh, const BvhOptions& options) {
+  if (options.width == 8) return make_wide_bvh_accelerator(mesh, options);
+  if (options.width != 2) throw std::invalid_argument("bvh width must be 2 or 8");
   return std::make_unique<BvhAccelerator>(mesh, options);
 }
 

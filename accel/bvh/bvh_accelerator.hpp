@@ -6,15 +6,12 @@
 #include <string>
 
 #include "accel/accelerator.hpp"
+#include "accel/bvh/indexed_face_set.hpp"
 #include "accel/bvh/node_layout.hpp"
 #include "accel/bvh/sah_builder.hpp"
 #include "scene/triangle_mesh.hpp"
 
 namespace wavetrace {
-
-enum class TriangleOrder { input, morton };
-TriangleOrder parse_triangle_order(const std::string& text);  // "input" | "morton"
-std::string to_string(TriangleOrder order);
 
 struct BvhOptions {
   std::uint32_t max_leaf_size = 4;  // 1..16
@@ -24,9 +21,12 @@ struct BvhOptions {
   // first-use order, so a leaf's triangles and vertices sit close together in memory.
   TriangleOrder triangle_order = TriangleOrder::input;
   std::uint32_t bins = 16;
+  // 2: the papers' baseline of 32-byte binary nodes. 8: the same tree collapsed into
+  // 256-byte 8-wide nodes tested with AVX2 (wide_bvh_node.hpp); node layout is then depth-first.
+  std::uint32_t width = 2;
 };
 
-// `mesh` must outlive the accelerator (with input order its buffers are read in place).
+// Either width; `mesh` must outlive the accelerator (with input order its buffers are read in place).
 std::unique_ptr<Accelerator> make_bvh_accelerator(const TriangleMesh& mesh, const BvhOptions& options);
 
 }  // namespace wavetrace

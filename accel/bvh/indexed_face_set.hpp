@@ -1,0 +1,48 @@
+// The geometry a BVH traverses: an indexed face set, either the mesh's own arrays read in
+// place or a copy in Morton order of triangle centroids (vertices renumbered by first use).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "scene/triangle_mesh.hpp"
+
+namespace wavetrace {
+
+enum class TriangleOrder { input, morton };
+TriangleOrder parse_triangle_order(const std::string& text);  // "input" | "morton"
+std::string to_string(TriangleOrder order);
+
+class IndexedFaceSet {
+ public:
+  // `mesh` must outlive this object when order is input (its arrays are not copied).
+  IndexedFaceSet(const TriangleMesh& mesh, TriangleOrder order);
+
+  const glm::vec3* positions() const { return positions_; }
+  const glm::uvec3* triangles() const { return triangles_; }
+  std::size_t vertex_count() const { return vertex_count_; }
+  std::size_t triangle_count() const { return triangle_count_; }
+
+  // The mesh's index of the triangle stored at `slot`.
+  std::uint32_t input_id(std::uint32_t slot) const { return input_id_.empty() ? slot : input_id_[slot]; }
+
+  std::vector<Bounds3> triangle_bounds() const;  // parallel
+  std::size_t geometry_bytes() const { return vertex_count_ * sizeof(glm::vec3) + triangle_count_ * sizeof(glm::uvec3); }
+  std::size_t id_map_bytes() const { return input_id_.size() * sizeof(std::uint32_t); }
+  std::size_t build_scratch_bytes() const { return build_scratch_bytes_; }
+  std::vector<std::span<const std::byte>> spans() const;
+
+ private:
+  std::vector<glm::vec3> owned_positions_;
+  std::vector<glm::uvec3> owned_triangles_;
+  std::vector<std::uint32_t> input_id_;  // empty for input order
+  const glm::vec3* positions_ = nullptr;
+  const glm::uvec3* triangles_ = nullptr;
+  std::size_t vertex_count_ = 0;
+  std::size_t triangle_count_ = 0;
+  std::size_t build_scratch_bytes_ = 0;
+};
+
+}  // namespace wavetrace

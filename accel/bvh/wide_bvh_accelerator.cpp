@@ -1,0 +1,269 @@
+// The 8-wide BVH: the binary SAH tree collapsed (each node adopts the largest-area inner
+// child's children until it has eight), traversed one ray at a time with all eight child
+// boxes tested in one AVX2 pass, nearest child first.
+#include "accel/bvh/wide_bvh_accelerator.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <chrono>
+#include <limits>
+
+#if defined(__AVX2__)
+#include <immintrin.h>
+#endif
+
+#include "accel/bvh/indexed_face_set.hpp"
+#include "accel/bvh/wide_bvh_node.hpp"
+#include "kernels/ray_box.hpp"
+#include "kernels/triangle_intersect.hpp"
+#include "memory/cache_aligned_allocator.hpp"
+
+namespace wavetrace {
+namespace {
+
+constexpr float kInfinity = std::numeric_limits<float>::infinity();
+constexpr int kWidth = WideBvhNode::kWidth;
+
+float half_area(const Bounds3& b) {
+  const glm::vec3 e = b.extent();
+  return e.x * e.y + e.y * e.z + e.z * e.x;
+}
+
+// Per-ray constants of the eight-box test.
+struct WideRay {
+  glm::vec3 origin;
+  glm::vec3 inverse;
+  int zero_axes;  // bit a set: direction[a] == 0, that slab is tested by comparison
+};
+
+// Entry distances of the ray into the node's eight child boxes; returns the mask of the
+// lanes entered (bit k: child k), whose distances are valid.
+[[gnu::always_inline]] inline unsigned intersect_children(const WideBvhNode& node, const WideRay& ray, float tmin,
+                                                          float tmax, float distance[kWidth]) {
+#if defined(__AVX2__)
+  const float* lower[3] = {node.lower_x, node.lower_y, node.lower_z};
+  const float* upper[3] = {node.upper_x, node.upper_y, node.upper_z};
+  const __m256 infinity = _mm256_set1_ps(kInfinity);
+  __m256 near = _mm256_set1_ps(tmin);
+  __m256 far = infinity;
+  for (int axis = 0; axis < 3; ++axis) {
+    const __m256 lo = _mm256_load_ps(lower[axis]);
+    const __m256 hi = _mm256_load_ps(upper[axis]);
+    const __m256 origin = _mm256_set1_ps(ray.origin[axis]);
+    __m256 entry, exit;
+    if (ray.zero_axes & (1 << axis)) {
+      // The ray never moves along this axis: inside the slab for all t, or never.
+      const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(lo, origin, _CMP_LE_OQ), _mm256_cmp_ps(origin, hi, _CMP_LE_OQ));
+      entry = _mm256_blendv_ps(infinity, _mm256_set1_ps(-kInfinity), inside);
+      exit = _mm256_blendv_ps(_mm256_set1_ps(-kInfinity), infinity, inside);
+    } else {
+      const __m256 inverse = _mm256_set1_ps(ray.inverse[axis]);
+      const __m256 t0 = _mm256_mul_ps(_mm256_sub_ps(lo, origin), inverse);
+      const __m256 t1 = _mm256_mul_ps(_mm256_sub_ps(hi, origin), inverse);
+      entry = _mm256_min_ps(t0, t1);
+      exit = _mm256_max_ps(t0, t1);
+    }
+    near = _mm256_max_ps(near, entry);
+    far = _mm256_min_ps(far, exit);
+  }
+  far = _mm256_min_ps(_mm256_mul_ps(far, _mm256_set1_ps(kSlabFarScale)), _mm256_set1_ps(tmax));
+  _mm256_store_ps(distance, near);
+  // near < inf as well: an unused lane (bounds +inf) gives near = far = +inf when tmax is +inf.
+  const __m256 entered = _mm256_and_ps(_mm256_cmp_ps(near, far, _CMP_LE_OQ), _mm256_cmp_ps(near, infinity, _CMP_LT_OQ));
+  return static_cast<unsigned>(_mm256_movemask_ps(entered));
+#else
+  unsigned mask = 0;
+  for (int k = 0; k < kWidth; ++k) {
+    const BoxRay box{ray.origin, ray.inverse};
+    distance[k] = intersect_box(box, {node.lower_x[k], node.lower_y[k], node.lower_z[k]},
+                                {node.upper_x[k], node.upper_y[k], node.upper_z[k]}, tmin, tmax);
+    if (distance[k] != kInfinity) mask |= 1u << k;
+  }
+  return mask;
+#endif
+}
+
+class WideBvhAccelerator final : public Accelerator {
+ public:
+  WideBvhAccelerator(const TriangleMesh& mesh, const BvhOptions& options) : geometry_(mesh, options.triangle_order) {
+    const auto start = std::chrono::steady_clock::now();
+    const std::vector<Bounds3> bounds = geometry_.triangle_bounds();
+    SahOptions sah;
+    sah.max_leaf_size = options.max_leaf_size;
+    sah.bins = options.bins;
+    const BuildTree tree = build_sah_tree(bounds, sah);
+    leaf_triangles_.reserve(geometry_.triangle_count());
+    nodes_.reserve(tree.nodes.size() / 4 + 1);
+    collapse(tree, 0);
+    build_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    build_.peak_bytes = std::max(geometry_.build_scratch_bytes(), bounds.size() * sizeof(Bounds3) + tree.peak_bytes) +
+                        tree.nodes.size() * sizeof(BuildNode) + memory().total();
+  }
+
+  std::string name() const override { return "bvh8"; }
+
+  void intersect_closest(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
+    traverse<false>(rays, hits, range);
+  }
+  void intersect_any(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
+    traverse<true>(rays, hits, range);
+  }
+
+  MemoryReport memory() const override {
+    return {nodes_.size() * sizeof(WideBvhNode) + leaf_triangles_.size() * sizeof(std::uint32_t),
+            geometry_.geometry_bytes(), geometry_.id_map_bytes()};
+  }
+  BuildReport build() const override { return build_; }
+
+  std::vector<std::span<const std::byte>> memory_spans() const override {
+    std::vector<std::span<const std::byte>> spans = {std::as_bytes(std::span(nodes_)),
+                                                     std::as_bytes(std::span(leaf_triangles_))};
+    for (const auto& span : geometry_.spans()) spans.push_back(span);
+    return spans;
+  }
+
+ private:
+  // Writes the wide node for binary node `root` (and, depth-first, everything below it);
+  // returns its index. A binary leaf at the root becomes a wide node with one leaf lane.
+  std::uint32_t collapse(const BuildTree& tree, std::uint32_t root) {
+    std::vector<std::uint32_t> lanes;
+    if (tree.nodes[root].leaf()) {
+      lanes.push_back(root);
+    } else {
+      lanes = {tree.nodes[root].left, tree.nodes[root].right};
+      while (lanes.size() < kWidth) {
+        // Open the inner child with the largest surface: the one most rays would enter.
+        auto widest = lanes.end();
+        for (auto lane = lanes.begin(); lane != lanes.end(); ++lane) {
+          if (!tree.nodes[*lane].leaf() &&
+              (widest == lanes.end() || half_area(tree.nodes[*lane].bounds) > half_area(tree.nodes[*widest].bounds))) {
+            widest = lane;
+          }
+        }
+        if (widest == lanes.end()) break;
+        const BuildNode& opened = tree.nodes[*widest];
+        *widest = opened.left;
+        lanes.push_back(opened.right);
+      }
+    }
+    const auto index = static_cast<std::uint32_t>(nodes_.size());
+    nodes_.emplace_back();
+    WideBvhNode node{};
+    for (int k = 0; k < kWidth; ++k) {
+      node.lower_x[k] = node.lower_y[k] = node.lower_z[k] = kInfinity;
+      node.upper_x[k] = node.upper_y[k] = node.upper_z[k] = kInfinity;
+    }
+    for (std::size_t k = 0; k < lanes.size(); ++k) {
+      const BuildNode& child = tree.nodes[lanes[k]];
+      node.lower_x[k] = child.bounds.lower.x, node.lower_y[k] = child.bounds.lower.y, node.lower_z[k] = child.bounds.lower.z;
+      node.upper_x[k] = child.bounds.upper.x, node.upper_y[k] = child.bounds.upper.y, node.upper_z[k] = child.bounds.upper.z;
+      if (child.leaf()) {
+        node.child[k] = static_cast<std::uint32_t>(leaf_triangles_.size());
+        node.count[k] = static_cast<std::uint8_t>(child.count);
+        for (std::uint32_t i = 0; i < child.count; ++i) leaf_triangles_.push_back(tree.primitive_order[child.first + i]);
+      } else {
+        node.child[k] = collapse(tree, lanes[k]);
+        node.count[k] = 0;
+      }
+    }
+    nodes_[index] = node;
+    return index;
+  }
+
+  template <bool kAnyHit>
+  void traverse(const RayBatch& rays, HitBatch& hits, RayRange range) const {
+    struct StackEntry {
+      std::uint32_t child;
+      std::uint32_t count;
+      float distance;
+    };
+    // Each level pushes at most seven siblings.
+    StackEntry stack[kMaxTreeDepth * (kWidth - 1) + kWidth];
+    const WideBvhNode* nodes = nodes_.data();
+    const glm::vec3* positions = geometry_.positions();
+    const glm::uvec3* triangles = geometry_.triangles();
+    for (std::uint32_t i = range.begin; i < range.end; ++i) {
+      hits.t[i] = kInfinity;
+      hits.primitive[i] = kInvalidPrimitive;
+      hits.u[i] = hits.v[i] = 0.0f;
+      if (!(rays.flags[i] & ray_flags::alive)) continue;
+      const glm::vec3 origin(rays.origin_x[i], rays.origin_y[i], rays.origin_z[i]);
+      const glm::vec3 direction(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]);
+      const WideRay box_ray{origin, 1.0f / direction,
+                            (direction.x == 0.0f) | (direction.y == 0.0f) << 1 | (direction.z == 0.0f) << 2};
+      const WatertightRay triangle_ray = make_watertight_ray(origin, direction);
+      const float tmin = rays.tmin[i];
+      float tmax = rays.tmax[i];
+      std::uint32_t found = kInvalidPrimitive;
+      TriangleHit best{kInfinity, 0.0f, 0.0f};
+
+      std::uint32_t top = 0;
+      StackEntry current{0, 0, tmin};
+      while (true) {
+        if (current.count == 0) {
+          alignas(32) float distance[kWidth];
+          const WideBvhNode& node = nodes[current.child];
+          unsigned mask = intersect_children(node, box_ray, tmin, tmax, distance);
+          if (mask != 0 && (mask & (mask - 1)) == 0) {  // one child entered: no sorting
+            const int k = std::countr_zero(mask);
+            current = {node.child[k], node.count[k], distance[k]};
+            continue;
+          }
+          StackEntry entered[kWidth];
+          int entered_count = 0;
+          for (; mask != 0; mask &= mask - 1) {
+            const int k = std::countr_zero(mask);
+            // Insertion by descending distance: the nearest ends last, to be taken first.
+            int slot = entered_count++;
+            while (slot > 0 && entered[slot - 1].distance < distance[k]) {
+              entered[slot] = entered[slot - 1];
+              --slot;
+            }
+            entered[slot] = {node.child[k], node.count[k], distance[k]};
+          }
+          if (entered_count > 0) {
+            for (int k = 0; k + 1 < entered_count; ++k) stack[top++] = entered[k];
+            current = entered[entered_count - 1];
+            continue;
+          }
+        } else {
+          const std::uint32_t end = current.child + current.count;
+          for (std::uint32_t slot = current.child; slot < end; ++slot) {
+            const std::uint32_t triangle = leaf_triangles_[slot];
+            const glm::uvec3& tri = triangles[triangle];
+            TriangleHit hit;
+            if (intersect_watertight(triangle_ray, positions[tri.x], positions[tri.y], positions[tri.z], tmin, tmax, hit)) {
+              tmax = hit.t;
+              best = hit;
+              found = triangle;
+              if constexpr (kAnyHit) break;
+            }
+          }
+          if (kAnyHit && found != kInvalidPrimitive) break;
+        }
+        while (top > 0 && stack[top - 1].distance > tmax) --top;
+        if (top == 0) break;
+        current = stack[--top];
+      }
+      if (found != kInvalidPrimitive) {
+        hits.t[i] = best.t;
+        hits.primitive[i] = geometry_.input_id(found);
+        hits.u[i] = best.u;
+        hits.v[i] = best.v;
+      }
+    }
+  }
+
+  IndexedFaceSet geometry_;
+  std::vector<WideBvhNode, CacheAlignedAllocator<WideBvhNode>> nodes_;
+  std::vector<std::uint32_t> leaf_triangles_;
+  BuildReport build_;
+};
+
+}  // namespace
+
+std::unique_ptr<Accelerator> make_wide_bvh_accelerator(const TriangleMesh& mesh, const BvhOptions& options) {
+  return std::make_unique<WideBvhAccelerator>(mesh, options);
+}
+
+}  // namespace wavetrace

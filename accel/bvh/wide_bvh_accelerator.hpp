@@ -1,0 +1,12 @@
+// `bvh` with width 8: the same SAH tree collapsed into 8-wide nodes for AVX2 box tests.
+#pragma once
+
+#include <memory>
+
+#include "accel/bvh/bvh_accelerator.hpp"
+
+namespace wavetrace {
+
+std::unique_ptr<Accelerator> make_wide_bvh_accelerator(const TriangleMesh& mesh, const BvhOptions& options);
+
+}  // namespace wavetrace
