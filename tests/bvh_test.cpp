@@ -1,6 +1,7 @@
 // The BVH baseline: builder invariants, agreement with Embree on the same rays, any-hit
 // against closest-hit, identical hits for every layout, and no leaks.
 #include <algorithm>
+#include <limits>
 
 #include <gtest/gtest.h>
 #include <glm/vector_relational.hpp>
@@ -67,7 +68,9 @@ TEST(SahBuilder, CoincidentCentroidsStillSplitAndBadOptionsAreErrors) {
   }
   const BuildTree tree = build_sah_tree(same, SahOptions{});
   for (const BuildNode& node : tree.nodes) {
-    if (node.leaf()) EXPECT_LE(node.count, 4u);
+    if (node.leaf()) {
+      EXPECT_LE(node.count, 4u);
+    }
   }
   SahOptions bad;
   bad.max_leaf_size = 17;
@@ -98,11 +101,60 @@ class BvhAgreesWithEmbree : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(BvhAgreesWithEmbree, OnAtLeast9999PerMyriadOfRays) {
   const Scene scene = load_scene({GetParam(), 0});
-  const auto bvh = make_bvh_accelerator(scene.mesh, BvhOptions{});
-  for (const RaySetKind kind : {RaySetKind::primary, RaySetKind::random, RaySetKind::diffuse, RaySetKind::shadow}) {
-    const Agreement result = agreement(scene, *bvh, kind, 20000);
-    EXPECT_GE(result.hit, 0.9999) << to_string(kind) << " on " << GetParam();
-    EXPECT_GT(result.rays, 10000u);
+  for (const std::uint32_t width : {2u, 8u}) {
+    BvhOptions options;
+    options.width = width;
+    const auto bvh = make_bvh_accelerator(scene.mesh, options);
+    for (const RaySetKind kind : {RaySetKind::primary, RaySetKind::random, RaySetKind::diffuse, RaySetKind::shadow}) {
+      const Agreement result = agreement(scene, *bvh, kind, 20000);
+      EXPECT_GE(result.hit, 0.9999) << to_string(kind) << " width " << width << " on " << GetParam();
+      EXPECT_GT(result.rays, 10000u);
+    }
+  }
+}
+
+TEST(Bvh, AxisParallelRaysThroughBoxFacesAndEdges) {
+  // Rays along +-x, +-y, +-z on a lattice that puts many of them exactly on the planes of
+  // an axis-aligned box mesh's faces, edges and corners (zero direction components, origins
+  // on slab planes): every such ray that Embree robust sees hit must hit for both widths.
+  const Scene stadium = make_builtin_scene("builtin:stadium:2000");
+  AcceleratorOptions robust;
+  robust.embree.mode = EmbreeMode::robust;
+  const auto reference = make_accelerator(stadium.mesh, robust);
+  RayBatch rays(4096);
+  const float coordinates[] = {-500.0f, -250.0f, 0.0f, 0.5f, 250.0f, 500.0f};
+  for (int axis = 0; axis < 3; ++axis) {
+    for (const float sign : {-1.0f, 1.0f}) {
+      for (const float a : coordinates) {
+        for (const float b : coordinates) {
+          const std::size_t i = rays.count++;
+          glm::vec3 origin(0.0f), direction(0.0f);
+          origin[(axis + 1) % 3] = a;
+          origin[(axis + 2) % 3] = b;
+          direction[axis] = sign;
+          rays.origin_x[i] = origin.x, rays.origin_y[i] = origin.y, rays.origin_z[i] = origin.z;
+          rays.direction_x[i] = direction.x, rays.direction_y[i] = direction.y, rays.direction_z[i] = direction.z;
+          rays.tmin[i] = 0.0f;
+          rays.tmax[i] = std::numeric_limits<float>::infinity();
+          rays.flags[i] = ray_flags::alive;
+          rays.kind[i] = RayKind::camera;
+        }
+      }
+    }
+  }
+  HitBatch expected(4096), actual(4096);
+  reference->intersect_closest(rays, expected, rays.all());
+  for (const std::uint32_t width : {2u, 8u}) {
+    BvhOptions options;
+    options.width = width;
+    const auto bvh = make_bvh_accelerator(stadium.mesh, options);
+    bvh->intersect_closest(rays, actual, rays.all());
+    for (std::size_t i = 0; i < rays.count; ++i) {
+      EXPECT_TRUE(actual.is_hit(i)) << "width " << width << " ray " << i;  // the box is closed around the origins
+      if (expected.is_hit(i) && actual.is_hit(i)) {
+        EXPECT_NEAR(actual.t[i], expected.t[i], 1e-3f) << "width " << width << " ray " << i;
+      }
+    }
   }
 }
 
@@ -115,15 +167,19 @@ INSTANTIATE_TEST_SUITE_P(Scenes, BvhAgreesWithEmbree,
 
 TEST(Bvh, AnyHitAgreesWithClosestHitOnOcclusion) {
   const Scene scene = make_builtin_scene("builtin:default:20000");
-  const auto bvh = make_bvh_accelerator(scene.mesh, BvhOptions{});
   const auto reference = make_accelerator(scene.mesh, AcceleratorOptions{});
-  for (const RaySetKind kind : {RaySetKind::shadow, RaySetKind::random}) {
-    const RaySet rays = make_ray_set(kind, scene, *reference, 20000);
-    for (const auto& batch : rays.batches) {
-      HitBatch closest(batch->capacity()), any(batch->capacity());
-      bvh->intersect_closest(*batch, closest, batch->all());
-      bvh->intersect_any(*batch, any, batch->all());
-      for (std::size_t i = 0; i < batch->count; ++i) ASSERT_EQ(closest.is_hit(i), any.is_hit(i)) << i;
+  for (const std::uint32_t width : {2u, 8u}) {
+    BvhOptions options;
+    options.width = width;
+    const auto bvh = make_bvh_accelerator(scene.mesh, options);
+    for (const RaySetKind kind : {RaySetKind::shadow, RaySetKind::random}) {
+      const RaySet rays = make_ray_set(kind, scene, *reference, 20000);
+      for (const auto& batch : rays.batches) {
+        HitBatch closest(batch->capacity()), any(batch->capacity());
+        bvh->intersect_closest(*batch, closest, batch->all());
+        bvh->intersect_any(*batch, any, batch->all());
+        for (std::size_t i = 0; i < batch->count; ++i) ASSERT_EQ(closest.is_hit(i), any.is_hit(i)) << i;
+      }
     }
   }
 }
@@ -180,9 +236,11 @@ TEST(Bvh, MemoryIsNodesIndicesAndTheIndexedFaceSet) {
 
 TEST(Bvh, NoRayEscapesTheClosedSphere) {
   const Scene scene = make_builtin_scene("builtin:sphere:200k");
-  const LeakReport report = run_leak_bench(scene, {parse_accelerator_spec("bvh", Config{})}, 200000, 0);
-  ASSERT_EQ(report.results.size(), 1u);
+  const LeakReport report = run_leak_bench(
+      scene, {parse_accelerator_spec("bvh", Config{}), parse_accelerator_spec("bvh:width=8", Config{})}, 200000, 0);
+  ASSERT_EQ(report.results.size(), 2u);
   EXPECT_EQ(report.results[0].escaped, 0u);
+  EXPECT_EQ(report.results[1].escaped, 0u);
   EXPECT_GT(report.inside_points, 1000u);
 }
 
