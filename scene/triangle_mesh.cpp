@@ -10,16 +10,6 @@
 
 namespace wavetrace {
 
-void Bounds3::extend(const glm::vec3& point) {
-  lower = glm::min(lower, point);
-  upper = glm::max(upper, point);
-}
-
-void Bounds3::extend(const Bounds3& other) {
-  lower = glm::min(lower, other.lower);
-  upper = glm::max(upper, other.upper);
-}
-
 float Bounds3::diagonal() const { return empty() ? 0.0f : glm::length(extent()); }
 
 Bounds3 TriangleMesh::bounds() const {

@@ -10,6 +10,7 @@
 #include <string_view>
 #include <vector>
 
+#include <glm/common.hpp>
 #include <glm/vec3.hpp>
 
 namespace wavetrace {
@@ -25,8 +26,15 @@ struct Bounds3 {
   glm::vec3 upper{-std::numeric_limits<float>::infinity()};
 
   bool empty() const { return lower.x > upper.x; }
-  void extend(const glm::vec3& point);
-  void extend(const Bounds3& other);
+  // Inline: builders call these in their innermost loops.
+  void extend(const glm::vec3& point) {
+    lower = glm::min(lower, point);
+    upper = glm::max(upper, point);
+  }
+  void extend(const Bounds3& other) {
+    lower = glm::min(lower, other.lower);
+    upper = glm::max(upper, other.upper);
+  }
   glm::vec3 extent() const { return upper - lower; }
   glm::vec3 center() const { return (lower + upper) * 0.5f; }
   float diagonal() const;

@@ -42,8 +42,8 @@ const std::vector<ConfigKey>& config_schema() {
       {"accel.bvh.leaf_size", T::integer, std::int64_t{4}, 1, 16, {}, "most triangles per BVH leaf"},
       {"accel.bvh.layout", T::text, std::string("depth_first"), 0, 0, {"depth_first", "breadth_first", "veb"},
        "BVH node order in memory"},
-      {"accel.bvh.triangle_order", T::text, std::string("input"), 0, 0, {"input", "morton"},
-       "triangle and vertex order of the BVH's indexed face set"},
+      {"accel.bvh.triangle_order", T::text, std::string("input"), 0, 0, {"input", "morton", "leaf"},
+       "the BVH's indexed face set: the mesh's (input), a Morton-sorted copy, or a copy in leaf order"},
       {"accel.bvh.bins", T::integer, std::int64_t{16}, 2, 64, {}, "SAH bins per axis"},
       {"accel.bvh.width", T::integer, std::int64_t{2}, 2, 8, {}, "2: binary 32-byte nodes; 8: AVX2 8-wide nodes"},
 

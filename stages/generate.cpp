@@ -38,14 +38,22 @@ std::size_t GenerateStage::fill(RayBatch& rays) {
   const std::uint64_t first = next_.load(std::memory_order_relaxed);
   const std::size_t count = static_cast<std::size_t>(std::min<std::uint64_t>(rays.capacity(), total_ - first));
   const std::uint32_t spp = image_.samples_per_pixel;
+  // Walk (pixel, sample) incrementally: one division per batch, not two per ray.
+  auto order_index = static_cast<std::uint32_t>(first / spp);
+  auto sample = static_cast<std::uint32_t>(first % spp);
+  std::uint32_t pixel = 0;
+  float pixel_x = 0.0f, pixel_y = 0.0f;
+  const auto enter_pixel = [&] {
+    pixel = pixel_order_.empty() ? order_index : pixel_order_[order_index];
+    pixel_x = float(pixel % image_.width);
+    pixel_y = float(pixel / image_.width);
+  };
+  enter_pixel();
+  const float inverse_width = 1.0f / float(image_.width), inverse_height = 1.0f / float(image_.height);
   for (std::size_t i = 0; i < count; ++i) {
-    const std::uint64_t index = first + i;
-    const auto order_index = static_cast<std::uint32_t>(index / spp);
-    const auto sample = static_cast<std::uint32_t>(index % spp);
-    const std::uint32_t pixel = pixel_order_.empty() ? order_index : pixel_order_[order_index];
     const UnitPair jitter = unit_pair(random_bits(pixel, sample, 0, RandomPurpose::pixel_jitter));
-    const float x = (float(pixel % image_.width) + jitter.first) / float(image_.width);
-    const float y = 1.0f - (float(pixel / image_.width) + jitter.second) / float(image_.height);
+    const float x = (pixel_x + jitter.first) * inverse_width;
+    const float y = 1.0f - (pixel_y + jitter.second) * inverse_height;
     const glm::vec3 direction = glm::normalize(frame_.direction(x, y));
     rays.origin_x[i] = frame_.origin.x;
     rays.origin_y[i] = frame_.origin.y;
@@ -61,6 +69,11 @@ std::size_t GenerateStage::fill(RayBatch& rays) {
     rays.kind[i] = RayKind::camera;
     rays.throughput_r[i] = rays.throughput_g[i] = rays.throughput_b[i] = 1.0f;
     rays.flags[i] = ray_flags::alive;
+    if (++sample == spp && i + 1 < count) {
+      sample = 0;
+      ++order_index;
+      enter_pixel();
+    }
   }
   rays.count = count;
   next_.store(first + count, std::memory_order_relaxed);

@@ -26,13 +26,12 @@ class BvhAccelerator final : public Accelerator {
     const auto start = std::chrono::steady_clock::now();
     positions_ = geometry_.positions();
     triangles_ = geometry_.triangles();
-    const std::vector<Bounds3> bounds = geometry_.triangle_bounds();
+    const LargeArray<Bounds3> bounds = geometry_.triangle_bounds();
     SahOptions sah;
     sah.max_leaf_size = options.max_leaf_size;
     sah.bins = options.bins;
     const BuildTree tree = build_sah_tree(bounds, sah);
-    const std::size_t working_bytes =
-        std::max(geometry_.build_scratch_bytes(), bounds.size() * sizeof(Bounds3) + tree.peak_bytes);
+    const std::size_t working_bytes = bounds.size() * sizeof(Bounds3) + tree.peak_bytes;
 
     // Flatten in the chosen order: node i of the array is build node order[i].
     const std::vector<std::uint32_t> order = node_order(tree, options.layout);
@@ -58,9 +57,16 @@ class BvhAccelerator final : public Accelerator {
         node.count = position_of[built.right];
       }
     }
+    if (options.triangle_order == TriangleOrder::leaf) {
+      geometry_.adopt_order(leaf_triangles_);  // slots now equal leaf positions
+      leaf_triangles_ = {};
+      positions_ = geometry_.positions();
+      triangles_ = geometry_.triangles();
+    }
     depth_ = tree.depth();
     build_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    build_.peak_bytes = working_bytes + tree.nodes.size() * sizeof(BuildNode) + memory().total();
+    build_.peak_bytes = std::max(working_bytes, geometry_.build_scratch_bytes()) +
+                        tree.nodes.size() * sizeof(BuildNode) + memory().total();
   }
 
   std::string name() const override { return "bvh"; }
@@ -98,6 +104,7 @@ class BvhAccelerator final : public Accelerator {
     };
     StackEntry stack[kMaxTreeDepth];
     const BvhNode* nodes = nodes_.data();
+    const bool leaf_ordered = leaf_triangles_.empty();
     for (std::uint32_t i = range.begin; i < range.end; ++i) {
       hits.t[i] = kInfinity;
       hits.primitive[i] = kInvalidPrimitive;
@@ -120,7 +127,7 @@ class BvhAccelerator final : public Accelerator {
         if (current.leaf()) {
           const std::uint32_t end = current.first + current.triangle_count();
           for (std::uint32_t slot = current.first; slot < end; ++slot) {
-            const std::uint32_t triangle = leaf_triangles_[slot];
+            const std::uint32_t triangle = leaf_ordered ? slot : leaf_triangles_[slot];
             const glm::uvec3& tri = triangles_[triangle];
             TriangleHit hit;
             if (intersect_watertight(triangle_ray, positions_[tri.x], positions_[tri.y], positions_[tri.z], tmin, tmax,
@@ -164,8 +171,8 @@ class BvhAccelerator final : public Accelerator {
   IndexedFaceSet geometry_;
   const glm::vec3* positions_ = nullptr;  // geometry_'s, cached for the hot loop
   const glm::uvec3* triangles_ = nullptr;
-  std::vector<BvhNode, CacheAlignedAllocator<BvhNode>> nodes_;
-  std::vector<std::uint32_t> leaf_triangles_;
+  LargeArray<BvhNode> nodes_;
+  LargeArray<std::uint32_t> leaf_triangles_;
   std::uint32_t depth_ = 0;
   BuildReport build_;
 };

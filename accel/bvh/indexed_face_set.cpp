@@ -16,18 +16,24 @@ namespace wavetrace {
 TriangleOrder parse_triangle_order(const std::string& text) {
   if (text == "input") return TriangleOrder::input;
   if (text == "morton") return TriangleOrder::morton;
-  throw std::invalid_argument("unknown triangle order '" + text + "' (input, morton)");
+  if (text == "leaf") return TriangleOrder::leaf;
+  throw std::invalid_argument("unknown triangle order '" + text + "' (input, morton, leaf)");
 }
 
-std::string to_string(TriangleOrder order) { return order == TriangleOrder::morton ? "morton" : "input"; }
+std::string to_string(TriangleOrder order) {
+  switch (order) {
+    case TriangleOrder::morton: return "morton";
+    case TriangleOrder::leaf: return "leaf";
+    default: return "input";
+  }
+}
 
 IndexedFaceSet::IndexedFaceSet(const TriangleMesh& mesh, TriangleOrder order)
-    : vertex_count_(mesh.vertex_count()), triangle_count_(mesh.triangle_count()) {
-  if (order == TriangleOrder::input) {
-    positions_ = mesh.positions.data();
-    triangles_ = mesh.triangles.data();
-    return;
-  }
+    : positions_(mesh.positions.data()),
+      triangles_(mesh.triangles.data()),
+      vertex_count_(mesh.vertex_count()),
+      triangle_count_(mesh.triangle_count()) {
+  if (order != TriangleOrder::morton) return;
   const Bounds3 bounds = mesh.bounds();
   const glm::vec3 extent = glm::max(bounds.extent(), glm::vec3(1e-30f));
   std::vector<std::pair<std::uint64_t, std::uint32_t>> keys(triangle_count_);
@@ -39,33 +45,44 @@ IndexedFaceSet::IndexedFaceSet(const TriangleMesh& mesh, TriangleOrder order)
     keys[t] = {morton3d_encode(quantize(unit.x), quantize(unit.y), quantize(unit.z)), static_cast<std::uint32_t>(t)};
   });
   tbb::parallel_sort(keys.begin(), keys.end());
+  std::vector<std::uint32_t> sorted(triangle_count_);
+  for (std::size_t slot = 0; slot < keys.size(); ++slot) sorted[slot] = keys[slot].second;
+  build_scratch_bytes_ = keys.size() * sizeof(keys[0]);
+  adopt_order(sorted);
+}
 
-  owned_triangles_.resize(triangle_count_);
-  input_id_.resize(triangle_count_);
-  std::vector<std::uint32_t> new_vertex(mesh.vertex_count(), std::numeric_limits<std::uint32_t>::max());
-  owned_positions_.reserve(mesh.vertex_count() + 1);
-  for (std::size_t slot = 0; slot < keys.size(); ++slot) {
-    const std::uint32_t t = keys[slot].second;
-    input_id_[slot] = t;
-    glm::uvec3 tri = mesh.triangles[t];
+void IndexedFaceSet::adopt_order(std::span<const std::uint32_t> order) {
+  LargeArray<glm::vec3> positions;
+  LargeArray<glm::uvec3> triangles(triangle_count_);
+  LargeArray<std::uint32_t> input_id(triangle_count_);
+  std::vector<std::uint32_t> new_vertex(vertex_count_, std::numeric_limits<std::uint32_t>::max());
+  positions.reserve(vertex_count_ + 1);
+  for (std::size_t slot = 0; slot < triangle_count_; ++slot) {
+    const std::uint32_t from = order[slot];
+    input_id[slot] = this->input_id(from);
+    glm::uvec3 tri = triangles_[from];
     for (int k = 0; k < 3; ++k) {
       std::uint32_t& mapped = new_vertex[tri[k]];
       if (mapped == std::numeric_limits<std::uint32_t>::max()) {
-        mapped = static_cast<std::uint32_t>(owned_positions_.size());
-        owned_positions_.push_back(mesh.positions[tri[k]]);
+        mapped = static_cast<std::uint32_t>(positions.size());
+        positions.push_back(positions_[tri[k]]);
       }
       tri[k] = mapped;
     }
-    owned_triangles_[slot] = tri;
+    triangles[slot] = tri;
   }
+  build_scratch_bytes_ = std::max(build_scratch_bytes_, new_vertex.size() * sizeof(std::uint32_t) + geometry_bytes() +
+                                                            input_id_.size() * sizeof(std::uint32_t));
+  owned_positions_ = std::move(positions);
+  owned_triangles_ = std::move(triangles);
+  input_id_ = std::move(input_id);
   positions_ = owned_positions_.data();
   triangles_ = owned_triangles_.data();
   vertex_count_ = owned_positions_.size();
-  build_scratch_bytes_ = keys.size() * sizeof(keys[0]) + new_vertex.size() * sizeof(std::uint32_t);
 }
 
-std::vector<Bounds3> IndexedFaceSet::triangle_bounds() const {
-  std::vector<Bounds3> bounds(triangle_count_);
+LargeArray<Bounds3> IndexedFaceSet::triangle_bounds() const {
+  LargeArray<Bounds3> bounds(triangle_count_);
   tbb::parallel_for(std::size_t{0}, triangle_count_, [&](std::size_t t) {
     const glm::uvec3& tri = triangles_[t];
     Bounds3 b;

@@ -1,5 +1,6 @@
 // The geometry a BVH traverses: an indexed face set, either the mesh's own arrays read in
-// place or a copy in Morton order of triangle centroids (vertices renumbered by first use).
+// place, or a copy whose triangles follow a Morton curve of their centroids or the order
+// the BVH's leaves list them (vertices renumbered by first use in both copies).
 #pragma once
 
 #include <cstdint>
@@ -7,18 +8,27 @@
 #include <string>
 #include <vector>
 
+#include "memory/cache_aligned_allocator.hpp"
 #include "scene/triangle_mesh.hpp"
 
 namespace wavetrace {
 
-enum class TriangleOrder { input, morton };
-TriangleOrder parse_triangle_order(const std::string& text);  // "input" | "morton"
+// input: the mesh's arrays, leaves reach triangles through a 4-byte index per triangle.
+// morton: a copy sorted along a Morton curve, leaves still index it.
+// leaf: a copy in leaf order, so a leaf's triangles are contiguous and need no index.
+enum class TriangleOrder { input, morton, leaf };
+TriangleOrder parse_triangle_order(const std::string& text);  // "input" | "morton" | "leaf"
 std::string to_string(TriangleOrder order);
 
 class IndexedFaceSet {
  public:
-  // `mesh` must outlive this object when order is input (its arrays are not copied).
+  // `mesh` must outlive this object when order is input or leaf (leaf starts as input
+  // until adopt_leaf_order is called).
   IndexedFaceSet(const TriangleMesh& mesh, TriangleOrder order);
+
+  // Re-stores the triangles so that slot i holds what slot order[i] held before (a copy,
+  // vertices renumbered by first use); input ids follow.
+  void adopt_order(std::span<const std::uint32_t> order);
 
   const glm::vec3* positions() const { return positions_; }
   const glm::uvec3* triangles() const { return triangles_; }
@@ -28,16 +38,16 @@ class IndexedFaceSet {
   // The mesh's index of the triangle stored at `slot`.
   std::uint32_t input_id(std::uint32_t slot) const { return input_id_.empty() ? slot : input_id_[slot]; }
 
-  std::vector<Bounds3> triangle_bounds() const;  // parallel
+  LargeArray<Bounds3> triangle_bounds() const;  // parallel
   std::size_t geometry_bytes() const { return vertex_count_ * sizeof(glm::vec3) + triangle_count_ * sizeof(glm::uvec3); }
   std::size_t id_map_bytes() const { return input_id_.size() * sizeof(std::uint32_t); }
   std::size_t build_scratch_bytes() const { return build_scratch_bytes_; }
   std::vector<std::span<const std::byte>> spans() const;
 
  private:
-  std::vector<glm::vec3> owned_positions_;
-  std::vector<glm::uvec3> owned_triangles_;
-  std::vector<std::uint32_t> input_id_;  // empty for input order
+  LargeArray<glm::vec3> owned_positions_;
+  LargeArray<glm::uvec3> owned_triangles_;
+  LargeArray<std::uint32_t> input_id_;  // empty for input order
   const glm::vec3* positions_ = nullptr;
   const glm::uvec3* triangles_ = nullptr;
   std::size_t vertex_count_ = 0;

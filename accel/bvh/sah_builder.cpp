@@ -33,12 +33,19 @@ float half_area(const Bounds3& bounds) {
 
 struct Bin {
   Bounds3 bounds;
-  std::uint32_t count = 0;
+  std::uint32_t count;
 };
 
+// Bins of the three axes. Only the first `used` bins per axis are initialized: a node
+// is binned once, and clearing all kMaxBins bins would cost more than binning a small node.
 struct Binning {
-  std::array<std::array<Bin, kMaxBins>, 3> bins{};
-  Bounds3 bounds;  // of the primitives themselves
+  explicit Binning(std::uint32_t used) : used(used) {
+    for (auto& axis : bins) {
+      for (std::uint32_t i = 0; i < used; ++i) axis[i] = {Bounds3{}, 0};
+    }
+  }
+  std::uint32_t used;
+  std::array<std::array<Bin, kMaxBins>, 3> bins;
 };
 
 struct Split {
@@ -48,36 +55,44 @@ struct Split {
   Bounds3 left_bounds, right_bounds;
 };
 
+// A primitive as the builder moves it: its box and its id, 32 bytes, partitioned in
+// place so that binning streams through memory instead of gathering through an index.
+struct PrimitiveReference {
+  Bounds3 bounds;
+  std::uint32_t id;
+  std::uint32_t unused;
+  glm::vec3 centroid() const { return (bounds.lower + bounds.upper) * 0.5f; }
+};
+
 class Builder {
  public:
   Builder(std::span<const Bounds3> primitive_bounds, const SahOptions& options, BuildTree& tree)
-      : bounds_(primitive_bounds), options_(options), tree_(tree) {
+      : options_(options), tree_(tree), references_(primitive_bounds.size()) {
     const std::size_t count = primitive_bounds.size();
-    centroids_.resize(count);
-    tree_.primitive_order.resize(count);
     tbb::parallel_for(std::size_t{0}, count, [&](std::size_t i) {
-      centroids_[i] = primitive_bounds[i].center();
-      tree_.primitive_order[i] = static_cast<std::uint32_t>(i);
+      references_[i] = {primitive_bounds[i], static_cast<std::uint32_t>(i), 0};
     });
     tree_.nodes.resize(2 * count - 1);
-    tree_.peak_bytes = centroids_.size() * sizeof(glm::vec3) + tree_.primitive_order.size() * sizeof(std::uint32_t) +
+    tree_.peak_bytes = references_.size() * sizeof(PrimitiveReference) + count * sizeof(std::uint32_t) +
                        tree_.nodes.size() * sizeof(BuildNode);
   }
 
   void build() {
-    const Bounds3 root_bounds = bounds_of_range(0, static_cast<std::uint32_t>(bounds_.size()));
+    const auto count = static_cast<std::uint32_t>(references_.size());
+    const Bounds3 root_bounds = bounds_of_range(0, count);
     next_node_.store(1);
-    build_node(0, 0, static_cast<std::uint32_t>(bounds_.size()), root_bounds, 1);
+    build_node(0, 0, count, root_bounds, 1);
     tree_.nodes.resize(next_node_.load());
+    tree_.primitive_order.resize(count);
+    tbb::parallel_for(std::uint32_t{0}, count, [&](std::uint32_t i) { tree_.primitive_order[i] = references_[i].id; });
   }
 
  private:
   Bounds3 bounds_of_range(std::uint32_t first, std::uint32_t count) const {
-    const auto* order = tree_.primitive_order.data();
     return tbb::parallel_reduce(
         tbb::blocked_range<std::uint32_t>(first, first + count, 1 << 14), Bounds3{},
         [&](const tbb::blocked_range<std::uint32_t>& range, Bounds3 b) {
-          for (std::uint32_t i = range.begin(); i != range.end(); ++i) b.extend(bounds_[order[i]]);
+          for (std::uint32_t i = range.begin(); i != range.end(); ++i) b.extend(references_[i].bounds);
           return b;
         },
         [](Bounds3 a, const Bounds3& b) {
@@ -87,9 +102,8 @@ class Builder {
   }
 
   Bounds3 centroid_bounds(std::uint32_t first, std::uint32_t count) const {
-    const auto* order = tree_.primitive_order.data();
     const auto reduce = [&](std::uint32_t begin, std::uint32_t end, Bounds3 b) {
-      for (std::uint32_t i = begin; i != end; ++i) b.extend(centroids_[order[i]]);
+      for (std::uint32_t i = begin; i != end; ++i) b.extend(references_[i].centroid());
       return b;
     };
     if (count < kParallelBinningThreshold) return reduce(first, first + count, Bounds3{});
@@ -109,22 +123,21 @@ class Builder {
   }
 
   Binning bin_range(std::uint32_t first, std::uint32_t count, const Bounds3& centroids, const glm::vec3& scale) const {
-    const auto* order = tree_.primitive_order.data();
     const auto fill = [&](std::uint32_t begin, std::uint32_t end, Binning binning) {
       for (std::uint32_t i = begin; i != end; ++i) {
-        const std::uint32_t primitive = order[i];
-        const glm::vec3& c = centroids_[primitive];
+        const PrimitiveReference& reference = references_[i];
+        const glm::vec3 c = reference.centroid();
         for (int axis = 0; axis < 3; ++axis) {
           Bin& bin = binning.bins[axis][bin_of(c[axis], centroids.lower[axis], scale[axis])];
-          bin.bounds.extend(bounds_[primitive]);
+          bin.bounds.extend(reference.bounds);
           ++bin.count;
         }
       }
       return binning;
     };
-    if (count < kParallelBinningThreshold) return fill(first, first + count, Binning{});
+    if (count < kParallelBinningThreshold) return fill(first, first + count, Binning(options_.bins));
     return tbb::parallel_reduce(
-        tbb::blocked_range<std::uint32_t>(first, first + count, 1 << 14), Binning{},
+        tbb::blocked_range<std::uint32_t>(first, first + count, 1 << 14), Binning(options_.bins),
         [&](const tbb::blocked_range<std::uint32_t>& range, Binning b) { return fill(range.begin(), range.end(), b); },
         [&](Binning a, const Binning& b) {
           for (int axis = 0; axis < 3; ++axis) {
@@ -137,16 +150,16 @@ class Builder {
         });
   }
 
+  // The cheapest plane over all axes; only areas and counts are kept during the sweep
+  // (no per-bin boxes to initialize), the chosen split's two boxes are merged afterwards.
   Split best_split(const Binning& binning, const Bounds3& centroids) const {
     Split best;
     const std::uint32_t bins = options_.bins;
+    float right_area[kMaxBins];
+    std::uint32_t right_count[kMaxBins];
     for (int axis = 0; axis < 3; ++axis) {
       if (!(centroids.upper[axis] > centroids.lower[axis])) continue;
       const auto& row = binning.bins[axis];
-      // Sweep from the right, storing the area and count right of each plane.
-      std::array<float, kMaxBins> right_area{};
-      std::array<std::uint32_t, kMaxBins> right_count{};
-      std::array<Bounds3, kMaxBins> right_bounds{};
       Bounds3 accumulated;
       std::uint32_t count = 0;
       for (std::uint32_t i = bins - 1; i > 0; --i) {
@@ -154,7 +167,6 @@ class Builder {
         count += row[i].count;
         right_area[i - 1] = half_area(accumulated);
         right_count[i - 1] = count;
-        right_bounds[i - 1] = accumulated;
       }
       accumulated = Bounds3{};
       count = 0;
@@ -163,8 +175,16 @@ class Builder {
         count += row[i].count;
         if (count == 0 || right_count[i] == 0) continue;
         const float cost = half_area(accumulated) * float(count) + right_area[i] * float(right_count[i]);
-        if (cost < best.cost) best = {axis, i, cost, accumulated, right_bounds[i]};
+        if (cost < best.cost) {
+          best.axis = axis;
+          best.bin = i;
+          best.cost = cost;
+        }
       }
+    }
+    if (best.axis >= 0) {
+      const auto& row = binning.bins[best.axis];
+      for (std::uint32_t i = 0; i < bins; ++i) (i <= best.bin ? best.left_bounds : best.right_bounds).extend(row[i].bounds);
     }
     return best;
   }
@@ -195,15 +215,15 @@ class Builder {
 
     std::uint32_t middle;
     Bounds3 left_bounds, right_bounds;
-    auto* order = tree_.primitive_order.data();
+    PrimitiveReference* references = references_.data();
     if (split.axis >= 0) {
       const int axis = split.axis;
       middle = static_cast<std::uint32_t>(
-          std::partition(order + first, order + first + count,
-                         [&](std::uint32_t p) {
-                           return bin_of(centroids_[p][axis], centroids.lower[axis], scale[axis]) <= split.bin;
+          std::partition(references + first, references + first + count,
+                         [&](const PrimitiveReference& r) {
+                           return bin_of(r.centroid()[axis], centroids.lower[axis], scale[axis]) <= split.bin;
                          }) -
-          order);
+          references);
       left_bounds = split.left_bounds;
       right_bounds = split.right_bounds;
     } else {
@@ -230,10 +250,9 @@ class Builder {
     }
   }
 
-  std::span<const Bounds3> bounds_;
   SahOptions options_;
   BuildTree& tree_;
-  std::vector<glm::vec3> centroids_;
+  LargeArray<PrimitiveReference> references_;
   std::atomic<std::uint32_t> next_node_{0};
 };
 

@@ -7,6 +7,7 @@
 #include <span>
 #include <vector>
 
+#include "memory/cache_aligned_allocator.hpp"
 #include "scene/triangle_mesh.hpp"
 
 namespace wavetrace {
@@ -31,8 +32,8 @@ struct BuildNode {
 };
 
 struct BuildTree {
-  std::vector<BuildNode> nodes;                // root at index 0
-  std::vector<std::uint32_t> primitive_order;  // input primitive ids in leaf order
+  LargeArray<BuildNode> nodes;                 // root at index 0
+  LargeArray<std::uint32_t> primitive_order;   // input primitive ids in leaf order
   std::size_t peak_bytes = 0;                  // the builder's own working memory at its peak
   std::uint32_t depth() const;                 // levels from the root to the deepest leaf, root = 1
 };

@@ -87,7 +87,7 @@ class WideBvhAccelerator final : public Accelerator {
  public:
   WideBvhAccelerator(const TriangleMesh& mesh, const BvhOptions& options) : geometry_(mesh, options.triangle_order) {
     const auto start = std::chrono::steady_clock::now();
-    const std::vector<Bounds3> bounds = geometry_.triangle_bounds();
+    const LargeArray<Bounds3> bounds = geometry_.triangle_bounds();
     SahOptions sah;
     sah.max_leaf_size = options.max_leaf_size;
     sah.bins = options.bins;
@@ -95,9 +95,14 @@ class WideBvhAccelerator final : public Accelerator {
     leaf_triangles_.reserve(geometry_.triangle_count());
     nodes_.reserve(tree.nodes.size() / 4 + 1);
     collapse(tree, 0);
+    if (options.triangle_order == TriangleOrder::leaf) {
+      geometry_.adopt_order(leaf_triangles_);  // slots now equal leaf positions
+      leaf_triangles_ = {};
+    }
     build_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     build_.peak_bytes = std::max(geometry_.build_scratch_bytes(), bounds.size() * sizeof(Bounds3) + tree.peak_bytes) +
                         tree.nodes.size() * sizeof(BuildNode) + memory().total();
+    // (the leaf-order copy is made after the tree's scratch is gone; build_scratch_bytes covers it)
   }
 
   std::string name() const override { return "bvh8"; }
@@ -182,6 +187,7 @@ class WideBvhAccelerator final : public Accelerator {
     const WideBvhNode* nodes = nodes_.data();
     const glm::vec3* positions = geometry_.positions();
     const glm::uvec3* triangles = geometry_.triangles();
+    const bool leaf_ordered = leaf_triangles_.empty();
     for (std::uint32_t i = range.begin; i < range.end; ++i) {
       hits.t[i] = kInfinity;
       hits.primitive[i] = kInvalidPrimitive;
@@ -229,7 +235,7 @@ class WideBvhAccelerator final : public Accelerator {
         } else {
           const std::uint32_t end = current.child + current.count;
           for (std::uint32_t slot = current.child; slot < end; ++slot) {
-            const std::uint32_t triangle = leaf_triangles_[slot];
+            const std::uint32_t triangle = leaf_ordered ? slot : leaf_triangles_[slot];
             const glm::uvec3& tri = triangles[triangle];
             TriangleHit hit;
             if (intersect_watertight(triangle_ray, positions[tri.x], positions[tri.y], positions[tri.z], tmin, tmax, hit)) {
@@ -255,8 +261,8 @@ class WideBvhAccelerator final : public Accelerator {
   }
 
   IndexedFaceSet geometry_;
-  std::vector<WideBvhNode, CacheAlignedAllocator<WideBvhNode>> nodes_;
-  std::vector<std::uint32_t> leaf_triangles_;
+  LargeArray<WideBvhNode> nodes_;
+  LargeArray<std::uint32_t> leaf_triangles_;
   BuildReport build_;
 };
 
