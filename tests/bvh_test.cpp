@@ -189,24 +189,35 @@ TEST(Bvh, EveryLayoutGivesIdenticalHits) {
   const auto reference = make_accelerator(scene.mesh, AcceleratorOptions{});
   const RaySet rays = make_ray_set(RaySetKind::random, scene, *reference, 20000);
   const auto baseline = trace_ray_set(*make_bvh_accelerator(scene.mesh, BvhOptions{}), rays);
-  for (const NodeLayout layout : {NodeLayout::breadth_first, NodeLayout::van_emde_boas}) {
+  // The same tree in another node or triangle order: bit-identical answers.
+  for (const auto& [layout, order] : {std::pair{NodeLayout::breadth_first, TriangleOrder::input},
+                                      std::pair{NodeLayout::van_emde_boas, TriangleOrder::input},
+                                      std::pair{NodeLayout::depth_first, TriangleOrder::leaf},
+                                      std::pair{NodeLayout::van_emde_boas, TriangleOrder::leaf}}) {
     BvhOptions options;
     options.layout = layout;
+    options.triangle_order = order;
     const auto hits = trace_ray_set(*make_bvh_accelerator(scene.mesh, options), rays);
     for (std::size_t b = 0; b < rays.batches.size(); ++b) {
       for (std::size_t i = 0; i < rays.batches[b]->count; ++i) {
-        ASSERT_EQ(hits[b]->primitive[i], baseline[b]->primitive[i]) << to_string(layout);
-        ASSERT_EQ(hits[b]->t[i], baseline[b]->t[i]) << to_string(layout);
+        ASSERT_EQ(hits[b]->primitive[i], baseline[b]->primitive[i]) << to_string(layout) << " " << to_string(order);
+        ASSERT_EQ(hits[b]->t[i], baseline[b]->t[i]) << to_string(layout) << " " << to_string(order);
       }
     }
   }
   // Morton order and other leaf sizes change the tree: same hits, the same distance up to
   // rounding (a ray through a shared edge may report either triangle).
-  for (const auto& [order, leaf] : {std::pair{TriangleOrder::morton, 4u}, std::pair{TriangleOrder::input, 1u},
-                                    std::pair{TriangleOrder::input, 16u}}) {
+  struct Variant {
+    TriangleOrder order;
+    std::uint32_t leaf_size, width;
+  };
+  for (const Variant& variant : {Variant{TriangleOrder::morton, 4, 2}, Variant{TriangleOrder::input, 1, 2},
+                                 Variant{TriangleOrder::input, 16, 2}, Variant{TriangleOrder::input, 4, 8},
+                                 Variant{TriangleOrder::leaf, 4, 8}}) {
     BvhOptions options;
-    options.triangle_order = order;
-    options.max_leaf_size = leaf;
+    options.triangle_order = variant.order;
+    options.max_leaf_size = variant.leaf_size;
+    options.width = variant.width;
     const auto hits = trace_ray_set(*make_bvh_accelerator(scene.mesh, options), rays);
     for (std::size_t b = 0; b < rays.batches.size(); ++b) {
       for (std::size_t i = 0; i < rays.batches[b]->count; ++i) {
@@ -231,6 +242,11 @@ TEST(Bvh, MemoryIsNodesIndicesAndTheIndexedFaceSet) {
   BvhOptions morton;
   morton.triangle_order = TriangleOrder::morton;
   EXPECT_EQ(make_bvh_accelerator(scene.mesh, morton)->memory().other, triangles * 4);  // the input-id map
+  BvhOptions leaf;
+  leaf.triangle_order = TriangleOrder::leaf;
+  const MemoryReport leaf_memory = make_bvh_accelerator(scene.mesh, leaf)->memory();
+  EXPECT_EQ(leaf_memory.hierarchy, memory.hierarchy - triangles * 4);  // no leaf index array
+  EXPECT_EQ(leaf_memory.other, triangles * 4);
   EXPECT_GE(bvh->build().peak_bytes, memory.total());
 }
 
