@@ -17,6 +17,7 @@ struct BenchArguments {
   std::string scene = "builtin:sphere:1M";
   std::string accel = "embree,bvh";
   std::string rays = "primary";
+  std::string reference = "embree";
   std::size_t count = 1 << 20;
   int threads = 0;
   int repeat = 3;
@@ -66,6 +67,7 @@ int run_accel(const BenchArguments& args) {
   BenchSetup setup = prepare(args);
   AccelBenchRequest request;
   request.accelerators = setup.accelerators;
+  request.reference = parse_accelerator_spec(args.reference, setup.config);
   request.rays = parse_ray_set_kind(args.rays);
   request.count = args.count;
   request.threads = args.threads;
@@ -111,6 +113,8 @@ void add_bench_command(CLI::App& app, int& exit_code) {
   add_common_options(accel, *accel_args);
   accel->add_option("--rays", accel_args->rays, "primary, diffuse, shadow or random");
   accel->add_option("--repeat", accel_args->repeat, "timed runs per accelerator (the median is reported)");
+  accel->add_option("--reference", accel_args->reference,
+                    "accelerator the accuracy is measured against (default embree; embree:mode=robust is watertight)");
   accel->callback([accel_args, &exit_code] { exit_code = run_accel(*accel_args); });
 
   auto leak_args = std::make_shared<BenchArguments>();

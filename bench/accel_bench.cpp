@@ -69,12 +69,13 @@ AccelBenchReport run_accel_bench(const Scene& scene, const AccelBenchRequest& re
   report.scene = scene.name;
   report.triangles = scene.mesh.triangle_count();
   report.rays = to_string(request.rays);
+  report.reference = request.reference.label;
   report.threads = arena.threads();
   report.repeats = request.repeats;
   const float diagonal = scene.mesh.bounds().diagonal();
 
   arena.execute([&] {
-    const auto reference = make_accelerator(scene.mesh, AcceleratorOptions{});
+    const auto reference = make_accelerator(scene.mesh, request.reference.options);
     const RaySet rays = make_ray_set(request.rays, scene, *reference, request.count);
     report.ray_count = rays.count();
     const auto reference_hits = trace_ray_set(*reference, rays);
@@ -126,6 +127,7 @@ nlohmann::json to_json(const AccelBenchReport& report) {
                        {"t_error_mean", optional(r.t_error_mean)}});
   }
   return {{"scene", {{"source", report.scene}, {"triangles", report.triangles}}},
+          {"reference", report.reference},
           {"rays", {{"kind", report.rays}, {"count", report.ray_count}, {"reference_hit_rate", report.reference_hit_rate}}},
           {"threads", report.threads},
           {"repeats", report.repeats},
@@ -149,8 +151,9 @@ std::string to_csv(const AccelBenchReport& report) {
 
 std::string to_table(const AccelBenchReport& report) {
   std::string table = fmt::format(
-      "{}: {} triangles; {} {} rays ({:.1f}% hit the reference); {} threads; median of {} runs\n", report.scene,
-      report.triangles, report.ray_count, report.rays, 100.0 * report.reference_hit_rate, report.threads, report.repeats);
+      "{}: {} triangles; {} {} rays ({:.1f}% hit the reference, {}); {} threads; median of {} runs\n", report.scene,
+      report.triangles, report.ray_count, report.rays, 100.0 * report.reference_hit_rate, report.reference,
+      report.threads, report.repeats);
   table += fmt::format("{:<24} {:>9} {:>8} {:>8} {:>8} {:>9} {:>10} {:>8} {:>10} {:>10} {:>10} {:>10}\n", "accel",
                        "MB", "B/tri", "hier", "geom", "build s", "peak MB", "Mrays/s", "vs first", "hit agr", "prim agr",
                        "t err max");

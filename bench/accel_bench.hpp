@@ -39,6 +39,7 @@ struct AccelBenchResult {
 struct AccelBenchReport {
   std::string scene;
   std::size_t triangles = 0;
+  std::string reference;
   std::string rays;
   std::size_t ray_count = 0;
   int threads = 0;
@@ -49,6 +50,7 @@ struct AccelBenchReport {
 
 struct AccelBenchRequest {
   std::vector<AcceleratorSpec> accelerators;
+  AcceleratorSpec reference{"embree", AcceleratorOptions{}};  // accuracy is measured against it
   RaySetKind rays = RaySetKind::primary;
   std::size_t count = 1 << 20;
   int threads = 0;

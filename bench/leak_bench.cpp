@@ -24,13 +24,7 @@ std::size_t crossings(const Accelerator& reference, const glm::vec3& origin, con
   RayBatch ray(1);
   HitBatch hit(1);
   ray.count = 1;
-  ray.origin_x[0] = origin.x;
-  ray.origin_y[0] = origin.y;
-  ray.origin_z[0] = origin.z;
-  ray.direction_x[0] = direction.x;
-  ray.direction_y[0] = direction.y;
-  ray.direction_z[0] = direction.z;
-  ray.tmax[0] = std::numeric_limits<float>::infinity();
+  ray.set_geometry(0, origin, direction, 0.0f, std::numeric_limits<float>::infinity());
   ray.flags[0] = ray_flags::alive;
   ray.kind[0] = RayKind::camera;
   float tmin = 0.0f;
@@ -104,14 +98,8 @@ LeakReport run_leak_bench(const Scene& scene, const std::vector<AcceleratorSpec>
         const UnitPair u = unit_pair(random_bits(id, 0, 3, RandomPurpose::benchmark));
         const float z = 1.0f - 2.0f * u.first, phi = 2.0f * kPi * u.second;
         const float ring = std::sqrt(std::max(0.0f, 1.0f - z * z));
-        rays.origin_x[i] = origin.x;
-        rays.origin_y[i] = origin.y;
-        rays.origin_z[i] = origin.z;
-        rays.direction_x[i] = ring * std::cos(phi);
-        rays.direction_y[i] = ring * std::sin(phi);
-        rays.direction_z[i] = z;
-        rays.tmin[i] = 0.0f;
-        rays.tmax[i] = std::numeric_limits<float>::infinity();
+        rays.set_geometry(i, origin, glm::vec3(ring * std::cos(phi), ring * std::sin(phi), z), 0.0f,
+                          std::numeric_limits<float>::infinity());
         rays.flags[i] = ray_flags::alive;
         rays.kind[i] = RayKind::camera;
       }

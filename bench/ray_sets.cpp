@@ -28,14 +28,7 @@ struct RayWriter {
     }
     RayBatch& rays = *set.batches.back();
     const std::size_t i = rays.count++;
-    rays.origin_x[i] = origin.x;
-    rays.origin_y[i] = origin.y;
-    rays.origin_z[i] = origin.z;
-    rays.direction_x[i] = direction.x;
-    rays.direction_y[i] = direction.y;
-    rays.direction_z[i] = direction.z;
-    rays.tmin[i] = 0.0f;
-    rays.tmax[i] = tmax;
+    rays.set_geometry(i, origin, direction, 0.0f, tmax);
     rays.pixel[i] = id;
     rays.sample[i] = 0;
     rays.depth[i] = 0;

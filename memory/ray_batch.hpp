@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <limits>
 
+#include <glm/vec3.hpp>
+
 #include "memory/aligned_buffer.hpp"
 
 namespace wavetrace {
@@ -63,6 +65,18 @@ class RayBatch {
   float* approx_hit_y = nullptr;
   float* approx_hit_z = nullptr;
   std::uint64_t* sort_key = nullptr;
+
+  // Writes a ray's origin, direction and [tmin, tmax]; other columns are untouched.
+  void set_geometry(std::size_t i, const glm::vec3& origin, const glm::vec3& direction, float ray_tmin, float ray_tmax) {
+    origin_x[i] = origin.x;
+    origin_y[i] = origin.y;
+    origin_z[i] = origin.z;
+    direction_x[i] = direction.x;
+    direction_y[i] = direction.y;
+    direction_z[i] = direction.z;
+    tmin[i] = ray_tmin;
+    tmax[i] = ray_tmax;
+  }
 
   // Copies every present column of ray `from` of `source` into slot `to` of this batch.
   void copy_ray(std::size_t to, const RayBatch& source, std::size_t from);

@@ -55,14 +55,7 @@ std::size_t GenerateStage::fill(RayBatch& rays) {
     const float x = (pixel_x + jitter.first) * inverse_width;
     const float y = 1.0f - (pixel_y + jitter.second) * inverse_height;
     const glm::vec3 direction = glm::normalize(frame_.direction(x, y));
-    rays.origin_x[i] = frame_.origin.x;
-    rays.origin_y[i] = frame_.origin.y;
-    rays.origin_z[i] = frame_.origin.z;
-    rays.direction_x[i] = direction.x;
-    rays.direction_y[i] = direction.y;
-    rays.direction_z[i] = direction.z;
-    rays.tmin[i] = 0.0f;
-    rays.tmax[i] = std::numeric_limits<float>::infinity();
+    rays.set_geometry(i, frame_.origin, direction, 0.0f, std::numeric_limits<float>::infinity());
     rays.pixel[i] = pixel;
     rays.sample[i] = sample;
     rays.depth[i] = 0;

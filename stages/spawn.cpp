@@ -17,14 +17,7 @@ constexpr float kShadowRayShortening = 1e-4f;
 
 void write_ray(RayBatch& to, std::size_t slot, const RayBatch& parent, std::size_t i, const glm::vec3& origin,
                const glm::vec3& direction, float tmax, RayKind kind, std::uint16_t depth, const glm::vec3& throughput) {
-  to.origin_x[slot] = origin.x;
-  to.origin_y[slot] = origin.y;
-  to.origin_z[slot] = origin.z;
-  to.direction_x[slot] = direction.x;
-  to.direction_y[slot] = direction.y;
-  to.direction_z[slot] = direction.z;
-  to.tmin[slot] = 0.0f;
-  to.tmax[slot] = tmax;
+  to.set_geometry(slot, origin, direction, 0.0f, tmax);
   to.pixel[slot] = parent.pixel[i];
   to.sample[slot] = parent.sample[i];
   to.depth[slot] = depth;

@@ -22,14 +22,7 @@ TriangleMesh unit_square() {
 
 void set_ray(RayBatch& rays, std::size_t i, glm::vec3 origin, glm::vec3 direction, float tmin = 0.0f,
              float tmax = std::numeric_limits<float>::infinity()) {
-  rays.origin_x[i] = origin.x;
-  rays.origin_y[i] = origin.y;
-  rays.origin_z[i] = origin.z;
-  rays.direction_x[i] = direction.x;
-  rays.direction_y[i] = direction.y;
-  rays.direction_z[i] = direction.z;
-  rays.tmin[i] = tmin;
-  rays.tmax[i] = tmax;
+  rays.set_geometry(i, origin, direction, tmin, tmax);
   rays.flags[i] = ray_flags::alive;
   rays.kind[i] = RayKind::camera;
 }

@@ -11,7 +11,7 @@
 #include "accel/bvh/bvh_node.hpp"
 #include "accel/bvh/wide_bvh_accelerator.hpp"
 #include "kernels/ray_box.hpp"
-#include "kernels/triangle_intersect.hpp"
+#include "accel/bvh/leaf_query.hpp"
 #include "memory/cache_aligned_allocator.hpp"
 
 namespace wavetrace {
@@ -24,8 +24,6 @@ class BvhAccelerator final : public Accelerator {
   BvhAccelerator(const TriangleMesh& mesh, const BvhOptions& options)
       : options_(options), geometry_(mesh, options.triangle_order) {
     const auto start = std::chrono::steady_clock::now();
-    positions_ = geometry_.positions();
-    triangles_ = geometry_.triangles();
     const LargeArray<Bounds3> bounds = geometry_.triangle_bounds();
     SahOptions sah;
     sah.max_leaf_size = options.max_leaf_size;
@@ -60,8 +58,6 @@ class BvhAccelerator final : public Accelerator {
     if (options.triangle_order == TriangleOrder::leaf) {
       geometry_.adopt_order(leaf_triangles_);  // slots now equal leaf positions
       leaf_triangles_ = {};
-      positions_ = geometry_.positions();
-      triangles_ = geometry_.triangles();
     }
     depth_ = tree.depth();
     build_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -89,10 +85,7 @@ class BvhAccelerator final : public Accelerator {
   BuildReport build() const override { return build_; }
 
   std::vector<std::span<const std::byte>> memory_spans() const override {
-    std::vector<std::span<const std::byte>> spans = {std::as_bytes(std::span(nodes_)),
-                                                     std::as_bytes(std::span(leaf_triangles_))};
-    for (const auto& span : geometry_.spans()) spans.push_back(span);
-    return spans;
+    return bvh_memory_spans(nodes_, leaf_triangles_, geometry_);
   }
 
  private:
@@ -104,41 +97,29 @@ class BvhAccelerator final : public Accelerator {
     };
     StackEntry stack[kMaxTreeDepth];
     const BvhNode* nodes = nodes_.data();
-    const bool leaf_ordered = leaf_triangles_.empty();
     for (std::uint32_t i = range.begin; i < range.end; ++i) {
-      hits.t[i] = kInfinity;
-      hits.primitive[i] = kInvalidPrimitive;
-      hits.u[i] = hits.v[i] = 0.0f;
-      if (!(rays.flags[i] & ray_flags::alive)) continue;
+      if (!(rays.flags[i] & ray_flags::alive)) {
+        write_miss(hits, i);
+        continue;
+      }
       const glm::vec3 origin(rays.origin_x[i], rays.origin_y[i], rays.origin_z[i]);
       const glm::vec3 direction(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]);
       const BoxRay box_ray = make_box_ray(origin, direction);
-      const WatertightRay triangle_ray = make_watertight_ray(origin, direction);
-      const float tmin = rays.tmin[i];
-      float tmax = rays.tmax[i];
-      std::uint32_t found = kInvalidPrimitive;
-      TriangleHit best{kInfinity, 0.0f, 0.0f};
+      LeafQuery query(geometry_, leaf_triangles_, origin, direction, rays.tmin[i], rays.tmax[i]);
+      const float tmin = query.tmin;
+      float& tmax = query.tmax;
 
       std::uint32_t top = 0;
       std::uint32_t node = 0;
-      if (intersect_box(box_ray, nodes[0].lower, nodes[0].upper, tmin, tmax) == kInfinity) continue;
+      if (intersect_box(box_ray, nodes[0].lower, nodes[0].upper, tmin, tmax) == kInfinity) {
+        write_miss(hits, i);
+        continue;
+      }
       while (true) {
         const BvhNode& current = nodes[node];
         if (current.leaf()) {
-          const std::uint32_t end = current.first + current.triangle_count();
-          for (std::uint32_t slot = current.first; slot < end; ++slot) {
-            const std::uint32_t triangle = leaf_ordered ? slot : leaf_triangles_[slot];
-            const glm::uvec3& tri = triangles_[triangle];
-            TriangleHit hit;
-            if (intersect_watertight(triangle_ray, positions_[tri.x], positions_[tri.y], positions_[tri.z], tmin, tmax,
-                                     hit)) {
-              tmax = hit.t;
-              best = hit;
-              found = triangle;
-              if constexpr (kAnyHit) break;
-            }
-          }
-          if (kAnyHit && found != kInvalidPrimitive) break;
+          query.test_leaf<kAnyHit>(current.first, current.triangle_count());
+          if (kAnyHit && query.found()) break;
         } else {
           std::uint32_t near = current.left(), far = current.right();
           float near_distance = intersect_box(box_ray, nodes[near].lower, nodes[near].upper, tmin, tmax);
@@ -158,19 +139,12 @@ class BvhAccelerator final : public Accelerator {
         if (top == 0) break;
         node = stack[--top].node;
       }
-      if (found != kInvalidPrimitive) {
-        hits.t[i] = best.t;
-        hits.primitive[i] = geometry_.input_id(found);
-        hits.u[i] = best.u;
-        hits.v[i] = best.v;
-      }
+      query.write(hits, i);
     }
   }
 
   BvhOptions options_;
   IndexedFaceSet geometry_;
-  const glm::vec3* positions_ = nullptr;  // geometry_'s, cached for the hot loop
-  const glm::uvec3* triangles_ = nullptr;
   LargeArray<BvhNode> nodes_;
   LargeArray<std::uint32_t> leaf_triangles_;
   std::uint32_t depth_ = 0;

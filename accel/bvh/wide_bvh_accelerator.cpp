@@ -15,7 +15,7 @@
 #include "accel/bvh/indexed_face_set.hpp"
 #include "accel/bvh/wide_bvh_node.hpp"
 #include "kernels/ray_box.hpp"
-#include "kernels/triangle_intersect.hpp"
+#include "accel/bvh/leaf_query.hpp"
 #include "memory/cache_aligned_allocator.hpp"
 
 namespace wavetrace {
@@ -121,10 +121,7 @@ class WideBvhAccelerator final : public Accelerator {
   BuildReport build() const override { return build_; }
 
   std::vector<std::span<const std::byte>> memory_spans() const override {
-    std::vector<std::span<const std::byte>> spans = {std::as_bytes(std::span(nodes_)),
-                                                     std::as_bytes(std::span(leaf_triangles_))};
-    for (const auto& span : geometry_.spans()) spans.push_back(span);
-    return spans;
+    return bvh_memory_spans(nodes_, leaf_triangles_, geometry_);
   }
 
  private:
@@ -185,23 +182,18 @@ class WideBvhAccelerator final : public Accelerator {
     // Each level pushes at most seven siblings.
     StackEntry stack[kMaxTreeDepth * (kWidth - 1) + kWidth];
     const WideBvhNode* nodes = nodes_.data();
-    const glm::vec3* positions = geometry_.positions();
-    const glm::uvec3* triangles = geometry_.triangles();
-    const bool leaf_ordered = leaf_triangles_.empty();
     for (std::uint32_t i = range.begin; i < range.end; ++i) {
-      hits.t[i] = kInfinity;
-      hits.primitive[i] = kInvalidPrimitive;
-      hits.u[i] = hits.v[i] = 0.0f;
-      if (!(rays.flags[i] & ray_flags::alive)) continue;
+      if (!(rays.flags[i] & ray_flags::alive)) {
+        write_miss(hits, i);
+        continue;
+      }
       const glm::vec3 origin(rays.origin_x[i], rays.origin_y[i], rays.origin_z[i]);
       const glm::vec3 direction(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]);
       const WideRay box_ray{origin, 1.0f / direction,
                             (direction.x == 0.0f) | (direction.y == 0.0f) << 1 | (direction.z == 0.0f) << 2};
-      const WatertightRay triangle_ray = make_watertight_ray(origin, direction);
-      const float tmin = rays.tmin[i];
-      float tmax = rays.tmax[i];
-      std::uint32_t found = kInvalidPrimitive;
-      TriangleHit best{kInfinity, 0.0f, 0.0f};
+      LeafQuery query(geometry_, leaf_triangles_, origin, direction, rays.tmin[i], rays.tmax[i]);
+      const float tmin = query.tmin;
+      float& tmax = query.tmax;
 
       std::uint32_t top = 0;
       StackEntry current{0, 0, tmin};
@@ -233,30 +225,14 @@ class WideBvhAccelerator final : public Accelerator {
             continue;
           }
         } else {
-          const std::uint32_t end = current.child + current.count;
-          for (std::uint32_t slot = current.child; slot < end; ++slot) {
-            const std::uint32_t triangle = leaf_ordered ? slot : leaf_triangles_[slot];
-            const glm::uvec3& tri = triangles[triangle];
-            TriangleHit hit;
-            if (intersect_watertight(triangle_ray, positions[tri.x], positions[tri.y], positions[tri.z], tmin, tmax, hit)) {
-              tmax = hit.t;
-              best = hit;
-              found = triangle;
-              if constexpr (kAnyHit) break;
-            }
-          }
-          if (kAnyHit && found != kInvalidPrimitive) break;
+          query.test_leaf<kAnyHit>(current.child, current.count);
+          if (kAnyHit && query.found()) break;
         }
         while (top > 0 && stack[top - 1].distance > tmax) --top;
         if (top == 0) break;
         current = stack[--top];
       }
-      if (found != kInvalidPrimitive) {
-        hits.t[i] = best.t;
-        hits.primitive[i] = geometry_.input_id(found);
-        hits.u[i] = best.u;
-        hits.v[i] = best.v;
-      }
+      query.write(hits, i);
     }
   }
 

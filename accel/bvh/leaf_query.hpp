@@ -1,0 +1,82 @@
+// What the binary and the 8-wide BVH share per ray: the nearest hit so far, the leaf test
+// over an indexed face set, and writing the answer into the hit batch.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <vector>
+
+#include "accel/bvh/indexed_face_set.hpp"
+#include "kernels/triangle_intersect.hpp"
+#include "memory/ray_batch.hpp"
+
+namespace wavetrace {
+
+inline void write_miss(HitBatch& hits, std::uint32_t i) {
+  hits.t[i] = std::numeric_limits<float>::infinity();
+  hits.primitive[i] = kInvalidPrimitive;
+  hits.u[i] = hits.v[i] = 0.0f;
+}
+
+class LeafQuery {
+ public:
+  // `leaf_index` maps leaf slots to face-set slots; empty when the face set is in leaf order.
+  LeafQuery(const IndexedFaceSet& geometry, std::span<const std::uint32_t> leaf_index, const glm::vec3& origin,
+            const glm::vec3& direction, float tmin, float tmax)
+      : tmin(tmin),
+        tmax(tmax),
+        geometry_(geometry),
+        leaf_index_(leaf_index.empty() ? nullptr : leaf_index.data()),
+        ray_(make_watertight_ray(origin, direction)) {}
+
+  float tmin;
+  float tmax;  // shrinks to the nearest hit found
+
+  bool found() const { return found_ != kInvalidPrimitive; }
+
+  // Tests leaf slots [first, first + count); with kAnyHit stops at the first hit.
+  template <bool kAnyHit>
+  void test_leaf(std::uint32_t first, std::uint32_t count) {
+    const glm::vec3* positions = geometry_.positions();
+    const glm::uvec3* triangles = geometry_.triangles();
+    for (std::uint32_t slot = first; slot < first + count; ++slot) {
+      const std::uint32_t triangle = leaf_index_ ? leaf_index_[slot] : slot;
+      const glm::uvec3& tri = triangles[triangle];
+      TriangleHit hit;
+      if (intersect_watertight(ray_, positions[tri.x], positions[tri.y], positions[tri.z], tmin, tmax, hit)) {
+        tmax = hit.t;
+        best_ = hit;
+        found_ = triangle;
+        if constexpr (kAnyHit) return;
+      }
+    }
+  }
+
+  // The answer in the mesh's triangle numbering (a miss if nothing was found).
+  void write(HitBatch& hits, std::uint32_t i) const {
+    if (!found()) return write_miss(hits, i);
+    hits.t[i] = best_.t;
+    hits.primitive[i] = geometry_.input_id(found_);
+    hits.u[i] = best_.u;
+    hits.v[i] = best_.v;
+  }
+
+ private:
+  const IndexedFaceSet& geometry_;
+  const std::uint32_t* leaf_index_;
+  WatertightRay ray_;
+  std::uint32_t found_ = kInvalidPrimitive;
+  TriangleHit best_{std::numeric_limits<float>::infinity(), 0.0f, 0.0f};
+};
+
+// The byte ranges a BVH's traversal reads, for the pager.
+template <typename NodeArray, typename IndexArray>
+std::vector<std::span<const std::byte>> bvh_memory_spans(const NodeArray& nodes, const IndexArray& leaf_index,
+                                                         const IndexedFaceSet& geometry) {
+  std::vector<std::span<const std::byte>> spans = {std::as_bytes(std::span(nodes)), std::as_bytes(std::span(leaf_index))};
+  for (const auto& span : geometry.spans()) spans.push_back(span);
+  return spans;
+}
+
+}  // namespace wavetrace
