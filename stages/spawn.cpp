@@ -1,7 +1,6 @@
 // Next-event estimation and bounce sampling for a diffuse path tracer.
 #include "stages/spawn.hpp"
 
-#include <algorithm>
 #include <limits>
 
 #include <glm/geometric.hpp>
@@ -29,26 +28,6 @@ void write_ray(RayBatch& to, std::size_t slot, const RayBatch& parent, std::size
   to.flags[slot] = ray_flags::alive;
 }
 
-// Hit triangles lie anywhere in the mesh, so each ray's first reads miss the cache. Asking
-// for a chunk's triangles, then their vertices, before any arithmetic lets those misses
-// overlap instead of queueing one ray after another.
-constexpr std::size_t kPrefetchChunk = 128;
-
-void prefetch_hit_geometry(const RayBatch& rays, const HitBatch& hits, const TriangleMesh& mesh, std::size_t begin,
-                           std::size_t end) {
-  for (std::size_t i = begin; i < end; ++i) {
-    if (rays.flags[i] & ray_flags::alive) __builtin_prefetch(&mesh.triangles[hits.primitive[i]]);
-  }
-  for (std::size_t i = begin; i < end; ++i) {
-    if (!(rays.flags[i] & ray_flags::alive)) continue;
-    const glm::uvec3& corners = mesh.triangles[hits.primitive[i]];
-    __builtin_prefetch(&mesh.positions[corners.x]);
-    __builtin_prefetch(&mesh.positions[corners.y]);
-    __builtin_prefetch(&mesh.positions[corners.z]);
-    if (!mesh.material_of_triangle.empty()) __builtin_prefetch(&mesh.material_of_triangle[hits.primitive[i]]);
-  }
-}
-
 }  // namespace
 
 void SpawnStage::process(Batch* batch, StageOutput& out) const {
@@ -59,53 +38,49 @@ void SpawnStage::process(Batch* batch, StageOutput& out) const {
   Batch* bounces = out.acquire();
   Batch* shadows = has_lights ? out.acquire() : nullptr;
 
-  for (std::size_t chunk = 0; chunk < rays.count; chunk += kPrefetchChunk) {
-    const std::size_t chunk_end = std::min(rays.count, chunk + kPrefetchChunk);
-    prefetch_hit_geometry(rays, hits, mesh, chunk, chunk_end);
-    for (std::size_t i = chunk; i < chunk_end; ++i) {
-      if (!(rays.flags[i] & ray_flags::alive)) continue;
-      const std::uint32_t triangle = hits.primitive[i];
-      const glm::uvec3& corners = mesh.triangles[triangle];
-      const glm::vec3 a = mesh.positions[corners.x], b = mesh.positions[corners.y], c = mesh.positions[corners.z];
-      // From barycentrics rather than origin + t * direction: exact to the triangle's plane.
-      const glm::vec3 point = a + (b - a) * hits.u[i] + (c - a) * hits.v[i];
-      const glm::vec3 direction(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]);
-      glm::vec3 normal = glm::normalize(glm::cross(b - a, c - a));
-      if (glm::dot(normal, direction) > 0.0f) normal = -normal;  // two-sided: face the incoming ray
-      const glm::vec3 origin = offset_ray_origin(point, normal);
-      const glm::vec3 albedo = world_.scene.materials[mesh.material(triangle)].albedo;
-      const glm::vec3 throughput(rays.throughput_r[i], rays.throughput_g[i], rays.throughput_b[i]);
-      const std::uint32_t depth = rays.depth[i];
+  for (std::size_t i = 0; i < rays.count; ++i) {
+    if (!(rays.flags[i] & ray_flags::alive)) continue;
+    const std::uint32_t triangle = hits.primitive[i];
+    const glm::uvec3& corners = mesh.triangles[triangle];
+    const glm::vec3 a = mesh.positions[corners.x], b = mesh.positions[corners.y], c = mesh.positions[corners.z];
+    // From barycentrics rather than origin + t * direction: exact to the triangle's plane.
+    const glm::vec3 point = a + (b - a) * hits.u[i] + (c - a) * hits.v[i];
+    const glm::vec3 direction(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]);
+    glm::vec3 normal = glm::normalize(glm::cross(b - a, c - a));
+    if (glm::dot(normal, direction) > 0.0f) normal = -normal;  // two-sided: face the incoming ray
+    const glm::vec3 origin = offset_ray_origin(point, normal);
+    const glm::vec3 albedo = world_.scene.materials[mesh.material(triangle)].albedo;
+    const glm::vec3 throughput(rays.throughput_r[i], rays.throughput_g[i], rays.throughput_b[i]);
+    const std::uint32_t depth = rays.depth[i];
 
-      if (has_lights) {
-        const float choice = unit_float(random_bits(rays.pixel[i], rays.sample[i], depth, RandomPurpose::light_choice));
-        const UnitPair uv = unit_pair(random_bits(rays.pixel[i], rays.sample[i], depth, RandomPurpose::light_point));
-        const LightSample light = world_.lights.sample(choice, uv.first, uv.second);
-        const glm::vec3 to_light = light.point - origin;
-        const float distance_squared = glm::dot(to_light, to_light);
-        const float distance = std::sqrt(distance_squared);
-        const glm::vec3 toward = to_light / distance;
-        const float cos_surface = glm::dot(normal, toward);
-        const float cos_light = -glm::dot(light.normal, toward);
-        if (cos_surface > 0.0f && cos_light > 0.0f && distance_squared > 0.0f) {
-          const glm::vec3 carried = throughput * albedo * (1.0f / kPi) * light.emission *
-                                    (cos_surface * cos_light / (distance_squared * light.pdf_area));
-          RayBatch& to = shadows->rays;
-          write_ray(to, to.count++, rays, i, origin, toward, distance * (1.0f - kShadowRayShortening),
-                    RayKind::shadow, static_cast<std::uint16_t>(depth), carried);
-        }
+    if (has_lights) {
+      const float choice = unit_float(random_bits(rays.pixel[i], rays.sample[i], depth, RandomPurpose::light_choice));
+      const UnitPair uv = unit_pair(random_bits(rays.pixel[i], rays.sample[i], depth, RandomPurpose::light_point));
+      const LightSample light = world_.lights.sample(choice, uv.first, uv.second);
+      const glm::vec3 to_light = light.point - origin;
+      const float distance_squared = glm::dot(to_light, to_light);
+      const float distance = std::sqrt(distance_squared);
+      const glm::vec3 toward = to_light / distance;
+      const float cos_surface = glm::dot(normal, toward);
+      const float cos_light = -glm::dot(light.normal, toward);
+      if (cos_surface > 0.0f && cos_light > 0.0f && distance_squared > 0.0f) {
+        const glm::vec3 carried = throughput * albedo * (1.0f / kPi) * light.emission *
+                                  (cos_surface * cos_light / (distance_squared * light.pdf_area));
+        RayBatch& to = shadows->rays;
+        write_ray(to, to.count++, rays, i, origin, toward, distance * (1.0f - kShadowRayShortening),
+                  RayKind::shadow, static_cast<std::uint16_t>(depth), carried);
       }
+    }
 
-      if (rays.flags[i] & ray_flags::continues) {
-        const UnitPair uv = unit_pair(random_bits(rays.pixel[i], rays.sample[i], depth, RandomPurpose::bounce_direction));
-        const glm::vec3 bounce = cosine_hemisphere(normal, uv.first, uv.second);
-        // Cosine-weighted sampling of a Lambertian surface: f cos / pdf = albedo.
-        glm::vec3 next = throughput * albedo;
-        if (rules_.roulette_applies(depth)) next /= survival_probability(albedo);
-        RayBatch& to = bounces->rays;
-        write_ray(to, to.count++, rays, i, origin, bounce, std::numeric_limits<float>::infinity(), RayKind::bounce,
-                  static_cast<std::uint16_t>(depth + 1), next);
-      }
+    if (rays.flags[i] & ray_flags::continues) {
+      const UnitPair uv = unit_pair(random_bits(rays.pixel[i], rays.sample[i], depth, RandomPurpose::bounce_direction));
+      const glm::vec3 bounce = cosine_hemisphere(normal, uv.first, uv.second);
+      // Cosine-weighted sampling of a Lambertian surface: f cos / pdf = albedo.
+      glm::vec3 next = throughput * albedo;
+      if (rules_.roulette_applies(depth)) next /= survival_probability(albedo);
+      RayBatch& to = bounces->rays;
+      write_ray(to, to.count++, rays, i, origin, bounce, std::numeric_limits<float>::infinity(), RayKind::bounce,
+                static_cast<std::uint16_t>(depth + 1), next);
     }
   }
 
