@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 
+#include "accel/bvh/bvh_build.hpp"
 #include "accel/bvh/bvh_node.hpp"
 #include "accel/bvh/wide_bvh_accelerator.hpp"
 #include "kernels/ray_box.hpp"
@@ -22,14 +23,9 @@ constexpr float kInfinity = std::numeric_limits<float>::infinity();
 class BvhAccelerator final : public Accelerator {
  public:
   BvhAccelerator(const TriangleMesh& mesh, const BvhOptions& options)
-      : options_(options), geometry_(mesh, options.triangle_order) {
+      : geometry_(mesh, options.triangle_order) {
     const auto start = std::chrono::steady_clock::now();
-    const LargeArray<Bounds3> bounds = geometry_.triangle_bounds();
-    SahOptions sah;
-    sah.max_leaf_size = options.max_leaf_size;
-    sah.bins = options.bins;
-    const BuildTree tree = build_sah_tree(bounds, sah);
-    const std::size_t working_bytes = bounds.size() * sizeof(Bounds3) + tree.peak_bytes;
+    const BuildTree tree = build_bvh_tree(geometry_, options);
 
     // Flatten in the chosen order: node i of the array is build node order[i].
     const std::vector<std::uint32_t> order = node_order(tree, options.layout);
@@ -55,14 +51,9 @@ class BvhAccelerator final : public Accelerator {
         node.count = position_of[built.right];
       }
     }
-    if (options.triangle_order == TriangleOrder::leaf) {
-      geometry_.adopt_order(leaf_triangles_);  // slots now equal leaf positions
-      leaf_triangles_ = {};
-    }
-    depth_ = tree.depth();
+    adopt_leaf_order(options, geometry_, leaf_triangles_);
     build_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    build_.peak_bytes = std::max(working_bytes, geometry_.build_scratch_bytes()) +
-                        tree.nodes.size() * sizeof(BuildNode) + memory().total();
+    build_.peak_bytes = bvh_build_peak_bytes(tree, geometry_, memory().total());
   }
 
   std::string name() const override { return "bvh"; }
@@ -143,11 +134,9 @@ class BvhAccelerator final : public Accelerator {
     }
   }
 
-  BvhOptions options_;
   IndexedFaceSet geometry_;
   LargeArray<BvhNode> nodes_;
   LargeArray<std::uint32_t> leaf_triangles_;
-  std::uint32_t depth_ = 0;
   BuildReport build_;
 };
 

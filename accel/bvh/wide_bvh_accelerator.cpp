@@ -12,6 +12,7 @@
 #include <immintrin.h>
 #endif
 
+#include "accel/bvh/bvh_build.hpp"
 #include "accel/bvh/indexed_face_set.hpp"
 #include "accel/bvh/wide_bvh_node.hpp"
 #include "kernels/ray_box.hpp"
@@ -87,22 +88,13 @@ class WideBvhAccelerator final : public Accelerator {
  public:
   WideBvhAccelerator(const TriangleMesh& mesh, const BvhOptions& options) : geometry_(mesh, options.triangle_order) {
     const auto start = std::chrono::steady_clock::now();
-    const LargeArray<Bounds3> bounds = geometry_.triangle_bounds();
-    SahOptions sah;
-    sah.max_leaf_size = options.max_leaf_size;
-    sah.bins = options.bins;
-    const BuildTree tree = build_sah_tree(bounds, sah);
+    const BuildTree tree = build_bvh_tree(geometry_, options);
     leaf_triangles_.reserve(geometry_.triangle_count());
     nodes_.reserve(tree.nodes.size() / 4 + 1);
     collapse(tree, 0);
-    if (options.triangle_order == TriangleOrder::leaf) {
-      geometry_.adopt_order(leaf_triangles_);  // slots now equal leaf positions
-      leaf_triangles_ = {};
-    }
+    adopt_leaf_order(options, geometry_, leaf_triangles_);
     build_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    build_.peak_bytes = std::max(geometry_.build_scratch_bytes(), bounds.size() * sizeof(Bounds3) + tree.peak_bytes) +
-                        tree.nodes.size() * sizeof(BuildNode) + memory().total();
-    // (the leaf-order copy is made after the tree's scratch is gone; build_scratch_bytes covers it)
+    build_.peak_bytes = bvh_build_peak_bytes(tree, geometry_, memory().total());
   }
 
   std::string name() const override { return "bvh8"; }
