@@ -91,7 +91,7 @@ int run_leak(const BenchArguments& args) {
 }
 
 void add_common_options(CLI::App* command, BenchArguments& args) {
-  command->add_option("--scene", args.scene, "mesh file or builtin:NAME[:TRIANGLES]");
+  command->add_option("--scene", args.scene, "mesh file, scene file (.toml) or builtin:NAME[:TRIANGLES]");
   command->add_option("--accel", args.accel,
                       "comma-separated accelerators, each TYPE[:key=value]..., e.g. bvh:layout=veb,embree:mode=robust");
   command->add_option("--count", args.count, "number of rays");

@@ -61,7 +61,7 @@ int run_info(const InfoArguments& args) {
 void add_info_command(CLI::App& app, int& exit_code) {
   auto args = std::make_shared<InfoArguments>();
   CLI::App* command = app.add_subcommand("info", "report a scene's size, bounds and topology");
-  command->add_option("scene", args->scene, "mesh file or builtin:NAME[:TRIANGLES]");
+  command->add_option("scene,--scene", args->scene, "mesh file, scene file (.toml) or builtin:NAME[:TRIANGLES]");
   command->add_option("--subdivide", args->subdivide, "levels of Loop subdivision first");
   command->add_flag("--json", args->json, "print JSON");
   command->callback([args, &exit_code] { exit_code = run_info(*args); });

@@ -84,7 +84,8 @@ int run_render(const RenderArguments& args) {
 void add_render_command(CLI::App& app, int& exit_code) {
   auto args = std::make_shared<RenderArguments>();
   CLI::App* command = app.add_subcommand("render", "path-trace an image through the stage pipeline");
-  command->add_option("scene", args->scene, "mesh file or builtin:NAME[:TRIANGLES] (default builtin:default)");
+  command->add_option("scene,--scene", args->scene,
+                      "mesh file, scene file (.toml) or builtin:NAME[:TRIANGLES] (default builtin:default)");
   command->add_option("--accel", args->accel, "accelerator (accel.type)");
   command->add_option("--spp", args->spp, "samples per pixel (render.spp)");
   command->add_option("--size", args->size, "image size as WIDTHxHEIGHT");

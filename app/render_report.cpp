@@ -22,6 +22,10 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
                       {"seconds", stage.seconds},
                       {"mrays_per_s", stage.mrays_per_s()}});
   }
+  nlohmann::json hit_rates = nlohmann::json::array();
+  for (const DepthHitRate& rate : facts.output.hit_rates) {
+    hit_rates.push_back({{"depth", rate.depth}, {"rays", rate.rays}, {"hits", rate.hits}, {"hit_rate", rate.rate()}});
+  }
   return {
       {"scene",
        {{"source", facts.scene.name},
@@ -37,6 +41,7 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
         {"build_seconds", build.seconds},
         {"build_peak_bytes", build.peak_bytes}}},
       {"stages", stages},
+      {"hit_rates", hit_rates},
       {"render", {{"seconds", facts.output.run.seconds}, {"threads", facts.output.run.threads}}},
       {"image",
        {{"width", facts.plan.image.width},
@@ -56,6 +61,13 @@ std::string render_table(const RenderFacts& facts) {
     table += fmt::format("{:<10} {:>14} {:>14} {:>10.3f} {:>7.1f}% {:>12.2f}\n", stage.name, stage.rays_in,
                          stage.rays_out, stage.seconds, 100.0 * stage.seconds / thread_seconds, stage.mrays_per_s());
     if (stage.name == "trace") traced = double(stage.rays_in);
+  }
+  if (!facts.output.hit_rates.empty()) {
+    table += "hit rate by depth (camera 0, bounces 1+):";
+    for (const DepthHitRate& rate : facts.output.hit_rates) {
+      table += fmt::format(" {}: {:.1f}%", rate.depth, 100.0 * rate.rate());
+    }
+    table += "\n";
   }
   const MemoryReport memory = facts.accelerator.memory();
   const BuildReport build = facts.accelerator.build();

@@ -1,4 +1,4 @@
-// `wavetrace bench leak`: rays from random points strictly inside a closed mesh, in random
+// `wavetrace bench leak`: rays from random points strictly inside a closed surface, in random
 // directions. Every such ray must hit the surface; one that finds nothing has slipped
 // through a crack between triangles (a watertightness failure).
 #pragma once
@@ -23,11 +23,13 @@ struct LeakReport {
   std::string scene;
   std::size_t triangles = 0;
   std::size_t inside_points = 0;
+  bool enclosure = false;  // points drawn in the scene's enclosure, not found by ray parity
   std::vector<LeakResult> results;
 };
 
-// Throws std::runtime_error naming the reason when the scene is not closed, or when no
-// inside point is found.
+// A closed mesh gets points inside it; an open one with an enclosure (builtin:room) gets
+// points anywhere in the enclosure. Throws std::runtime_error naming the reason when the
+// scene is neither, or when no inside point is found.
 LeakReport run_leak_bench(const Scene& scene, const std::vector<AcceleratorSpec>& accelerators, std::size_t count,
                           int threads);
 

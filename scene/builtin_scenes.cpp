@@ -1,279 +1,66 @@
-// Generators of the builtin scenes. The sphere is an icosahedron whose faces are split
-// into n x n triangle lattices with globally shared vertices, so it is closed and manifold.
+// The builtin scenes, composed from the procedural shapes.
 #include "scene/builtin_scenes.hpp"
 
-#include <array>
 #include <charconv>
-#include <cmath>
-#include <map>
 
 #include <fmt/format.h>
-#include <glm/geometric.hpp>
-#include <glm/vec2.hpp>
 #include <tbb/parallel_for.h>
 
-#include "kernels/random.hpp"
-#include "scene/noise.hpp"
+#include "scene/scene_assembly.hpp"
+#include "scene/shapes.hpp"
 
 namespace wavetrace {
 namespace {
 
 constexpr std::string_view kPrefix = "builtin:";
-constexpr float kDisplacementAmplitude = 0.12f;
-constexpr float kDisplacementFrequency = 2.5f;
-constexpr int kDisplacementOctaves = 7;
+constexpr std::uint32_t kSeed = 1;
+const glm::vec3 kWhiteSky(1.0f);
 
-// The regular icosahedron: 12 corners, 20 outward-facing (counter-clockwise) faces.
-struct Icosahedron {
-  std::array<glm::vec3, 12> corners;
-  std::array<glm::uvec3, 20> faces;
-  std::array<glm::uvec2, 30> edges;  // (low, high) corner pairs
-  std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> edge_of;
-
-  Icosahedron() {
-    const float phi = (1.0f + std::sqrt(5.0f)) * 0.5f;
-    corners = {glm::vec3(-1, phi, 0), glm::vec3(1, phi, 0),   glm::vec3(-1, -phi, 0), glm::vec3(1, -phi, 0),
-               glm::vec3(0, -1, phi), glm::vec3(0, 1, phi),   glm::vec3(0, -1, -phi), glm::vec3(0, 1, -phi),
-               glm::vec3(phi, 0, -1), glm::vec3(phi, 0, 1),   glm::vec3(-phi, 0, -1), glm::vec3(-phi, 0, 1)};
-    for (glm::vec3& corner : corners) corner = glm::normalize(corner);
-    faces = {glm::uvec3(0, 11, 5), glm::uvec3(0, 5, 1),  glm::uvec3(0, 1, 7),   glm::uvec3(0, 7, 10),
-             glm::uvec3(0, 10, 11), glm::uvec3(1, 5, 9),  glm::uvec3(5, 11, 4),  glm::uvec3(11, 10, 2),
-             glm::uvec3(10, 7, 6), glm::uvec3(7, 1, 8),   glm::uvec3(3, 9, 4),   glm::uvec3(3, 4, 2),
-             glm::uvec3(3, 2, 6),  glm::uvec3(3, 6, 8),   glm::uvec3(3, 8, 9),   glm::uvec3(4, 9, 5),
-             glm::uvec3(2, 4, 11), glm::uvec3(6, 2, 10),  glm::uvec3(8, 6, 7),   glm::uvec3(9, 8, 1)};
-    std::uint32_t next = 0;
-    for (const glm::uvec3& face : faces) {
-      for (int k = 0; k < 3; ++k) {
-        const auto key = std::minmax(face[k], face[(k + 1) % 3]);
-        if (edge_of.emplace(std::pair(key.first, key.second), next).second) {
-          edges[next++] = glm::uvec2(key.first, key.second);
-        }
-      }
-    }
-  }
-};
-
-const Icosahedron& icosahedron() {
-  static const Icosahedron instance;
-  return instance;
+Scene single_object(std::string name, const TriangleMesh& mesh, const Material& material) {
+  SceneAssembly assembly;
+  assembly.add(mesh, assembly.add_material(material));
+  return std::move(assembly).finish(std::move(name), kWhiteSky);
 }
 
-// Global vertex numbering of the frequency-n icosphere: 12 corners, then n-1 points per
-// edge (ordered from the edge's lower corner), then the (n-1)(n-2)/2 interior points per face.
-class IcosphereLattice {
- public:
-  explicit IcosphereLattice(std::uint32_t n) : n_(n) {}
-
-  std::size_t vertex_count() const { return 12 + 30 * std::size_t(n_ - 1) + 20 * interior_per_face(); }
-  std::size_t triangle_count() const { return 20 * std::size_t(n_) * n_; }
-
-  // Vertex id of lattice point (i, j) of face f: A + (B-A) i/n + (C-A) j/n.
-  std::uint32_t vertex(std::uint32_t face, std::uint32_t i, std::uint32_t j) const {
-    const glm::uvec3& corners = icosahedron().faces[face];
-    if (i == 0 && j == 0) return corners.x;
-    if (i == n_ && j == 0) return corners.y;
-    if (i == 0 && j == n_) return corners.z;
-    if (j == 0) return edge_vertex(corners.x, corners.y, i);
-    if (i == 0) return edge_vertex(corners.x, corners.z, j);
-    if (i + j == n_) return edge_vertex(corners.y, corners.z, j);
-    const std::uint32_t local = (i - 1) * (n_ - 1) - (i - 1) * i / 2 + (j - 1);
-    return static_cast<std::uint32_t>(12 + 30 * std::size_t(n_ - 1) + face * interior_per_face() + local);
-  }
-
-  // Unit-sphere direction of every vertex id.
-  glm::vec3 direction(std::size_t id) const {
-    const Icosahedron& ico = icosahedron();
-    if (id < 12) return ico.corners[id];
-    id -= 12;
-    if (id < 30 * std::size_t(n_ - 1)) {
-      const glm::uvec2 edge = ico.edges[id / (n_ - 1)];
-      const float s = float(id % (n_ - 1) + 1) / float(n_);
-      return glm::normalize(ico.corners[edge.x] * (1.0f - s) + ico.corners[edge.y] * s);
-    }
-    id -= 30 * std::size_t(n_ - 1);
-    const std::size_t face = id / interior_per_face();
-    std::uint32_t local = static_cast<std::uint32_t>(id % interior_per_face());
-    std::uint32_t i = 1;
-    while (local >= n_ - 1 - i) {
-      local -= n_ - 1 - i;
-      ++i;
-    }
-    const std::uint32_t j = local + 1;
-    const glm::uvec3& corners = ico.faces[face];
-    const glm::vec3 a = ico.corners[corners.x], b = ico.corners[corners.y], c = ico.corners[corners.z];
-    return glm::normalize(a + (b - a) * (float(i) / n_) + (c - a) * (float(j) / n_));
-  }
-
- private:
-  std::size_t interior_per_face() const { return n_ < 3 ? 0 : std::size_t(n_ - 1) * (n_ - 2) / 2; }
-  std::uint32_t edge_vertex(std::uint32_t from, std::uint32_t to, std::uint32_t steps_from_start) const {
-    const std::uint32_t edge = icosahedron().edge_of.at(std::minmax(from, to));
-    const std::uint32_t steps = from < to ? steps_from_start : n_ - steps_from_start;
-    return 12 + edge * (n_ - 1) + (steps - 1);
-  }
-  std::uint32_t n_;
-};
-
-std::uint32_t icosphere_frequency(std::size_t triangles) {
-  const double n = std::round(std::sqrt(double(triangles) / 20.0));
-  return static_cast<std::uint32_t>(std::max(1.0, n));
-}
-
-void append(TriangleMesh& into, const TriangleMesh& part, std::uint32_t material) {
-  const auto offset = static_cast<std::uint32_t>(into.positions.size());
-  into.positions.insert(into.positions.end(), part.positions.begin(), part.positions.end());
-  const std::size_t first = into.triangles.size();
-  into.triangles.resize(first + part.triangles.size());
-  tbb::parallel_for(std::size_t{0}, part.triangles.size(),
-                    [&](std::size_t t) { into.triangles[first + t] = part.triangles[t] + offset; });
-  into.material_of_triangle.resize(into.triangles.size(), material);
-}
-
-// An axis-aligned quad from corner with edges u and v; front face along cross(u, v).
-TriangleMesh make_quad(const glm::vec3& corner, const glm::vec3& u, const glm::vec3& v) {
-  TriangleMesh quad;
-  quad.positions = {corner, corner + u, corner + u + v, corner + v};
-  quad.triangles = {glm::uvec3(0, 1, 2), glm::uvec3(0, 2, 3)};
-  return quad;
-}
-
-// The six faces of a box, facing inward, as 12 triangles over 8 shared corners.
-TriangleMesh make_inward_box(const glm::vec3& lower, const glm::vec3& upper) {
-  TriangleMesh box;
-  for (int c = 0; c < 8; ++c) {
-    box.positions.emplace_back(c & 1 ? upper.x : lower.x, c & 2 ? upper.y : lower.y, c & 4 ? upper.z : lower.z);
-  }
-  const std::array<std::array<std::uint32_t, 4>, 6> faces = {
-      {{0, 1, 3, 2}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 3, 7, 5}}};
-  const glm::vec3 center = (lower + upper) * 0.5f;
-  for (const auto& f : faces) {
-    glm::uvec3 first(f[0], f[1], f[2]), second(f[0], f[2], f[3]);
-    const glm::vec3 a = box.positions[f[0]], b = box.positions[f[1]], c = box.positions[f[2]];
-    if (glm::dot(glm::cross(b - a, c - a), center - a) < 0.0f) {  // wound outward: flip to face in
-      std::swap(first.y, first.z);
-      std::swap(second.y, second.z);
-    }
-    box.triangles.push_back(first);
-    box.triangles.push_back(second);
-  }
-  return box;
-}
-
-TriangleMesh make_terrain(std::size_t triangles, float size, float height, std::uint32_t seed) {
-  const auto cells = static_cast<std::uint32_t>(std::max(1.0, std::round(std::sqrt(double(triangles) / 2.0))));
-  const std::uint32_t row = cells + 1;
-  TriangleMesh mesh;
-  mesh.positions.resize(std::size_t(row) * row);
-  tbb::parallel_for(std::uint32_t{0}, row, [&](std::uint32_t z) {
-    for (std::uint32_t x = 0; x < row; ++x) {
-      const float fx = float(x) / cells, fz = float(z) / cells;
-      const glm::vec3 ground((fx - 0.5f) * size, 0.0f, (fz - 0.5f) * size);
-      const float y = height * fractal_noise(glm::vec3(fx * 4.0f, 0.37f, fz * 4.0f), 8, seed);
-      mesh.positions[std::size_t(z) * row + x] = ground + glm::vec3(0.0f, y, 0.0f);
-    }
-  });
-  mesh.triangles.resize(std::size_t(cells) * cells * 2);
-  tbb::parallel_for(std::uint32_t{0}, cells, [&](std::uint32_t z) {
-    for (std::uint32_t x = 0; x < cells; ++x) {
-      const std::uint32_t v00 = z * row + x, v10 = v00 + 1, v01 = v00 + row, v11 = v01 + 1;
-      const std::size_t t = (std::size_t(z) * cells + x) * 2;
-      mesh.triangles[t] = glm::uvec3(v00, v01, v11);  // counter-clockwise seen from +y
-      mesh.triangles[t + 1] = glm::uvec3(v00, v11, v10);
-    }
-  });
-  return mesh;
-}
-
-// Thin open tubes of triangular cross-section growing from a sphere of radius `radius`.
-TriangleMesh make_strands(std::size_t triangles, float radius, float length, float width, std::uint32_t seed) {
-  constexpr std::uint32_t kSegments = 4, kSides = 3, kRings = kSegments + 1;
-  constexpr std::uint32_t kTrianglesPerStrand = kSegments * kSides * 2;
-  const std::size_t strands = std::max<std::size_t>(1, triangles / kTrianglesPerStrand);
-  TriangleMesh mesh;
-  mesh.positions.resize(strands * kRings * kSides);
-  mesh.triangles.resize(strands * kTrianglesPerStrand);
-  tbb::parallel_for(std::size_t{0}, strands, [&](std::size_t s) {
-    const UnitPair root = unit_pair(random_bits(std::uint32_t(s), seed, 0, RandomPurpose::scene_generation));
-    const UnitPair bend = unit_pair(random_bits(std::uint32_t(s), seed, 1, RandomPurpose::scene_generation));
-    const float z = 1.0f - 2.0f * root.first, phi = 2.0f * 3.14159265f * root.second;
-    const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
-    const glm::vec3 normal(r * std::cos(phi), r * std::sin(phi), z);
-    const glm::vec3 tangent = glm::normalize(glm::cross(normal, std::fabs(normal.y) < 0.9f ? glm::vec3(0, 1, 0)
-                                                                                          : glm::vec3(1, 0, 0)));
-    const glm::vec3 bitangent = glm::cross(normal, tangent);
-    const glm::vec3 sway = tangent * (bend.first - 0.5f) + bitangent * (bend.second - 0.5f);
-    const std::size_t first_vertex = s * kRings * kSides;
-    for (std::uint32_t ring = 0; ring < kRings; ++ring) {
-      const float along = float(ring) / kSegments;
-      const glm::vec3 center = normal * (radius + length * along) + sway * (length * along * along);
-      const float ring_width = width * (1.0f - 0.7f * along);
-      for (std::uint32_t side = 0; side < kSides; ++side) {
-        const float angle = 2.0f * 3.14159265f * float(side) / kSides;
-        mesh.positions[first_vertex + ring * kSides + side] =
-            center + (tangent * std::cos(angle) + bitangent * std::sin(angle)) * ring_width;
-      }
-    }
-    std::size_t t = s * kTrianglesPerStrand;
-    for (std::uint32_t ring = 0; ring < kSegments; ++ring) {
-      for (std::uint32_t side = 0; side < kSides; ++side) {
-        const auto a = static_cast<std::uint32_t>(first_vertex + ring * kSides + side);
-        const auto b = static_cast<std::uint32_t>(first_vertex + ring * kSides + (side + 1) % kSides);
-        mesh.triangles[t++] = glm::uvec3(a, b, b + kSides);
-        mesh.triangles[t++] = glm::uvec3(a, b + kSides, a + kSides);
-      }
-    }
-  });
-  return mesh;
-}
-
-Scene finish(std::string name, TriangleMesh mesh, std::vector<Material> materials, glm::vec3 background) {
-  Scene scene;
-  scene.name = std::move(name);
-  scene.cleanup = validate_and_clean(mesh, scene.name);
-  scene.mesh = std::move(mesh);
-  scene.materials = std::move(materials);
-  scene.background = background;
+// A closed room (the paper's Cornell box and Sponza play this part): walls, floor and
+// ceiling facing inward, an area light under the ceiling, and detailed objects sharing the
+// triangle budget. Every ray from inside hits something, so bounces are real work.
+Scene make_room(std::string name, std::size_t triangles) {
+  const glm::vec3 lower(-4.0f, 0.0f, -4.0f), upper(4.0f, 3.5f, 4.0f);
+  const auto share = [&](double fraction) { return std::max<std::size_t>(20, std::size_t(double(triangles) * fraction)); };
+  SceneAssembly assembly;
+  // Left wall red, right wall green, the rest white, as in a Cornell box.
+  assembly.add(make_room_shell(lower, upper, share(0.04)),
+               {Material{glm::vec3(0.63f, 0.065f, 0.05f)}, Material{glm::vec3(0.14f, 0.45f, 0.09f)},
+                Material{glm::vec3(0.75f)}});
+  // Just under the ceiling, facing down: the room stays closed without it.
+  assembly.add(make_quad(glm::vec3(-0.8f, upper.y - 0.01f, -1.8f), glm::vec3(1.6f, 0.0f, 0.0f), glm::vec3(0.0f, 0.0f, 1.6f)),
+               assembly.add_material(Material{glm::vec3(0.0f), glm::vec3(17.0f)}));
+  assembly.add(translated(make_terrain(share(0.20), 3.2f, 0.35f, kSeed), glm::vec3(-2.0f, 0.3f, -1.6f)),
+               assembly.add_material(Material{glm::vec3(0.55f, 0.5f, 0.4f)}));
+  assembly.add(make_displaced_sphere(share(0.28), glm::vec3(1.5f, 1.0f, -1.8f), 0.9f, kSeed),
+               assembly.add_material(Material{glm::vec3(0.80f, 0.45f, 0.25f)}));
+  assembly.add(make_displaced_sphere(share(0.16), glm::vec3(-2.0f, 1.05f, -1.8f), 0.6f, kSeed + 1),
+               assembly.add_material(Material{glm::vec3(0.30f, 0.45f, 0.75f)}));
+  assembly.add(make_displaced_sphere(share(0.10), glm::vec3(0.1f, 0.42f, 0.3f), 0.4f, kSeed + 2),
+               assembly.add_material(Material{glm::vec3(0.75f)}));
+  const glm::vec3 fur_center(1.9f, 0.85f, 0.9f);
+  const std::size_t fur = share(0.22);
+  assembly.add(make_displaced_sphere(fur / 10, fur_center, 0.45f, kSeed + 3),
+               assembly.add_material(Material{glm::vec3(0.6f)}));
+  assembly.add(translated(make_strands(fur - fur / 10, 0.45f, 0.3f, 0.004f, kSeed), fur_center),
+               assembly.add_material(Material{glm::vec3(0.85f, 0.65f, 0.4f)}));
+  Scene scene = std::move(assembly).finish(std::move(name), glm::vec3(0.0f));
+  scene.camera = Camera{glm::vec3(0.0f, 1.7f, 3.7f), glm::vec3(0.0f, 1.0f, -1.0f), glm::vec3(0.0f, 1.0f, 0.0f), 62.0f};
+  scene.enclosure = Bounds3{lower, upper};
   return scene;
 }
 
 }  // namespace
 
-TriangleMesh make_displaced_sphere(std::size_t triangles, const glm::vec3& center, float radius,
-                                   std::uint32_t seed) {
-  const IcosphereLattice lattice(icosphere_frequency(triangles));
-  const std::uint32_t n = icosphere_frequency(triangles);
-  TriangleMesh mesh;
-  mesh.positions.resize(lattice.vertex_count());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, lattice.vertex_count(), 4096),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      for (std::size_t id = range.begin(); id != range.end(); ++id) {
-                        const glm::vec3 direction = lattice.direction(id);
-                        const float displacement =
-                            kDisplacementAmplitude *
-                            fractal_noise(direction * kDisplacementFrequency, kDisplacementOctaves, seed);
-                        mesh.positions[id] = center + direction * (radius * (1.0f + displacement));
-                      }
-                    });
-  mesh.triangles.resize(lattice.triangle_count());
-  tbb::parallel_for(std::uint32_t{0}, 20u * n, [&](std::uint32_t face_row) {
-    const std::uint32_t face = face_row / n, i = face_row % n;
-    // Row i of face f: n-i "up" triangles and n-i-1 "down" triangles, in a fixed order.
-    std::size_t t = std::size_t(face) * n * n + std::size_t(i) * (2 * n - i);
-    for (std::uint32_t j = 0; i + j < n; ++j) {
-      mesh.triangles[t++] = glm::uvec3(lattice.vertex(face, i, j), lattice.vertex(face, i + 1, j),
-                                       lattice.vertex(face, i, j + 1));
-      if (i + j + 1 < n) {
-        mesh.triangles[t++] = glm::uvec3(lattice.vertex(face, i + 1, j), lattice.vertex(face, i + 1, j + 1),
-                                         lattice.vertex(face, i, j + 1));
-      }
-    }
-  });
-  return mesh;
-}
-
 bool is_builtin_scene(std::string_view source) { return source.starts_with(kPrefix); }
 
-std::vector<std::string> builtin_scene_names() { return {"sphere", "terrain", "soup", "stadium", "fur", "default"}; }
+std::vector<std::string> builtin_scene_names() { return {"sphere", "terrain", "soup", "stadium", "fur", "default", "room"}; }
 
 std::size_t parse_triangle_count(std::string_view text, std::string_view what) {
   std::size_t multiplier = 1;
@@ -304,15 +91,12 @@ Scene make_builtin_scene(std::string_view source) {
   const auto count_or = [&](std::size_t fallback) {
     return colon == std::string_view::npos ? fallback : parse_triangle_count(spec.substr(colon + 1), label);
   };
-  const std::uint32_t seed = 1;
-  const glm::vec3 white_sky(1.0f);
-
   if (name == "sphere") {
-    return finish(label, make_displaced_sphere(count_or(1000000), glm::vec3(0.0f), 1.0f, seed),
-                  {Material{glm::vec3(0.7f)}}, white_sky);
+    return single_object(label, make_displaced_sphere(count_or(1000000), glm::vec3(0.0f), 1.0f, kSeed),
+                         Material{glm::vec3(0.7f)});
   }
   if (name == "soup") {
-    const TriangleMesh sphere = make_displaced_sphere(count_or(1000000), glm::vec3(0.0f), 1.0f, seed);
+    const TriangleMesh sphere = make_displaced_sphere(count_or(1000000), glm::vec3(0.0f), 1.0f, kSeed);
     TriangleMesh soup;
     soup.positions.resize(sphere.triangle_count() * 3);
     soup.triangles.resize(sphere.triangle_count());
@@ -321,41 +105,43 @@ Scene make_builtin_scene(std::string_view source) {
       for (int k = 0; k < 3; ++k) soup.positions[base + k] = sphere.positions[sphere.triangles[t][k]];
       soup.triangles[t] = glm::uvec3(base, base + 1, base + 2);
     });
-    return finish(label, std::move(soup), {Material{glm::vec3(0.7f)}}, white_sky);
+    return single_object(label, soup, Material{glm::vec3(0.7f)});
   }
   if (name == "terrain") {
-    return finish(label, make_terrain(count_or(1000000), 4.0f, 0.6f, seed), {Material{glm::vec3(0.6f)}},
-                  white_sky);
+    return single_object(label, make_terrain(count_or(1000000), 4.0f, 0.6f, kSeed), Material{glm::vec3(0.6f)});
   }
   if (name == "stadium") {
     const std::size_t total = std::max<std::size_t>(count_or(1000000), 32);
-    TriangleMesh mesh;
-    append(mesh, make_displaced_sphere(total - 12, glm::vec3(0.0f), 1.0f, seed), 0);
-    append(mesh, make_inward_box(glm::vec3(-500.0f), glm::vec3(500.0f)), 1);
-    Scene scene = finish(label, std::move(mesh), {Material{glm::vec3(0.7f)}, Material{glm::vec3(0.5f)}}, white_sky);
+    SceneAssembly assembly;
+    assembly.add(make_displaced_sphere(total - 12, glm::vec3(0.0f), 1.0f, kSeed),
+                 assembly.add_material(Material{glm::vec3(0.7f)}));
+    assembly.add(make_inward_box(glm::vec3(-500.0f), glm::vec3(500.0f)), assembly.add_material(Material{glm::vec3(0.5f)}));
+    Scene scene = std::move(assembly).finish(label, kWhiteSky);
     scene.camera = Camera{glm::vec3(0.0f, 1.0f, 4.0f), glm::vec3(0.0f), glm::vec3(0.0f, 1.0f, 0.0f), 40.0f};
     return scene;
   }
   if (name == "fur") {
     const std::size_t total = std::max<std::size_t>(count_or(1000000), 200);
-    TriangleMesh mesh;
-    append(mesh, make_displaced_sphere(total / 10, glm::vec3(0.0f), 0.8f, seed), 0);
-    append(mesh, make_strands(total - mesh.triangle_count(), 0.8f, 0.35f, 0.004f, seed), 1);
-    return finish(label, std::move(mesh), {Material{glm::vec3(0.6f)}, Material{glm::vec3(0.8f, 0.6f, 0.4f)}},
-                  white_sky);
+    SceneAssembly assembly;
+    assembly.add(make_displaced_sphere(total / 10, glm::vec3(0.0f), 0.8f, kSeed),
+                 assembly.add_material(Material{glm::vec3(0.6f)}));
+    assembly.add(make_strands(total - assembly.triangle_count(), 0.8f, 0.35f, 0.004f, kSeed),
+                 assembly.add_material(Material{glm::vec3(0.8f, 0.6f, 0.4f)}));
+    return std::move(assembly).finish(label, kWhiteSky);
   }
   if (name == "default") {
-    TriangleMesh mesh;
-    append(mesh, make_displaced_sphere(count_or(200000), glm::vec3(0.0f, 1.15f, 0.0f), 1.0f, seed), 0);
-    append(mesh, make_quad(glm::vec3(-10.0f, 0.0f, 10.0f), glm::vec3(20.0f, 0.0f, 0.0f), glm::vec3(0.0f, 0.0f, -20.0f)), 1);
-    append(mesh, make_quad(glm::vec3(-1.0f, 4.5f, -1.0f), glm::vec3(2.0f, 0.0f, 0.0f), glm::vec3(0.0f, 0.0f, 2.0f)), 2);
-    Scene scene = finish(label, std::move(mesh),
-                         {Material{glm::vec3(0.80f, 0.45f, 0.25f)}, Material{glm::vec3(0.65f)},
-                          Material{glm::vec3(0.0f), glm::vec3(15.0f)}},
-                         glm::vec3(0.03f, 0.04f, 0.06f));
+    SceneAssembly assembly;
+    assembly.add(make_displaced_sphere(count_or(200000), glm::vec3(0.0f, 1.15f, 0.0f), 1.0f, kSeed),
+                 assembly.add_material(Material{glm::vec3(0.80f, 0.45f, 0.25f)}));
+    assembly.add(make_quad(glm::vec3(-10.0f, 0.0f, 10.0f), glm::vec3(20.0f, 0.0f, 0.0f), glm::vec3(0.0f, 0.0f, -20.0f)),
+                 assembly.add_material(Material{glm::vec3(0.65f)}));
+    assembly.add(make_quad(glm::vec3(-1.0f, 4.5f, -1.0f), glm::vec3(2.0f, 0.0f, 0.0f), glm::vec3(0.0f, 0.0f, 2.0f)),
+                 assembly.add_material(Material{glm::vec3(0.0f), glm::vec3(15.0f)}));
+    Scene scene = std::move(assembly).finish(label, glm::vec3(0.03f, 0.04f, 0.06f));
     scene.camera = Camera{glm::vec3(0.0f, 2.4f, 5.8f), glm::vec3(0.0f, 1.0f, 0.0f), glm::vec3(0.0f, 1.0f, 0.0f), 40.0f};
     return scene;
   }
+  if (name == "room") return make_room(label, std::max<std::size_t>(count_or(1000000), 2000));
   std::string known;
   for (const std::string& builtin : builtin_scene_names()) known += (known.empty() ? "" : ", ") + builtin;
   throw SceneError(fmt::format("{}: unknown builtin scene '{}' (known: {})", label, name, known));

@@ -5,6 +5,8 @@
 //   stadium  a small dense sphere inside a huge, sparse box (the grids' failure case)
 //   fur      many thin disconnected strands on a small sphere (the proxy's failure case)
 //   default  a displaced sphere on a ground plane under an area light, framed by the camera
+//   room     a closed room lit from its ceiling holding displaced spheres, a terrain patch
+//            and fur; the camera inside (the benchmark scene for bounces and reordering)
 #pragma once
 
 #include <cstddef>
@@ -25,10 +27,5 @@ Scene make_builtin_scene(std::string_view source);
 
 // Parses a count such as "8M", "250k" or "1000"; throws SceneError naming `what`.
 std::size_t parse_triangle_count(std::string_view text, std::string_view what);
-
-// The closed displaced sphere on its own, for composing scenes: about `triangles`
-// triangles (20 n^2 for the nearest n), radius about `radius`, centred at `center`.
-TriangleMesh make_displaced_sphere(std::size_t triangles, const glm::vec3& center, float radius,
-                                   std::uint32_t seed);
 
 }  // namespace wavetrace

@@ -1,10 +1,12 @@
-// Scene loading: files through mesh_io, builtins through builtin_scenes, then subdivision.
+// Scene loading: mesh files through mesh_io, scene files through scene_file, builtins through
+// builtin_scenes, then subdivision.
 #include "scene/scene.hpp"
 
 #include <fmt/format.h>
 
 #include "scene/builtin_scenes.hpp"
 #include "scene/mesh_io.hpp"
+#include "scene/scene_file.hpp"
 #include "scene/subdivide.hpp"
 
 namespace wavetrace {
@@ -16,6 +18,8 @@ Scene load_scene(const SceneRequest& request) {
   Scene scene;
   if (is_builtin_scene(request.source)) {
     scene = make_builtin_scene(request.source);
+  } else if (is_scene_file(request.source)) {
+    scene = load_scene_file(request.source);
   } else {
     LoadedMesh loaded = load_mesh_file(request.source);
     scene.name = request.source;
@@ -31,6 +35,7 @@ Scene load_scene(const SceneRequest& request) {
     const MeshCleanup cleanup = validate_and_clean(scene.mesh, request.source + " (subdivided)");
     scene.cleanup.degenerate_dropped += cleanup.degenerate_dropped;
     scene.subdivision_levels = static_cast<std::size_t>(request.subdivide);
+    scene.enclosure.reset();  // Loop subdivision pulls the walls inward
   }
   return scene;
 }

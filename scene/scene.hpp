@@ -26,17 +26,21 @@ struct Scene {
   std::vector<Material> materials;
   glm::vec3 background{0.0f};    // radiance of every ray that leaves the scene
   std::optional<Camera> camera;  // the scene author's view, if any
+  // A box whose every inside point is enclosed by a closed shell of the scene's triangles
+  // (builtin:room's walls): rays from it can never escape, whatever else the scene holds.
+  std::optional<Bounds3> enclosure;
   MeshCleanup cleanup;
   std::size_t subdivision_levels = 0;
   std::size_t non_manifold_faces_dropped = 0;
 };
 
 struct SceneRequest {
-  std::string source = "builtin:default";  // a mesh file or builtin:NAME[:TRIANGLES]
+  std::string source = "builtin:default";  // a mesh file, a scene file (.toml) or builtin:NAME[:TRIANGLES]
   int subdivide = 0;                       // Loop subdivision levels applied after loading
 };
 
-// Loads a file or generates a builtin, subdivides, validates; throws SceneError.
+// Loads a mesh or scene file or generates a builtin, subdivides, validates; throws
+// SceneError. Subdivision moves the walls of an enclosure, so it drops the enclosure.
 Scene load_scene(const SceneRequest& request);
 
 }  // namespace wavetrace

@@ -1,19 +1,20 @@
 // Loop subdivision through OpenMesh's uniform LoopT subdivider.
 #include "scene/subdivide.hpp"
 
+#include <limits>
+#include <set>
+
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 #include <OpenMesh/Tools/Subdivider/Uniform/LoopT.hh>
 
 namespace wavetrace {
+namespace {
 
-SubdivisionResult loop_subdivide(const TriangleMesh& mesh, int levels) {
+// One surface, its materials ignored.
+SubdivisionResult subdivide_surface(const TriangleMesh& mesh, int levels) {
   using OpenMeshTriangles = OpenMesh::TriMesh_ArrayKernelT<>;
   SubdivisionResult result;
-  if (levels <= 0) {
-    result.mesh = mesh;
-    return result;
-  }
   OpenMeshTriangles kernel;
   kernel.reserve(mesh.vertex_count(), mesh.triangle_count() * 3 / 2, mesh.triangle_count());
   std::vector<OpenMeshTriangles::VertexHandle> handles;
@@ -51,9 +52,52 @@ SubdivisionResult loop_subdivide(const TriangleMesh& mesh, int levels) {
     for (const auto vertex : kernel.fv_range(face)) triangle[corner++] = static_cast<std::uint32_t>(vertex.idx());
     result.mesh.triangles.push_back(triangle);
   }
-  if (!mesh.material_of_triangle.empty()) {
-    result.mesh.material_of_triangle.assign(result.mesh.triangles.size(), mesh.material_of_triangle.front());
+  return result;
+}
+
+// The triangles of one material, with only the vertices they use.
+TriangleMesh triangles_of_material(const TriangleMesh& mesh, std::uint32_t material) {
+  TriangleMesh part;
+  std::vector<std::uint32_t> new_index(mesh.vertex_count(), std::numeric_limits<std::uint32_t>::max());
+  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+    if (mesh.material(t) != material) continue;
+    glm::uvec3 triangle;
+    for (int corner = 0; corner < 3; ++corner) {
+      std::uint32_t& index = new_index[mesh.triangles[t][corner]];
+      if (index == std::numeric_limits<std::uint32_t>::max()) {
+        index = static_cast<std::uint32_t>(part.positions.size());
+        part.positions.push_back(mesh.positions[mesh.triangles[t][corner]]);
+      }
+      triangle[corner] = index;
+    }
+    part.triangles.push_back(triangle);
   }
+  return part;
+}
+
+}  // namespace
+
+SubdivisionResult loop_subdivide(const TriangleMesh& mesh, int levels) {
+  if (levels <= 0) return SubdivisionResult{mesh, 0};
+  const std::set<std::uint32_t> materials(mesh.material_of_triangle.begin(), mesh.material_of_triangle.end());
+  if (materials.size() <= 1) {
+    SubdivisionResult result = subdivide_surface(mesh, levels);
+    if (!materials.empty()) result.mesh.material_of_triangle.assign(result.mesh.triangle_count(), *materials.begin());
+    return result;
+  }
+  // Material boundaries become open boundaries, which Loop's boundary rules subdivide from
+  // the boundary curve alone, so both sides of a seam between two materials still meet.
+  // Where three or more materials meet at a vertex the curves differ and a crack may open.
+  SubdivisionResult result;
+  for (std::uint32_t material : materials) {
+    SubdivisionResult part = subdivide_surface(triangles_of_material(mesh, material), levels);
+    result.non_manifold_faces_dropped += part.non_manifold_faces_dropped;
+    const auto offset = static_cast<std::uint32_t>(result.mesh.positions.size());
+    result.mesh.positions.insert(result.mesh.positions.end(), part.mesh.positions.begin(), part.mesh.positions.end());
+    for (const glm::uvec3& triangle : part.mesh.triangles) result.mesh.triangles.push_back(triangle + offset);
+    result.mesh.material_of_triangle.resize(result.mesh.triangle_count(), material);
+  }
+  result.mesh.positions.reserve(result.mesh.positions.size() + 1);
   return result;
 }
 

@@ -11,7 +11,8 @@ struct SubdivisionResult {
 };
 
 // Applies `levels` rounds of Loop subdivision (each multiplies the triangle count by 4).
-// Material indices do not survive subdivision: the result uses the first triangle's material.
+// Each triangle's material carries over to the triangles it becomes: the triangles of each
+// material are subdivided as one surface.
 SubdivisionResult loop_subdivide(const TriangleMesh& mesh, int levels);
 
 }  // namespace wavetrace

@@ -14,12 +14,12 @@ const std::vector<ConfigKey>& config_schema() {
   using T = ConfigType;
   static const std::vector<ConfigKey> schema = {
       {"scene.source", T::text, std::string("builtin:default"), 0, 0, {},
-       "mesh file (.off .ply .obj .stl) or builtin:NAME[:TRIANGLES]"},
+       "mesh file (.off .ply .obj .stl), scene file (.toml) or builtin:NAME[:TRIANGLES]"},
       {"scene.subdivide", T::integer, std::int64_t{0}, 0, 6, {}, "levels of Loop subdivision after loading"},
 
       {"camera.position", T::vector3, std::nullopt, 0, 0, {}, "eye point (default: the scene's or framed)"},
       {"camera.look_at", T::vector3, std::nullopt, 0, 0, {}, "point looked at"},
-      {"camera.up", T::vector3, glm::vec3(0.0f, 1.0f, 0.0f), 0, 0, {}, "up direction"},
+      {"camera.up", T::vector3, std::nullopt, 0, 0, {}, "up direction (default: the scene's, or +y)"},
       {"camera.fov", T::real, std::nullopt, 1, 179, {}, "vertical field of view in degrees"},
 
       {"render.width", T::integer, std::int64_t{640}, 1, 16384, {}, "image width in pixels"},

@@ -60,7 +60,7 @@ RenderPlan plan_render(const Config& config) {
   plan.scene.subdivide = static_cast<int>(config.integer("scene.subdivide"));
   if (config.has("camera.position")) plan.camera.position = config.vector3("camera.position");
   if (config.has("camera.look_at")) plan.camera.look_at = config.vector3("camera.look_at");
-  plan.camera.up = config.vector3("camera.up");
+  if (config.has("camera.up")) plan.camera.up = config.vector3("camera.up");
   if (config.has("camera.fov")) plan.camera.vertical_fov_degrees = static_cast<float>(config.real("camera.fov"));
 
   plan.image.width = static_cast<std::uint32_t>(config.integer("render.width"));
@@ -87,7 +87,7 @@ Camera resolve_camera(const CameraOverride& override, const Scene& scene) {
   Camera camera = scene.camera.value_or(frame_bounds(scene.mesh.bounds()));
   if (override.position) camera.position = *override.position;
   if (override.look_at) camera.look_at = *override.look_at;
-  camera.up = override.up;
+  if (override.up) camera.up = *override.up;
   if (override.vertical_fov_degrees) camera.vertical_fov_degrees = *override.vertical_fov_degrees;
   validate_camera(camera);
   return camera;
@@ -96,7 +96,7 @@ Camera resolve_camera(const CameraOverride& override, const Scene& scene) {
 StageChain::StageChain(const std::vector<std::string>& names, const World& world, Film& film, const PathRules& rules) {
   for (const std::string& name : names) {
     if (name == "generate") continue;
-    if (name == "trace") owned_.push_back(std::make_unique<TraceStage>(world.accelerator));
+    if (name == "trace") owned_.push_back(std::make_unique<TraceStage>(world.accelerator, &hit_rates_));
     if (name == "shade") owned_.push_back(std::make_unique<ShadeStage>(world, film, rules));
     if (name == "spawn") {
       owned_.push_back(std::make_unique<SpawnStage>(world, rules));
@@ -121,6 +121,7 @@ RenderOutput render_image(const RenderPlan& plan, const World& world, const Came
   output.run = pipeline.run(on_progress);
   output.image = film.resolve(plan.image.samples_per_pixel);
   output.rejected_contributions = film.rejected_contributions();
+  output.hit_rates = chain.hit_rates().snapshot();
   return output;
 }
 

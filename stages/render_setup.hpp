@@ -13,6 +13,7 @@
 #include "stages/config.hpp"
 #include "stages/film.hpp"
 #include "stages/generate.hpp"
+#include "stages/hit_rates.hpp"
 #include "stages/path_rules.hpp"
 #include "stages/pipeline.hpp"
 #include "stages/world.hpp"
@@ -20,8 +21,7 @@
 namespace wavetrace {
 
 struct CameraOverride {
-  std::optional<glm::vec3> position, look_at;
-  glm::vec3 up{0.0f, 1.0f, 0.0f};
+  std::optional<glm::vec3> position, look_at, up;
   std::optional<float> vertical_fov_degrees;
 };
 
@@ -51,15 +51,18 @@ class StageChain {
   StageChain(const std::vector<std::string>& names, const World& world, Film& film, const PathRules& rules);
   std::vector<const Stage*> stages() const;
   bool loops() const { return loops_; }
+  const HitRateCounters& hit_rates() const { return hit_rates_; }
 
  private:
   std::vector<std::unique_ptr<Stage>> owned_;
+  HitRateCounters hit_rates_;
   bool loops_ = false;
 };
 
 struct RenderOutput {
   PipelineRun run;
   std::vector<float> image;  // linear RGB, top row first
+  std::vector<DepthHitRate> hit_rates;  // closest-hit rays per path depth
   std::uint64_t rejected_contributions = 0;
 };
 

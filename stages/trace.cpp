@@ -15,6 +15,7 @@ void TraceStage::process(Batch* batch, StageOutput& out) const {
       accelerator_.intersect_any(rays, batch->hits, {begin, end});
     } else {
       accelerator_.intersect_closest(rays, batch->hits, {begin, end});
+      if (hit_rates_ != nullptr) hit_rates_->record(rays, batch->hits, {begin, end});
     }
     begin = end;
   }

@@ -2,18 +2,22 @@
 #pragma once
 
 #include "accel/accelerator.hpp"
+#include "stages/hit_rates.hpp"
 #include "stages/stage.hpp"
 
 namespace wavetrace {
 
 class TraceStage final : public Stage {
  public:
-  explicit TraceStage(const Accelerator& accelerator) : accelerator_(accelerator) {}
+  // `hit_rates`, if given, counts hits per depth of the closest-hit rays.
+  explicit TraceStage(const Accelerator& accelerator, HitRateCounters* hit_rates = nullptr)
+      : accelerator_(accelerator), hit_rates_(hit_rates) {}
   std::string name() const override { return "trace"; }
   void process(Batch* batch, StageOutput& out) const override;
 
  private:
   const Accelerator& accelerator_;
+  HitRateCounters* hit_rates_;
 };
 
 }  // namespace wavetrace

@@ -1,0 +1,221 @@
+// Scene files and multi-object scenes: transforms, material indices, errors that name the
+// object, and a scene of several real meshes that renders.
+#include <gtest/gtest.h>
+
+#include <glm/geometric.hpp>
+
+#include "accel/registry.hpp"
+#include "scene/builtin_scenes.hpp"
+#include "scene/lights.hpp"
+#include "scene/object_transform.hpp"
+#include "scene/scene_file.hpp"
+#include "scene/subdivide.hpp"
+#include "stages/render_setup.hpp"
+#include "test_support.hpp"
+
+namespace wavetrace {
+namespace {
+
+using testing::write_temp_file;
+
+// A right-angled tetrahedron with outward faces: corners at the origin and on the axes.
+const char* kTetrahedronOff = "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+
+double signed_volume(const TriangleMesh& mesh) {
+  double volume = 0.0;
+  for (const glm::uvec3& t : mesh.triangles) {
+    volume += glm::dot(glm::dvec3(mesh.positions[t.x]),
+                       glm::cross(glm::dvec3(mesh.positions[t.y]), glm::dvec3(mesh.positions[t.z]))) / 6.0;
+  }
+  return volume;
+}
+
+std::string scene_file(const std::string& name, const std::string& body) {
+  write_temp_file("tetrahedron.off", kTetrahedronOff);
+  return write_temp_file(name, body);
+}
+
+void expect_near(const glm::vec3& actual, const glm::vec3& expected) {
+  EXPECT_NEAR(actual.x, expected.x, 1e-5f);
+  EXPECT_NEAR(actual.y, expected.y, 1e-5f);
+  EXPECT_NEAR(actual.z, expected.z, 1e-5f);
+}
+
+TEST(SceneFile, ScaleRotateTranslateInThatOrder) {
+  const Scene scene = load_scene_file(scene_file("transform.toml", R"(
+[[object]]
+mesh = "tetrahedron.off"
+scale = [2, 3, 4]
+rotate = [0, 90, 0]
+translate = [10, 20, 30]
+)"));
+  ASSERT_EQ(scene.mesh.vertex_count(), 4u);
+  // x-axis corner: scaled to (2,0,0), turned 90 degrees about y to (0,0,-2), then moved.
+  expect_near(scene.mesh.positions[0], glm::vec3(10, 20, 30));
+  expect_near(scene.mesh.positions[1], glm::vec3(10, 20, 28));
+  expect_near(scene.mesh.positions[2], glm::vec3(10, 23, 30));
+  expect_near(scene.mesh.positions[3], glm::vec3(14, 20, 30));
+  EXPECT_NEAR(signed_volume(scene.mesh), 24.0 / 6.0, 1e-4);  // outward, 2*3*4 times 1/6
+}
+
+TEST(SceneFile, RotationsComposeAboutXThenYThenZ) {
+  TriangleMesh mesh;
+  mesh.positions = {glm::vec3(0, 1, 0)};
+  ObjectTransform transform;
+  transform.rotate_degrees = glm::vec3(90, 0, 90);  // y -> z about x, then z stays under z
+  apply_transform(mesh, transform, "test");
+  expect_near(mesh.positions[0], glm::vec3(0, 0, 1));
+  mesh.positions = {glm::vec3(1, 0, 0)};
+  apply_transform(mesh, transform, "test");  // x stays under x, then x -> y about z
+  expect_near(mesh.positions[0], glm::vec3(0, 1, 0));
+}
+
+TEST(SceneFile, MirroringKeepsFacesOutward) {
+  const Scene scene = load_scene_file(scene_file("mirror.toml", R"(
+[[object]]
+mesh = "tetrahedron.off"
+scale = [-1, 1, 1]
+)"));
+  EXPECT_NEAR(signed_volume(scene.mesh), 1.0 / 6.0, 1e-6);
+}
+
+TEST(SceneFile, FitCentresAndScalesTheLargestExtent) {
+  const Scene scene = load_scene_file(scene_file("fit.toml", R"(
+[[object]]
+mesh = "tetrahedron.off"
+fit = 5
+translate = [0, 1, 0]
+)"));
+  const Bounds3 bounds = scene.mesh.bounds();
+  expect_near(bounds.extent(), glm::vec3(5.0f));
+  expect_near(bounds.center(), glm::vec3(0, 1, 0));
+}
+
+TEST(SceneFile, MaterialIndicesFollowObjectsAndBuiltinsKeepTheirOwn) {
+  const Scene scene = load_scene_file(scene_file("materials.toml", R"(
+background = 0.5
+[[object]]
+name = "red"
+mesh = "tetrahedron.off"
+albedo = [0.9, 0.1, 0.1]
+[[object]]
+name = "default scene"
+mesh = "builtin:default:80"
+translate = [5, 0, 0]
+[[light]]
+corner = [0, 4, 0]
+edge_u = [1, 0, 0]
+edge_v = [0, 0, 1]
+emission = 7
+)"));
+  const Scene builtin = make_builtin_scene("builtin:default:80");
+  ASSERT_EQ(scene.mesh.triangle_count(), 4 + builtin.mesh.triangle_count() + 2);
+  ASSERT_EQ(scene.materials.size(), 1 + builtin.materials.size() + 1);
+  for (std::size_t t = 0; t < 4; ++t) EXPECT_EQ(scene.mesh.material(t), 0u);
+  for (std::size_t t = 0; t < builtin.mesh.triangle_count(); ++t) {
+    ASSERT_EQ(scene.mesh.material(4 + t), 1 + builtin.mesh.material(t));
+  }
+  EXPECT_EQ(scene.mesh.material(scene.mesh.triangle_count() - 1), scene.materials.size() - 1);
+  EXPECT_EQ(scene.materials[0].albedo, glm::vec3(0.9f, 0.1f, 0.1f));
+  EXPECT_EQ(scene.materials.back().emission, glm::vec3(7.0f));
+  EXPECT_EQ(scene.background, glm::vec3(0.5f));
+  // Both the builtin's ceiling light and the file's light are emitters.
+  EXPECT_EQ(LightSampler(scene).count(), 4u);
+  // Facing down: the quad's normal is cross(edge_u, edge_v) = -y.
+  const glm::uvec3 light = scene.mesh.triangles.back();
+  const glm::vec3 normal = glm::cross(scene.mesh.positions[light.y] - scene.mesh.positions[light.x],
+                                      scene.mesh.positions[light.z] - scene.mesh.positions[light.x]);
+  EXPECT_LT(normal.y, 0.0f);
+}
+
+TEST(SceneFile, CameraComesFromTheFile) {
+  const Scene scene = load_scene_file(scene_file("camera.toml", R"(
+[camera]
+position = [1, 2, 3]
+look_at = [0, 0, 0]
+up = [0, 0, 1]
+fov = 30
+[[object]]
+mesh = "tetrahedron.off"
+)"));
+  ASSERT_TRUE(scene.camera.has_value());
+  EXPECT_EQ(scene.camera->position, glm::vec3(1, 2, 3));
+  EXPECT_EQ(scene.camera->up, glm::vec3(0, 0, 1));
+  EXPECT_EQ(scene.camera->vertical_fov_degrees, 30.0f);
+  const Camera resolved = resolve_camera(CameraOverride{}, scene);
+  EXPECT_EQ(resolved.up, glm::vec3(0, 0, 1));  // the config's default does not override it
+}
+
+struct BadScene {
+  std::string body;
+  std::string message;
+};
+
+class SceneFileErrors : public ::testing::TestWithParam<BadScene> {};
+
+TEST_P(SceneFileErrors, NameTheObjectAndTheProblem) {
+  const std::string path = scene_file("bad.toml", GetParam().body);
+  try {
+    load_scene_file(path);
+    FAIL() << "no error for:\n" << GetParam().body;
+  } catch (const SceneError& error) {
+    EXPECT_NE(std::string(error.what()).find(GetParam().message), std::string::npos) << error.what();
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, SceneFileErrors,
+    ::testing::Values(
+        BadScene{"[[object]]\nname = \"cat\"\nmesh = \"tetrahedron.off\"\ncolour = 1\n",
+                 "object 'cat' (#1): unknown key 'colour'"},
+        BadScene{"[[object]]\nmesh = \"tetrahedron.off\"\n[[object]]\nname = \"ghost\"\nmesh = \"missing.off\"\n",
+                 "object 'ghost' (#2): "},
+        BadScene{"[[object]]\nmesh = \"tetrahedron.off\"\nscale = [1, 0, 1]\n", "object #1: scale (1, 0, 1) is degenerate"},
+        BadScene{"[[object]]\nmesh = \"tetrahedron.off\"\nscale = [1, nan, 1]\n", "scale must be"},
+        BadScene{"[[object]]\nmesh = \"tetrahedron.off\"\nfit = -2\n", "fit = -2 must be a positive size"},
+        BadScene{"[[object]]\nmesh = \"tetrahedron.off\"\nrotate = [1, 2]\n", "rotate must be [x, y, z]"},
+        BadScene{"[[object]]\nmesh = \"tetrahedron.off\"\nalbedo = 1.5\n", "albedo components must be in [0, 1]"},
+        BadScene{"[[object]]\nmesh = \"tetrahedron.off\"\nsubdivide = 9\n", "subdivide must be an integer in [0, 6]"},
+        BadScene{"[[object]]\nname = \"nameless\"\n", "object 'nameless' (#1): 'mesh' is required"},
+        BadScene{"[[object]]\nmesh = \"other.toml\"\n", "a scene file cannot hold another scene file"},
+        BadScene{"[[object]]\nmesh = \"builtin:teapot\"\n", "unknown builtin scene 'teapot'"},
+        BadScene{"[[light]]\ncorner = [0, 0, 0]\nedge_u = [1, 0, 0]\nedge_v = [2, 0, 0]\nemission = 1\n",
+                 "light #1: edge_u and edge_v span no area"},
+        BadScene{"[[light]]\ncorner = [0, 0, 0]\nedge_u = [1, 0, 0]\n", "light #1: 'edge_v' is required"},
+        BadScene{"lights = 3\n", "unknown key 'lights'"}, BadScene{"background = 1\n", "the scene has no [[object]]"},
+        BadScene{"[camera]\nposition = [0, 0, 0]\nlook_at = [0, 0, 0]\n[[object]]\nmesh = \"tetrahedron.off\"\n",
+                 "camera: "},
+        BadScene{"[[object]\nmesh = 1\n", "bad.toml:1:"}),
+    [](const ::testing::TestParamInfo<BadScene>& info) { return "case" + std::to_string(info.index); });
+
+TEST(SceneFile, MissingFileIsAnError) {
+  EXPECT_THROW(load_scene({"/nonexistent/scene.toml", 0}), SceneError);
+}
+
+TEST(SceneFile, SubdivisionKeepsEachTrianglesMaterial) {
+  const Scene scene = load_scene({"builtin:default:80", 1});
+  ASSERT_EQ(scene.mesh.material_of_triangle.size(), scene.mesh.triangle_count());
+  EXPECT_EQ(LightSampler(scene).count(), 2u * 4);  // the ceiling quad, subdivided once
+}
+
+TEST(SceneFile, GalleryOfRealMeshesRenders) {
+  const Scene scene = load_scene({std::string(WAVETRACE_SOURCE_DIR) + "/scenes/gallery.toml", 0});
+  EXPECT_GT(scene.mesh.triangle_count(), 200000u);
+  EXPECT_GE(scene.materials.size(), 5u);
+  Config config;
+  config.set("render.width=40");
+  config.set("render.height=30");
+  config.set("render.spp=2");
+  const RenderPlan plan = plan_render(config);
+  const auto accelerator = make_accelerator(scene.mesh, plan.accelerator);
+  const LightSampler lights(scene);
+  const RenderOutput output = render_image(plan, World{scene, *accelerator, lights}, resolve_camera(plan.camera, scene));
+  ASSERT_FALSE(output.hit_rates.empty());
+  EXPECT_GT(output.hit_rates[0].rate(), 0.3);  // the camera sees the meshes and the plinth
+  double sum = 0.0;
+  for (float value : output.image) sum += value;
+  EXPECT_GT(sum / double(output.image.size()), 0.01);
+}
+
+}  // namespace
+}  // namespace wavetrace
