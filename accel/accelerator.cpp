@@ -1,2 +1,16 @@
-// Out-of-line anchor for the accelerator interface's vtable.
+// The accelerator interface's vtable anchor and the defaults of its probed queries.
 #include "accel/accelerator.hpp"
+
+#include <stdexcept>
+
+namespace wavetrace {
+
+void Accelerator::intersect_closest_probed(const RayBatch&, HitBatch&, RayRange, RecordingProbe&) const {
+  throw std::logic_error("accelerator '" + name() + "' cannot report its memory reads");
+}
+
+void Accelerator::intersect_any_probed(const RayBatch&, HitBatch&, RayRange, RecordingProbe&) const {
+  throw std::logic_error("accelerator '" + name() + "' cannot report its memory reads");
+}
+
+}  // namespace wavetrace

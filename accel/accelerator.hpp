@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "memory/memory_probe.hpp"
 #include "memory/ray_batch.hpp"
 
 namespace wavetrace {
@@ -39,6 +40,15 @@ class Accelerator {
   // For each ray in range: whether anything lies in [tmin, tmax]; an occluded ray gets a
   // valid primitive (any one it found), a free ray kInvalidPrimitive.
   virtual void intersect_any(const RayBatch& rays, HitBatch& hits, RayRange range) const = 0;
+
+  // The same queries with every memory read reported to `probe`, for the pager and the
+  // cache simulator. Only accelerators whose traversal is ours can do this (probed() is
+  // true); the defaults throw std::logic_error. Embree's traversal cannot be observed.
+  virtual bool probed() const { return false; }
+  virtual void intersect_closest_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
+                                        RecordingProbe& probe) const;
+  virtual void intersect_any_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
+                                    RecordingProbe& probe) const;
 
   virtual MemoryReport memory() const = 0;
   virtual BuildReport build() const = 0;

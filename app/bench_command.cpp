@@ -22,6 +22,7 @@ struct BenchArguments {
   int threads = 0;
   int repeat = 3;
   std::string json;
+  std::string budgets;
   std::vector<std::string> assignments;
 };
 
@@ -72,6 +73,15 @@ int run_accel(const BenchArguments& args) {
   request.count = args.count;
   request.threads = args.threads;
   request.repeats = args.repeat;
+  request.memory = plan_memory(setup.config);
+  request.budgets = split_commas(args.budgets);
+  for (const std::string& budget : request.budgets) {
+    try {
+      parse_memory_budget(budget);
+    } catch (const std::invalid_argument& error) {
+      throw ConfigError(fmt::format("--budgets: {}", error.what()));
+    }
+  }
   if (args.repeat < 1) throw ConfigError("--repeat must be at least 1");
   const AccelBenchReport report = run_accel_bench(setup.scene, request);
   fmt::print("{}", to_table(report));
@@ -115,6 +125,8 @@ void add_bench_command(CLI::App& app, int& exit_code) {
   accel->add_option("--repeat", accel_args->repeat, "timed runs per accelerator (the median is reported)");
   accel->add_option("--reference", accel_args->reference,
                     "accelerator the accuracy is measured against (default embree; embree:mode=robust is watertight)");
+  accel->add_option("--budgets", accel_args->budgets,
+                    "simulated page pool budgets, one probed pass each, e.g. 100%,50%,20%,10% (see [memory])");
   accel->callback([accel_args, &exit_code] { exit_code = run_accel(*accel_args); });
 
   auto leak_args = std::make_shared<BenchArguments>();

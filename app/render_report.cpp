@@ -10,17 +10,63 @@ nlohmann::json bounds_json(const Bounds3& bounds) {
           {"max", {bounds.upper.x, bounds.upper.y, bounds.upper.z}}};
 }
 
+nlohmann::json pager_json(const PagerStats& pager) {
+  return {{"page_bytes", pager.page_bytes},
+          {"budget_bytes", pager.budget_bytes},
+          {"accesses", pager.counters.accesses},
+          {"faults", pager.counters.faults},
+          {"bytes_loaded", pager.counters.bytes_loaded},
+          {"simulated_io_seconds", pager.counters.simulated_io_seconds}};
+}
+
+nlohmann::json cache_json(const CacheStats& cache) {
+  return {{"preset", cache.geometry.name},
+          {"line_bytes", cache.geometry.line_bytes},
+          {"capacity_bytes", cache.geometry.capacity_bytes},
+          {"ways", cache.geometry.ways},
+          {"accesses", cache.counters.accesses},
+          {"misses", cache.counters.misses}};
+}
+
+std::string memory_lines(const std::vector<StageStats>& stages) {
+  std::string lines;
+  for (const StageStats& stage : stages) {
+    const double rays = double(std::max<std::uint64_t>(stage.rays_in, 1));
+    if (stage.pager) {
+      const PagerCounters& c = stage.pager->counters;
+      lines += fmt::format("{} pager: {:.1f} MiB pages, budget {:.1f} MiB: {} reads, {} faults, {:.1f} MB loaded, "
+                           "{:.3f} s simulated I/O (not in the measured time)\n",
+                           stage.name, double(stage.pager->page_bytes) / (1 << 20),
+                           double(stage.pager->budget_bytes) / (1 << 20), c.accesses, c.faults,
+                           double(c.bytes_loaded) * 1e-6, c.simulated_io_seconds);
+    }
+    if (stage.cache) {
+      const CacheGeometry& g = stage.cache->geometry;
+      const CacheCounters& c = stage.cache->counters;
+      lines += fmt::format("{} cache {} ({} KiB, {}-way, {} B lines, one per thread): {} line reads, {} misses "
+                           "({:.2f}%), {:.2f} misses per ray\n",
+                           stage.name, g.name, g.capacity_bytes >> 10, g.ways, g.line_bytes, c.accesses, c.misses,
+                           100.0 * double(c.misses) / double(std::max<std::uint64_t>(c.accesses, 1)),
+                           double(c.misses) / rays);
+    }
+  }
+  return lines;
+}
+
 nlohmann::json render_stats_json(const RenderFacts& facts) {
   const MemoryReport memory = facts.accelerator.memory();
   const BuildReport build = facts.accelerator.build();
   const double triangles = double(facts.scene.mesh.triangle_count());
   nlohmann::json stages = nlohmann::json::array();
   for (const StageStats& stage : facts.output.run.stages) {
-    stages.push_back({{"name", stage.name},
-                      {"rays_in", stage.rays_in},
-                      {"rays_out", stage.rays_out},
-                      {"seconds", stage.seconds},
-                      {"mrays_per_s", stage.mrays_per_s()}});
+    nlohmann::json entry = {{"name", stage.name},
+                            {"rays_in", stage.rays_in},
+                            {"rays_out", stage.rays_out},
+                            {"seconds", stage.seconds},
+                            {"mrays_per_s", stage.mrays_per_s()}};
+    if (stage.pager) entry["pager"] = pager_json(*stage.pager);
+    if (stage.cache) entry["cache"] = cache_json(*stage.cache);
+    stages.push_back(entry);
   }
   nlohmann::json hit_rates = nlohmann::json::array();
   for (const DepthHitRate& rate : facts.output.hit_rates) {
@@ -78,6 +124,8 @@ std::string render_table(const RenderFacts& facts) {
                        double(memory.total()) / double(facts.scene.mesh.triangle_count()),
                        double(memory.hierarchy) / double(facts.scene.mesh.triangle_count()),
                        double(memory.geometry) / double(facts.scene.mesh.triangle_count()), build.seconds);
+  table += memory_lines(run.stages);
+  if (facts.output.memory_unobserved) table += "memory: " + *facts.output.memory_unobserved + "\n";
   if (facts.output.rejected_contributions > 0) {
     table += fmt::format("warning: {} non-finite film contributions were dropped\n", facts.output.rejected_contributions);
   }

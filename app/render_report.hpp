@@ -23,5 +23,7 @@ nlohmann::json render_stats_json(const RenderFacts& facts);
 std::string render_table(const RenderFacts& facts);
 
 nlohmann::json bounds_json(const Bounds3& bounds);
+nlohmann::json pager_json(const PagerStats& pager);
+nlohmann::json cache_json(const CacheStats& cache);
 
 }  // namespace wavetrace

@@ -63,6 +63,33 @@ AcceleratorSpec parse_accelerator_spec(const std::string& text, const Config& ba
   return {text, accelerator_options(config)};
 }
 
+// A probed pass per budget (or one cache-only pass), each with a fresh pool and caches.
+std::vector<MemoryRun> memory_runs(const Accelerator& accelerator, const RaySet& rays, const AccelBenchRequest& request,
+                                   int threads) {
+  std::vector<std::string> budgets = request.budgets;
+  if (budgets.empty()) budgets.push_back(request.memory.budget ? std::string("config") : std::string());
+  std::vector<MemoryRun> runs;
+  for (const std::string& label : budgets) {
+    MemoryPlan plan = request.memory;
+    if (!label.empty() && label != "config") plan.budget = parse_memory_budget(label);
+    MemoryObservation observation(plan, accelerator.memory_spans(), threads);
+    const auto start = std::chrono::steady_clock::now();
+    trace_ray_set_probed(accelerator, rays, observation.observers());
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::vector<StageStats> stages(1);
+    stages[0].name = "trace";
+    observation.report(stages);
+    MemoryRun run;
+    run.budget = label;
+    for (const auto& span : accelerator.memory_spans()) run.world_bytes += span.size();
+    run.pager = stages[0].pager;
+    run.cache = stages[0].cache;
+    run.instrumented_mrays_per_s = double(rays.count()) / seconds * 1e-6;
+    runs.push_back(std::move(run));
+  }
+  return runs;
+}
+
 AccelBenchReport run_accel_bench(const Scene& scene, const AccelBenchRequest& request) {
   TracingArena arena(request.threads);
   AccelBenchReport report;
@@ -72,6 +99,7 @@ AccelBenchReport run_accel_bench(const Scene& scene, const AccelBenchRequest& re
   report.reference = request.reference.label;
   report.threads = arena.threads();
   report.repeats = request.repeats;
+  report.memory_observed = request.memory.enabled() || !request.budgets.empty();
   const float diagonal = scene.mesh.bounds().diagonal();
 
   arena.execute([&] {
@@ -101,10 +129,39 @@ AccelBenchReport run_accel_bench(const Scene& scene, const AccelBenchRequest& re
       }
       result.mrays_per_s = median(result.mrays_per_s_runs);
       compare(rays, hits, reference_hits, diagonal, result);
+      result.probed = accelerator->probed();
+      if (report.memory_observed && result.probed) {
+        result.memory_runs = memory_runs(*accelerator, rays, request, report.threads);
+      }
       report.results.push_back(std::move(result));
     }
   });
   return report;
+}
+
+// Absent (null) where the accelerator cannot be observed or nothing was asked: never zeros.
+nlohmann::json memory_runs_json(const AccelBenchReport& report, const AccelBenchResult& r) {
+  if (!report.memory_observed || !r.probed) return nullptr;
+  nlohmann::json runs = nlohmann::json::array();
+  for (const MemoryRun& run : r.memory_runs) {
+    nlohmann::json entry = {{"budget", run.budget},
+                            {"world_bytes", run.world_bytes},
+                            {"instrumented_mrays_per_s", run.instrumented_mrays_per_s}};
+    if (run.pager) entry["pager"] = {{"page_bytes", run.pager->page_bytes},
+                                     {"budget_bytes", run.pager->budget_bytes},
+                                     {"accesses", run.pager->counters.accesses},
+                                     {"faults", run.pager->counters.faults},
+                                     {"bytes_loaded", run.pager->counters.bytes_loaded},
+                                     {"simulated_io_seconds", run.pager->counters.simulated_io_seconds}};
+    if (run.cache) entry["cache"] = {{"preset", run.cache->geometry.name},
+                                     {"line_bytes", run.cache->geometry.line_bytes},
+                                     {"capacity_bytes", run.cache->geometry.capacity_bytes},
+                                     {"ways", run.cache->geometry.ways},
+                                     {"accesses", run.cache->counters.accesses},
+                                     {"misses", run.cache->counters.misses}};
+    runs.push_back(entry);
+  }
+  return runs;
 }
 
 nlohmann::json to_json(const AccelBenchReport& report) {
@@ -124,7 +181,8 @@ nlohmann::json to_json(const AccelBenchReport& report) {
                        {"hit_agreement", r.hit_agreement},
                        {"prim_agreement", optional(r.prim_agreement)},
                        {"t_error_max", optional(r.t_error_max)},
-                       {"t_error_mean", optional(r.t_error_mean)}});
+                       {"t_error_mean", optional(r.t_error_mean)},
+                       {"memory_runs", memory_runs_json(report, r)}});
   }
   return {{"scene", {{"source", report.scene}, {"triangles", report.triangles}}},
           {"reference", report.reference},
@@ -149,6 +207,34 @@ std::string to_csv(const AccelBenchReport& report) {
   return csv;
 }
 
+std::string memory_table(const AccelBenchReport& report) {
+  const double rays = double(std::max<std::size_t>(report.ray_count, 1));
+  std::string table = fmt::format("\nsimulated memory (pager and cache counts are exact with 1 thread):\n{:<24} {:>7} {:>9} {:>10} "
+                                  "{:>10} {:>10} {:>11} {:>10} {:>12} {:>11}\n",
+                                  "accel", "budget", "world MB", "budget MB", "faults", "faults/ray", "loaded MB",
+                                  "sim I/O s", "misses/ray", "instr Mr/s");
+  for (const AccelBenchResult& r : report.results) {
+    if (!r.probed) {
+      table += fmt::format("{:<24} cannot be observed: no counters\n", r.label);
+      continue;
+    }
+    for (const MemoryRun& run : r.memory_runs) {
+      const auto& pager = run.pager;
+      table += fmt::format(
+          "{:<24} {:>7} {:>9.1f} {:>10} {:>10} {:>10} {:>11} {:>10} {:>12} {:>11.3f}\n", r.label,
+          run.budget.empty() ? "-" : run.budget, double(run.world_bytes) * 1e-6,
+          pager ? fmt::format("{:.1f}", double(pager->budget_bytes) * 1e-6) : "-",
+          pager ? fmt::format("{}", pager->counters.faults) : "-",
+          pager ? fmt::format("{:.4f}", double(pager->counters.faults) / rays) : "-",
+          pager ? fmt::format("{:.1f}", double(pager->counters.bytes_loaded) * 1e-6) : "-",
+          pager ? fmt::format("{:.2f}", pager->counters.simulated_io_seconds) : "-",
+          run.cache ? fmt::format("{:.3f}", double(run.cache->counters.misses) / rays) : "-",
+          run.instrumented_mrays_per_s);
+    }
+  }
+  return table;
+}
+
 std::string to_table(const AccelBenchReport& report) {
   std::string table = fmt::format(
       "{}: {} triangles; {} {} rays ({:.1f}% hit the reference, {}); {} threads; median of {} runs\n", report.scene,
@@ -168,6 +254,7 @@ std::string to_table(const AccelBenchReport& report) {
                          r.prim_agreement ? fmt::format("{:.4f}%", 100.0 * *r.prim_agreement) : std::string("-"),
                          r.t_error_max ? fmt::format("{:.2e}", *r.t_error_max) : std::string("-"));
   }
+  if (report.memory_observed) table += memory_table(report);
   return table;
 }
 

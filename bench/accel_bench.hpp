@@ -12,6 +12,7 @@
 #include "bench/ray_sets.hpp"
 #include "scene/scene.hpp"
 #include "stages/config.hpp"
+#include "stages/memory_observation.hpp"
 
 namespace wavetrace {
 
@@ -22,6 +23,16 @@ struct AcceleratorSpec {
   AcceleratorOptions options;
 };
 AcceleratorSpec parse_accelerator_spec(const std::string& text, const Config& base);
+
+// One probed pass of the ray set: the pager at one budget and/or the simulated cache, and
+// the trace speed with the probes on (the uninstrumented speed is the result's own).
+struct MemoryRun {
+  std::string budget;          // as given ("20%"), empty without a pager
+  std::size_t world_bytes = 0;
+  std::optional<PagerStats> pager;
+  std::optional<CacheStats> cache;
+  double instrumented_mrays_per_s = 0.0;
+};
 
 struct AccelBenchResult {
   std::string label;
@@ -34,6 +45,8 @@ struct AccelBenchResult {
   std::optional<double> prim_agreement;  // same primitive where both hit (closest-hit sets only)
   std::optional<double> t_error_max;     // |t - t_ref| / scene diagonal where both hit
   std::optional<double> t_error_mean;
+  bool probed = false;                 // false: the accelerator's reads cannot be observed (Embree)
+  std::vector<MemoryRun> memory_runs;  // one per budget, when memory observation was asked for
 };
 
 struct AccelBenchReport {
@@ -45,6 +58,7 @@ struct AccelBenchReport {
   int threads = 0;
   int repeats = 0;
   double reference_hit_rate = 0.0;  // share of rays Embree finds a hit (occluded, for shadow rays)
+  bool memory_observed = false;     // memory runs were asked for
   std::vector<AccelBenchResult> results;
 };
 
@@ -55,6 +69,9 @@ struct AccelBenchRequest {
   std::size_t count = 1 << 20;
   int threads = 0;
   int repeats = 3;
+  // Pager settings and cache; `budgets` (e.g. "100%", "20%") replace memory.budget when given.
+  MemoryPlan memory;
+  std::vector<std::string> budgets;
 };
 
 AccelBenchReport run_accel_bench(const Scene& scene, const AccelBenchRequest& request);

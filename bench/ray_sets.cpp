@@ -7,6 +7,7 @@
 
 #include <glm/geometric.hpp>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include "kernels/random.hpp"
 #include "kernels/ray_offset.hpp"
@@ -176,6 +177,25 @@ std::vector<std::unique_ptr<HitBatch>> trace_ray_set(const Accelerator& accelera
       accelerator.intersect_any(*rays.batches[b], *hits[b], rays.batches[b]->all());
     } else {
       accelerator.intersect_closest(*rays.batches[b], *hits[b], rays.batches[b]->all());
+    }
+  });
+  return hits;
+}
+
+}  // namespace wavetrace
+
+namespace wavetrace {
+
+std::vector<std::unique_ptr<HitBatch>> trace_ray_set_probed(const Accelerator& accelerator, const RaySet& rays,
+                                                            const MemoryObservers& observers) {
+  std::vector<std::unique_ptr<HitBatch>> hits(rays.batches.size());
+  tbb::parallel_for(std::size_t{0}, rays.batches.size(), [&](std::size_t b) {
+    hits[b] = std::make_unique<HitBatch>(rays.batches[b]->capacity());
+    RecordingProbe probe(observers, 0, std::size_t(tbb::this_task_arena::current_thread_index()));
+    if (rays.any_hit()) {
+      accelerator.intersect_any_probed(*rays.batches[b], *hits[b], rays.batches[b]->all(), probe);
+    } else {
+      accelerator.intersect_closest_probed(*rays.batches[b], *hits[b], rays.batches[b]->all(), probe);
     }
   });
   return hits;

@@ -33,5 +33,8 @@ RaySet make_ray_set(RaySetKind kind, const Scene& scene, const Accelerator& refe
 
 // Every ray of the set traced by `accelerator` into one HitBatch per ray batch.
 std::vector<std::unique_ptr<HitBatch>> trace_ray_set(const Accelerator& accelerator, const RaySet& rays);
+// The same with every read reported to `observers` (as client 0); needs accelerator.probed().
+std::vector<std::unique_ptr<HitBatch>> trace_ray_set_probed(const Accelerator& accelerator, const RaySet& rays,
+                                                            const MemoryObservers& observers);
 
 }  // namespace wavetrace

@@ -47,6 +47,19 @@ const std::vector<ConfigKey>& config_schema() {
       {"accel.bvh.bins", T::integer, std::int64_t{16}, 2, 64, {}, "SAH bins per axis"},
       {"accel.bvh.width", T::integer, std::int64_t{2}, 2, 8, {}, "2: binary 32-byte nodes; 8: AVX2 8-wide nodes"},
 
+      {"memory.budget", T::text, std::string("none"), 0, 0, {},
+       "simulated page pool: none, a share of the world (20%) or a size (512MiB, 2GB)"},
+      {"memory.page_bytes", T::integer, std::int64_t{4} << 20, 4096, std::int64_t{1} << 30, {},
+       "page size of the pool in bytes, a power of two (the paper: 4 MiB)"},
+      {"memory.io", T::text, std::string("disk"), 0, 0, {"disk", "nvme"},
+       "simulated device per fault: disk (the paper's, 101 MB/s, 8 ms) or nvme (3.5 GB/s, 80 us)"},
+      {"memory.cache", T::text, std::string("none"), 0, 0, {"none", "paper_l2", "l1d", "l2", "custom"},
+       "simulated cache per thread: paper_l2 (6 MiB, 24-way), l1d (32 KiB, 8-way), l2 (512 KiB, 8-way)"},
+      {"memory.cache_line_bytes", T::integer, std::nullopt, 4, 4096, {}, "cache line bytes (overrides the preset)"},
+      {"memory.cache_bytes", T::integer, std::nullopt, 64, std::int64_t{1} << 34, {},
+       "cache capacity bytes (overrides the preset)"},
+      {"memory.cache_ways", T::integer, std::nullopt, 1, 256, {}, "cache associativity (overrides the preset)"},
+
       {"pipeline.stages", T::text_list, std::vector<std::string>{"generate", "trace", "shade", "spawn"}, 0, 0,
        {"generate", "trace", "shade", "spawn"}, "the stage chain; spawn at the end loops back"},
   };

@@ -4,6 +4,7 @@
 #include <algorithm>
 
 #include <fmt/format.h>
+#include <tbb/info.h>
 
 #include "stages/shade.hpp"
 #include "stages/spawn.hpp"
@@ -75,6 +76,7 @@ RenderPlan plan_render(const Config& config) {
   plan.pipeline.batch_size = static_cast<std::size_t>(config.integer("render.batch_size"));
   plan.pipeline.rays_in_flight = static_cast<std::size_t>(config.integer("render.rays_in_flight"));
   plan.pipeline.threads = static_cast<int>(config.integer("render.threads"));
+  plan.memory = plan_memory(config);
 
   plan.accelerator = accelerator_options(config);
 
@@ -93,10 +95,11 @@ Camera resolve_camera(const CameraOverride& override, const Scene& scene) {
   return camera;
 }
 
-StageChain::StageChain(const std::vector<std::string>& names, const World& world, Film& film, const PathRules& rules) {
+StageChain::StageChain(const std::vector<std::string>& names, const World& world, Film& film, const PathRules& rules,
+                       const MemoryObservers* observers) {
   for (const std::string& name : names) {
     if (name == "generate") continue;
-    if (name == "trace") owned_.push_back(std::make_unique<TraceStage>(world.accelerator, &hit_rates_));
+    if (name == "trace") owned_.push_back(std::make_unique<TraceStage>(world.accelerator, &hit_rates_, observers));
     if (name == "shade") owned_.push_back(std::make_unique<ShadeStage>(world, film, rules));
     if (name == "spawn") {
       owned_.push_back(std::make_unique<SpawnStage>(world, rules));
@@ -115,10 +118,21 @@ RenderOutput render_image(const RenderPlan& plan, const World& world, const Came
                           const std::function<void(const Progress&)>& on_progress) {
   Film film(plan.image.width, plan.image.height);
   GenerateStage generate(camera, plan.image, plan.pixel_order);
-  const StageChain chain(plan.stages, world, film, plan.rules);
-  Pipeline pipeline(generate, chain.stages(), chain.loops(), plan.pipeline);
+  std::optional<MemoryObservation> observation;
   RenderOutput output;
+  if (plan.memory.enabled()) {
+    if (world.accelerator.probed()) {
+      const int threads = plan.pipeline.threads > 0 ? plan.pipeline.threads : tbb::info::default_concurrency();
+      observation.emplace(plan.memory, world.accelerator.memory_spans(), threads);
+    } else {
+      output.memory_unobserved = fmt::format("accelerator '{}' cannot report its memory reads: no pager or cache counters",
+                                             world.accelerator.name());
+    }
+  }
+  const StageChain chain(plan.stages, world, film, plan.rules, observation ? &observation->observers() : nullptr);
+  Pipeline pipeline(generate, chain.stages(), chain.loops(), plan.pipeline);
   output.run = pipeline.run(on_progress);
+  if (observation) observation->report(output.run.stages);
   output.image = film.resolve(plan.image.samples_per_pixel);
   output.rejected_contributions = film.rejected_contributions();
   output.hit_rates = chain.hit_rates().snapshot();

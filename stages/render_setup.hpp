@@ -14,6 +14,7 @@
 #include "stages/film.hpp"
 #include "stages/generate.hpp"
 #include "stages/hit_rates.hpp"
+#include "stages/memory_observation.hpp"
 #include "stages/path_rules.hpp"
 #include "stages/pipeline.hpp"
 #include "stages/world.hpp"
@@ -33,6 +34,7 @@ struct RenderPlan {
   PathRules rules;
   PipelineOptions pipeline;
   AcceleratorOptions accelerator;
+  MemoryPlan memory;
   std::vector<std::string> stages;
 };
 
@@ -48,7 +50,8 @@ Camera resolve_camera(const CameraOverride& override, const Scene& scene);
 // Owns the stage objects a plan names, in chain order (generate excluded).
 class StageChain {
  public:
-  StageChain(const std::vector<std::string>& names, const World& world, Film& film, const PathRules& rules);
+  StageChain(const std::vector<std::string>& names, const World& world, Film& film, const PathRules& rules,
+             const MemoryObservers* observers = nullptr);
   std::vector<const Stage*> stages() const;
   bool loops() const { return loops_; }
   const HitRateCounters& hit_rates() const { return hit_rates_; }
@@ -63,6 +66,8 @@ struct RenderOutput {
   PipelineRun run;
   std::vector<float> image;  // linear RGB, top row first
   std::vector<DepthHitRate> hit_rates;  // closest-hit rays per path depth
+  // Set when [memory] asks for observation but the accelerator's reads cannot be seen.
+  std::optional<std::string> memory_unobserved;
   std::uint64_t rejected_contributions = 0;
 };
 

@@ -4,7 +4,13 @@
 namespace wavetrace {
 
 StageStats StageCounters::snapshot() const {
-  return {name_, rays_in_.load(), rays_out_.load(), batches_.load(), double(nanoseconds_.load()) * 1e-9};
+  StageStats stats;
+  stats.name = name_;
+  stats.rays_in = rays_in_.load();
+  stats.rays_out = rays_out_.load();
+  stats.batches = batches_.load();
+  stats.seconds = double(nanoseconds_.load()) * 1e-9;
+  return stats;
 }
 
 }  // namespace wavetrace

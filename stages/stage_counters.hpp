@@ -3,9 +3,24 @@
 
 #include <atomic>
 #include <cstdint>
+#include <optional>
 #include <string>
 
+#include "memory/cache_simulator.hpp"
+#include "memory/pager.hpp"
+
 namespace wavetrace {
+
+struct PagerStats {
+  std::size_t page_bytes = 0;
+  std::size_t budget_bytes = 0;
+  PagerCounters counters;
+};
+
+struct CacheStats {
+  CacheGeometry geometry;
+  CacheCounters counters;
+};
 
 struct StageStats {
   std::string name;
@@ -15,6 +30,9 @@ struct StageStats {
   double seconds = 0.0;  // thread-seconds spent inside the stage, summed over threads
   // Rays in per busy thread-second: the stage's throughput on one core.
   double mrays_per_s() const { return seconds > 0.0 ? double(rays_in) / seconds * 1e-6 : 0.0; }
+  // Simulated memory traffic of the stage's accelerator reads, when observed.
+  std::optional<PagerStats> pager;
+  std::optional<CacheStats> cache;
 };
 
 class StageCounters {

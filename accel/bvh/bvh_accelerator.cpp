@@ -59,10 +59,21 @@ class BvhAccelerator final : public Accelerator {
   std::string name() const override { return "bvh"; }
 
   void intersect_closest(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
-    traverse<false>(rays, hits, range);
+    NullProbe probe;
+    traverse<false>(rays, hits, range, probe);
   }
   void intersect_any(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
-    traverse<true>(rays, hits, range);
+    NullProbe probe;
+    traverse<true>(rays, hits, range, probe);
+  }
+  bool probed() const override { return true; }
+  void intersect_closest_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
+                                RecordingProbe& probe) const override {
+    traverse<false>(rays, hits, range, probe);
+  }
+  void intersect_any_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
+                            RecordingProbe& probe) const override {
+    traverse<true>(rays, hits, range, probe);
   }
 
   MemoryReport memory() const override {
@@ -80,8 +91,8 @@ class BvhAccelerator final : public Accelerator {
   }
 
  private:
-  template <bool kAnyHit>
-  void traverse(const RayBatch& rays, HitBatch& hits, RayRange range) const {
+  template <bool kAnyHit, typename Probe>
+  void traverse(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
     struct StackEntry {
       std::uint32_t node;
       float distance;
@@ -102,6 +113,7 @@ class BvhAccelerator final : public Accelerator {
 
       std::uint32_t top = 0;
       std::uint32_t node = 0;
+      probe.read(nodes, sizeof(BvhNode));
       if (intersect_box(box_ray, nodes[0].lower, nodes[0].upper, tmin, tmax) == kInfinity) {
         write_miss(hits, i);
         continue;
@@ -109,10 +121,12 @@ class BvhAccelerator final : public Accelerator {
       while (true) {
         const BvhNode& current = nodes[node];
         if (current.leaf()) {
-          query.test_leaf<kAnyHit>(current.first, current.triangle_count());
+          query.test_leaf<kAnyHit>(current.first, current.triangle_count(), probe);
           if (kAnyHit && query.found()) break;
         } else {
           std::uint32_t near = current.left(), far = current.right();
+          probe.read(nodes + near, sizeof(BvhNode));
+          probe.read(nodes + far, sizeof(BvhNode));
           float near_distance = intersect_box(box_ray, nodes[near].lower, nodes[near].upper, tmin, tmax);
           float far_distance = intersect_box(box_ray, nodes[far].lower, nodes[far].upper, tmin, tmax);
           if (far_distance < near_distance) {
@@ -130,7 +144,7 @@ class BvhAccelerator final : public Accelerator {
         if (top == 0) break;
         node = stack[--top].node;
       }
-      query.write(hits, i);
+      query.write(hits, i, probe);
     }
   }
 

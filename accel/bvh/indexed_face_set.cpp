@@ -95,7 +95,11 @@ LargeArray<Bounds3> IndexedFaceSet::triangle_bounds() const {
 }
 
 std::vector<std::span<const std::byte>> IndexedFaceSet::spans() const {
-  return {std::as_bytes(std::span(triangles_, triangle_count_)), std::as_bytes(std::span(positions_, vertex_count_))};
+  std::vector<std::span<const std::byte>> spans = {std::as_bytes(std::span(triangles_, triangle_count_)),
+                                                   std::as_bytes(std::span(positions_, vertex_count_))};
+  // A reordered copy maps hits back to the mesh's numbering: traversal reads that too.
+  if (!input_id_.empty()) spans.push_back(std::as_bytes(std::span(input_id_.data(), input_id_.size())));
+  return spans;
 }
 
 }  // namespace wavetrace

@@ -37,6 +37,10 @@ class IndexedFaceSet {
 
   // The mesh's index of the triangle stored at `slot`.
   std::uint32_t input_id(std::uint32_t slot) const { return input_id_.empty() ? slot : input_id_[slot]; }
+  // Where input_id reads, for probes; null when the face set is in input order.
+  const std::uint32_t* input_id_address(std::uint32_t slot) const {
+    return input_id_.empty() ? nullptr : input_id_.data() + slot;
+  }
 
   LargeArray<Bounds3> triangle_bounds() const;  // parallel
   std::size_t geometry_bytes() const { return vertex_count_ * sizeof(glm::vec3) + triangle_count_ * sizeof(glm::uvec3); }

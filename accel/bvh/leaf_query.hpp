@@ -35,14 +35,20 @@ class LeafQuery {
 
   bool found() const { return found_ != kInvalidPrimitive; }
 
-  // Tests leaf slots [first, first + count); with kAnyHit stops at the first hit.
-  template <bool kAnyHit>
-  void test_leaf(std::uint32_t first, std::uint32_t count) {
+  // Tests leaf slots [first, first + count); with kAnyHit stops at the first hit. Reports
+  // each index, triangle and vertex read to `probe`.
+  template <bool kAnyHit, typename Probe>
+  void test_leaf(std::uint32_t first, std::uint32_t count, Probe& probe) {
     const glm::vec3* positions = geometry_.positions();
     const glm::uvec3* triangles = geometry_.triangles();
     for (std::uint32_t slot = first; slot < first + count; ++slot) {
+      if (leaf_index_) probe.read(leaf_index_ + slot, sizeof(std::uint32_t));
       const std::uint32_t triangle = leaf_index_ ? leaf_index_[slot] : slot;
       const glm::uvec3& tri = triangles[triangle];
+      if constexpr (Probe::kRecords) {
+        probe.read(&tri, sizeof tri);
+        for (int corner = 0; corner < 3; ++corner) probe.read(positions + tri[corner], sizeof(glm::vec3));
+      }
       TriangleHit hit;
       if (intersect_watertight(ray_, positions[tri.x], positions[tri.y], positions[tri.z], tmin, tmax, hit)) {
         tmax = hit.t;
@@ -54,8 +60,12 @@ class LeafQuery {
   }
 
   // The answer in the mesh's triangle numbering (a miss if nothing was found).
-  void write(HitBatch& hits, std::uint32_t i) const {
+  template <typename Probe>
+  void write(HitBatch& hits, std::uint32_t i, Probe& probe) const {
     if (!found()) return write_miss(hits, i);
+    if constexpr (Probe::kRecords) {
+      if (const std::uint32_t* id = geometry_.input_id_address(found_)) probe.read(id, sizeof *id);
+    }
     hits.t[i] = best_.t;
     hits.primitive[i] = geometry_.input_id(found_);
     hits.u[i] = best_.u;

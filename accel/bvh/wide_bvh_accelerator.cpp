@@ -100,10 +100,21 @@ class WideBvhAccelerator final : public Accelerator {
   std::string name() const override { return "bvh8"; }
 
   void intersect_closest(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
-    traverse<false>(rays, hits, range);
+    NullProbe probe;
+    traverse<false>(rays, hits, range, probe);
   }
   void intersect_any(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
-    traverse<true>(rays, hits, range);
+    NullProbe probe;
+    traverse<true>(rays, hits, range, probe);
+  }
+  bool probed() const override { return true; }
+  void intersect_closest_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
+                                RecordingProbe& probe) const override {
+    traverse<false>(rays, hits, range, probe);
+  }
+  void intersect_any_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
+                            RecordingProbe& probe) const override {
+    traverse<true>(rays, hits, range, probe);
   }
 
   MemoryReport memory() const override {
@@ -164,8 +175,8 @@ class WideBvhAccelerator final : public Accelerator {
     return index;
   }
 
-  template <bool kAnyHit>
-  void traverse(const RayBatch& rays, HitBatch& hits, RayRange range) const {
+  template <bool kAnyHit, typename Probe>
+  void traverse(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
     struct StackEntry {
       std::uint32_t child;
       std::uint32_t count;
@@ -193,6 +204,7 @@ class WideBvhAccelerator final : public Accelerator {
         if (current.count == 0) {
           alignas(32) float distance[kWidth];
           const WideBvhNode& node = nodes[current.child];
+          probe.read(&node, sizeof node);
           unsigned mask = intersect_children(node, box_ray, tmin, tmax, distance);
           if (mask != 0 && (mask & (mask - 1)) == 0) {  // one child entered: no sorting
             const int k = std::countr_zero(mask);
@@ -217,14 +229,14 @@ class WideBvhAccelerator final : public Accelerator {
             continue;
           }
         } else {
-          query.test_leaf<kAnyHit>(current.child, current.count);
+          query.test_leaf<kAnyHit>(current.child, current.count, probe);
           if (kAnyHit && query.found()) break;
         }
         while (top > 0 && stack[top - 1].distance > tmax) --top;
         if (top == 0) break;
         current = stack[--top];
       }
-      query.write(hits, i);
+      query.write(hits, i, probe);
     }
   }
 
