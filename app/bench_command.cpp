@@ -8,6 +8,7 @@
 #include "app/commands.hpp"
 #include "bench/accel_bench.hpp"
 #include "bench/leak_bench.hpp"
+#include "bench/reorder_bench.hpp"
 #include "stages/render_setup.hpp"
 
 namespace wavetrace {
@@ -100,6 +101,45 @@ int run_leak(const BenchArguments& args) {
   return 0;
 }
 
+struct ReorderArguments {
+  std::string scene = "builtin:room:1M";
+  std::string accel = "bvh";
+  std::string heuristics = "none,origin,origin_dir,hph,hph_origin,hph_dir";
+  std::string curve = "morton";
+  std::string size = "320x240";
+  int spp = 4;
+  int threads = 0;
+  std::string json;
+  std::vector<std::string> assignments;
+};
+
+int run_reorder(const ReorderArguments& args) {
+  Config config;
+  config.set("render.max_depth=5");
+  for (const std::string& assignment : args.assignments) config.set(assignment);
+  config.set_value("scene.source", args.scene);
+  config.set("accel.type=" + args.accel);
+  config.set("reorder.curve=" + args.curve);
+  config.set("render.spp=" + std::to_string(args.spp));
+  config.set("render.threads=" + std::to_string(args.threads));
+  const std::size_t by = args.size.find('x');
+  if (by == std::string::npos) throw ConfigError(fmt::format("--size '{}': expected WIDTHxHEIGHT", args.size));
+  config.set("render.width=" + args.size.substr(0, by));
+  config.set("render.height=" + args.size.substr(by + 1));
+  std::vector<ReorderHeuristic> heuristics;
+  for (const std::string& name : split_commas(args.heuristics)) {
+    try {
+      heuristics.push_back(parse_reorder_heuristic(name));
+    } catch (const std::invalid_argument& error) {
+      throw ConfigError(fmt::format("--heuristics: {}", error.what()));
+    }
+  }
+  const ReorderBenchReport report = run_reorder_bench(config, heuristics);
+  fmt::print("{}", to_table(report));
+  if (!args.json.empty()) write_text(args.json, to_json(report).dump(2) + "\n");
+  return 0;
+}
+
 void add_common_options(CLI::App* command, BenchArguments& args) {
   command->add_option("--scene", args.scene, "mesh file, scene file (.toml) or builtin:NAME[:TRIANGLES]");
   command->add_option("--accel", args.accel,
@@ -135,6 +175,22 @@ void add_bench_command(CLI::App& app, int& exit_code) {
   CLI::App* leak = bench->add_subcommand("leak", "count rays escaping a closed mesh from inside");
   add_common_options(leak, *leak_args);
   leak->callback([leak_args, &exit_code] { exit_code = run_leak(*leak_args); });
+
+  auto reorder_args = std::make_shared<ReorderArguments>();
+  CLI::App* reorder = bench->add_subcommand("reorder", "render the same image once per ray reordering heuristic");
+  reorder->add_option("--scene", reorder_args->scene, "mesh file, scene file (.toml) or builtin:NAME[:TRIANGLES]");
+  reorder->add_option("--accel", reorder_args->accel, "main accelerator (accel.type)");
+  reorder->add_option("--heuristics", reorder_args->heuristics,
+                      "comma-separated: none, origin, origin_dir, hph, hph_origin, hph_dir (the first is the baseline)");
+  reorder->add_option("--curve", reorder_args->curve, "morton or hilbert");
+  reorder->add_option("--spp", reorder_args->spp, "samples per pixel");
+  reorder->add_option("--size", reorder_args->size, "image size as WIDTHxHEIGHT");
+  reorder->add_option("--threads", reorder_args->threads, "worker threads (0: all cores)");
+  reorder->add_option("--json", reorder_args->json, "write results as JSON");
+  reorder->add_option("--set", reorder_args->assignments, "config override section.key=value (e.g. memory.budget=20%)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  reorder->callback([reorder_args, &exit_code] { exit_code = run_reorder(*reorder_args); });
 }
 
 }  // namespace wavetrace

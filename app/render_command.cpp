@@ -53,7 +53,8 @@ int run_render(const RenderArguments& args) {
   const Camera camera = resolve_camera(plan.camera, scene);
   const std::unique_ptr<Accelerator> accelerator = make_accelerator(scene.mesh, plan.accelerator);
   const LightSampler lights(scene);
-  const World world{scene, *accelerator, lights};
+  const std::unique_ptr<Proxy> proxy = build_proxy(plan, scene, *accelerator);
+  const World world{scene, *accelerator, lights, proxy.get()};
 
   ProgressLine progress(stderr);
   const RenderOutput output =
@@ -65,7 +66,7 @@ int run_render(const RenderArguments& args) {
   const std::string preview = preview_path_for(args.out);
   write_png_preview(preview, plan.image.width, plan.image.height, output.image);
 
-  const RenderFacts facts{scene, *accelerator, plan, output, args.out};
+  const RenderFacts facts{scene, *accelerator, plan, output, args.out, proxy.get()};
   fmt::print("{}: {} triangles, {} vertices{}\n", scene.name, scene.mesh.triangle_count(), scene.mesh.vertex_count(),
              scene.cleanup.degenerate_dropped ? fmt::format(", {} degenerate dropped", scene.cleanup.degenerate_dropped)
                                               : std::string());

@@ -53,6 +53,23 @@ std::string memory_lines(const std::vector<StageStats>& stages) {
   return lines;
 }
 
+nlohmann::json proxy_json(const Proxy& proxy) {
+  const ProxyReport& report = proxy.report();
+  const auto quality = [](const std::optional<ProxyQuality>& q) -> nlohmann::json {
+    if (!q) return nullptr;
+    return {{"hit_agreement", q->hit_agreement}, {"hit_overlap", q->hit_overlap},
+            {"mean_distance_error", q->mean_distance_error}};
+  };
+  return {{"method", to_string(report.method)},
+          {"triangles", report.triangles},
+          {"simplify_seconds", report.simplify_seconds},
+          {"build_seconds", report.build_seconds},
+          {"accel", proxy.accelerator().name()},
+          {"quality", quality(report.quality)},
+          {"cluster_quality", quality(report.cluster_quality)},
+          {"stochastic_quality", quality(report.stochastic_quality)}};
+}
+
 nlohmann::json render_stats_json(const RenderFacts& facts) {
   const MemoryReport memory = facts.accelerator.memory();
   const BuildReport build = facts.accelerator.build();
@@ -72,7 +89,13 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
   for (const DepthHitRate& rate : facts.output.hit_rates) {
     hit_rates.push_back({{"depth", rate.depth}, {"rays", rate.rays}, {"hits", rate.hits}, {"hit_rate", rate.rate()}});
   }
-  return {
+  nlohmann::json render = {{"seconds", facts.output.run.seconds}, {"threads", facts.output.run.threads}};
+  render["stages"] = facts.plan.stages;
+  render["reorder"] = {{"heuristic", to_string(facts.plan.reorder.heuristic)},
+                       {"curve", to_string(facts.plan.reorder.curve)},
+                       {"buffer_rays", facts.plan.reorder.buffer_rays},
+                       {"sort_seconds", facts.output.sort_seconds}};
+  nlohmann::json stats = {
       {"scene",
        {{"source", facts.scene.name},
         {"triangles", facts.scene.mesh.triangle_count()},
@@ -88,13 +111,15 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
         {"build_peak_bytes", build.peak_bytes}}},
       {"stages", stages},
       {"hit_rates", hit_rates},
-      {"render", {{"seconds", facts.output.run.seconds}, {"threads", facts.output.run.threads}}},
+      {"render", render},
       {"image",
        {{"width", facts.plan.image.width},
         {"height", facts.plan.image.height},
         {"spp", facts.plan.image.samples_per_pixel},
         {"path", facts.image_path}}},
   };
+  if (facts.proxy != nullptr) stats["proxy"] = proxy_json(*facts.proxy);
+  return stats;
 }
 
 std::string render_table(const RenderFacts& facts) {
@@ -114,6 +139,14 @@ std::string render_table(const RenderFacts& facts) {
       table += fmt::format(" {}: {:.1f}%", rate.depth, 100.0 * rate.rate());
     }
     table += "\n";
+  }
+  if (facts.proxy != nullptr) {
+    const ProxyReport& proxy = facts.proxy->report();
+    table += fmt::format("proxy: {} triangles by {} in {:.2f} s (+{:.2f} s {} build); hits overlap the scene's on "
+                         "{:.1f}% of test rays (agree on {:.1f}%)\n",
+                         proxy.triangles, to_string(proxy.method), proxy.simplify_seconds, proxy.build_seconds,
+                         facts.proxy->accelerator().name(), 100.0 * proxy.quality.hit_overlap,
+                         100.0 * proxy.quality.hit_agreement);
   }
   const MemoryReport memory = facts.accelerator.memory();
   const BuildReport build = facts.accelerator.build();

@@ -17,7 +17,10 @@ struct RenderFacts {
   const RenderPlan& plan;
   const RenderOutput& output;
   std::string image_path;
+  const Proxy* proxy = nullptr;
 };
+
+nlohmann::json proxy_json(const Proxy& proxy);
 
 nlohmann::json render_stats_json(const RenderFacts& facts);
 std::string render_table(const RenderFacts& facts);

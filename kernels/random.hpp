@@ -16,6 +16,7 @@ enum class RandomPurpose : std::uint32_t {
   russian_roulette = 5,
   scene_generation = 6,
   benchmark = 7,
+  simplification = 8,
 };
 
 // A 64-bit finalizer (SplitMix64's): full avalanche, cheap, and good enough for sampling.

@@ -52,6 +52,20 @@ inline float intersect_box(const BoxRay& ray, const glm::vec3& lower, const glm:
   return near <= far ? near : std::numeric_limits<float>::infinity();
 }
 
+// The part [near, far] of [tmin, tmax] inside the box; false on a miss.
+inline bool clip_to_box(const BoxRay& ray, const glm::vec3& lower, const glm::vec3& upper, float tmin, float tmax,
+                        float& near, float& far) {
+  near = tmin;
+  far = tmax;
+  clip_slab((lower.x - ray.origin.x) * ray.inverse_direction.x, (upper.x - ray.origin.x) * ray.inverse_direction.x,
+            near, far);
+  clip_slab((lower.y - ray.origin.y) * ray.inverse_direction.y, (upper.y - ray.origin.y) * ray.inverse_direction.y,
+            near, far);
+  clip_slab((lower.z - ray.origin.z) * ray.inverse_direction.z, (upper.z - ray.origin.z) * ray.inverse_direction.z,
+            near, far);
+  return near <= far;
+}
+
 // The same test for `count` rays in SoA columns against one box; writes entry distances
 // (or +inf) to `entry`. Plain loops the compiler vectorizes (AVX2 here).
 inline void intersect_box_soa(const float* origin_x, const float* origin_y, const float* origin_z,

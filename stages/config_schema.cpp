@@ -60,8 +60,21 @@ const std::vector<ConfigKey>& config_schema() {
        "cache capacity bytes (overrides the preset)"},
       {"memory.cache_ways", T::integer, std::nullopt, 1, 256, {}, "cache associativity (overrides the preset)"},
 
-      {"pipeline.stages", T::text_list, std::vector<std::string>{"generate", "trace", "shade", "spawn"}, 0, 0,
-       {"generate", "trace", "shade", "spawn"}, "the stage chain; spawn at the end loops back"},
+      {"proxy.share", T::real, 0.02, 1e-6, 1.0, {}, "proxy triangles as a share of the scene's (the paper: 0.02)"},
+      {"proxy.method", T::text, std::string("auto"), 0, 0, {"auto", "cluster", "stochastic"},
+       "simplification: vertex clustering with quadrics, stochastic pruning, or the better of both on test rays"},
+      {"proxy.accel", T::text, std::string("embree"), 0, 0, {"embree", "bvh"},
+       "the proxy's accelerator (bvh: its reads can be observed by [memory])"},
+
+      {"reorder.heuristic", T::text, std::string("none"), 0, 0,
+       {"none", "origin", "origin_dir", "hph", "hph_origin", "hph_dir"}, "ray ordering keys (none: no reordering)"},
+      {"reorder.curve", T::text, std::string("morton"), 0, 0, {"morton", "hilbert"}, "space-filling curve of the keys"},
+      {"reorder.buffer_rays", T::integer, std::int64_t{1} << 18, 1, std::int64_t{1} << 32, {},
+       "rays zsort holds before it sorts (it also flushes when it holds every live ray)"},
+
+      {"pipeline.stages", T::text_list, std::vector<std::string>{"auto"}, 0, 0,
+       {"auto", "generate", "approx_hit", "zsort", "trace", "shade", "spawn"},
+       "the stage chain; spawn at the end loops back. auto: the chain reorder.heuristic needs"},
   };
   return schema;
 }

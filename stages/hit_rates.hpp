@@ -24,6 +24,11 @@ class HitRateCounters {
 
   // Counts the non-shadow rays of `range` and their hits; atomics once per call.
   void record(const RayBatch& rays, const HitBatch& hits, RayRange range);
+  // Adds counts decided elsewhere (approx_hit's box misses).
+  void add(int depth, std::uint64_t rays, std::uint64_t hits) {
+    rays_[depth].fetch_add(rays, std::memory_order_relaxed);
+    hits_[depth].fetch_add(hits, std::memory_order_relaxed);
+  }
   // Every depth that saw a ray, in order.
   std::vector<DepthHitRate> snapshot() const;
 

@@ -3,6 +3,8 @@
 
 #include <condition_variable>
 #include <mutex>
+#include <stdexcept>
+#include <string>
 #include <thread>
 
 #include "stages/tracing_arena.hpp"
@@ -41,7 +43,11 @@ PipelineContext::PipelineContext(std::size_t batch_capacity, std::size_t rays_in
     : pool_(batch_capacity), budget_(std::max(rays_in_flight, 2 * batch_capacity)) {}
 
 void PipelineContext::retire_rays(std::size_t count) {
-  const std::int64_t now = live_rays_.fetch_sub(std::int64_t(count), std::memory_order_acq_rel) - std::int64_t(count);
+  const std::int64_t now = live_rays_.fetch_sub(std::int64_t(count), std::memory_order_seq_cst) - std::int64_t(count);
+  if (zsort_node_ != nullptr) {
+    const auto waiting = std::int64_t(zsort_stage_->buffered_rays());
+    if (waiting > 0 && now <= waiting) zsort_node_->try_put(nullptr);
+  }
   if (generator_node_ != nullptr && !generator_stage_->exhausted() &&
       now + std::int64_t(pool_.batch_capacity()) <= std::int64_t(budget_)) {
     generator_node_->try_put(tbb::flow::continue_msg());
@@ -77,6 +83,42 @@ std::unique_ptr<BatchNode> make_stage_node(tbb::flow::graph& graph, const Stage&
         counters.record(rays_in, out.emitted_rays, nanoseconds_since(start));
         context.retire_rays(rays_in);
       });
+}
+
+namespace {
+
+// zsort's output: its rays are already counted alive, so emitting adds nothing.
+class BufferedOutput final : public StageOutput {
+ public:
+  BufferedOutput(PipelineContext& context, BatchNode::output_ports_type& ports) : context_(context), ports_(ports) {}
+  void emit(Batch* batch) override { std::get<0>(ports_).try_put(batch); }
+  Batch* acquire() override { return context_.pool().acquire(); }
+  void release(Batch* batch) override { context_.pool().release(batch); }
+
+ private:
+  PipelineContext& context_;
+  BatchNode::output_ports_type& ports_;
+};
+
+}  // namespace
+
+std::unique_ptr<BatchNode> make_zsort_node(tbb::flow::graph& graph, const ZSortStage& stage, PipelineContext& context,
+                                           StageCounters& counters) {
+  auto node = std::make_unique<BatchNode>(
+      graph, tbb::flow::serial, [&stage, &context, &counters](Batch* batch, BatchNode::output_ports_type& ports) {
+        const Clock::time_point start = Clock::now();
+        const std::size_t rays_in = batch != nullptr ? batch->rays.count : 0;
+        const bool full = batch != nullptr && stage.buffer(batch);
+        const std::size_t waiting = stage.buffered_rays();
+        std::size_t rays_out = 0;
+        if (waiting > 0 && (full || std::int64_t(waiting) >= context.live_rays())) {
+          BufferedOutput out(context, ports);
+          rays_out = stage.flush(out);
+        }
+        if (rays_in > 0 || rays_out > 0) counters.record(rays_in, rays_out, nanoseconds_since(start));
+      });
+  context.attach_zsort(node.get(), &stage);
+  return node;
 }
 
 std::unique_ptr<tbb::flow::function_node<Batch*>> make_retire_node(tbb::flow::graph& graph, PipelineContext& context) {
@@ -125,7 +167,13 @@ PipelineRun Pipeline::run(const std::function<void(const Progress&)>& on_progres
     tbb::flow::graph graph;
     auto generate_node = make_generate_node(graph, generate_, context, generate_counters);
     std::vector<std::unique_ptr<BatchNode>> nodes;
-    for (std::size_t i = 0; i < chain_.size(); ++i) nodes.push_back(make_stage_node(graph, *chain_[i], context, *counters[i]));
+    for (std::size_t i = 0; i < chain_.size(); ++i) {
+      if (const auto* zsort = dynamic_cast<const ZSortStage*>(chain_[i])) {
+        nodes.push_back(make_zsort_node(graph, *zsort, context, *counters[i]));
+      } else {
+        nodes.push_back(make_stage_node(graph, *chain_[i], context, *counters[i]));
+      }
+    }
     std::unique_ptr<tbb::flow::function_node<Batch*>> retire;
     if (nodes.empty()) {
       retire = make_retire_node(graph, context);
@@ -145,6 +193,9 @@ PipelineRun Pipeline::run(const std::function<void(const Progress&)>& on_progres
     generate_node->try_put(tbb::flow::continue_msg());
     graph.wait_for_all();
   });
+  if (context.live_rays() != 0) {
+    throw std::logic_error("the pipeline drained with " + std::to_string(context.live_rays()) + " rays still alive");
+  }
 
   PipelineRun result;
   result.seconds = std::chrono::duration<double>(Clock::now() - start).count();

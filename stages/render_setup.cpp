@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <tbb/info.h>
 
+#include "stages/approx_hit.hpp"
 #include "stages/shade.hpp"
 #include "stages/spawn.hpp"
 #include "stages/trace.hpp"
@@ -13,7 +14,7 @@
 namespace wavetrace {
 namespace {
 
-void check_stage_order(const std::vector<std::string>& names) {
+void check_stage_order(const std::vector<std::string>& names, ReorderHeuristic heuristic) {
   const auto position = [&](std::string_view name) {
     return std::find(names.begin(), names.end(), name) - names.begin();
   };
@@ -31,6 +32,19 @@ void check_stage_order(const std::vector<std::string>& names) {
   }
   if (present("spawn") && (!present("shade") || position("shade") > position("spawn"))) {
     throw ConfigError("pipeline.stages: 'spawn' needs 'shade' before it");
+  }
+  if (present("approx_hit") && (!present("trace") || position("approx_hit") > position("trace"))) {
+    throw ConfigError("pipeline.stages: 'approx_hit' needs 'trace' after it");
+  }
+  if (present("zsort") && (!present("trace") || position("zsort") > position("trace"))) {
+    throw ConfigError("pipeline.stages: 'zsort' needs 'trace' after it");
+  }
+  if (present("zsort") && present("approx_hit") && position("approx_hit") > position("zsort")) {
+    throw ConfigError("pipeline.stages: 'approx_hit' must come before 'zsort' (zsort sorts by its points)");
+  }
+  if (uses_hit_points(heuristic) && present("zsort") && !present("approx_hit")) {
+    throw ConfigError(fmt::format("pipeline.stages: reorder.heuristic = '{}' needs 'approx_hit' before 'zsort'",
+                                  to_string(heuristic)));
   }
   if (present("spawn") && names.back() != "spawn") {
     throw ConfigError("pipeline.stages: 'spawn' must be last (its rays go back to the start of the chain)");
@@ -80,9 +94,36 @@ RenderPlan plan_render(const Config& config) {
 
   plan.accelerator = accelerator_options(config);
 
+  plan.proxy.share = config.real("proxy.share");
+  plan.proxy.method = parse_proxy_method(config.text("proxy.method"));
+  plan.proxy.accelerator = plan.accelerator;
+  plan.proxy.accelerator.type = config.text("proxy.accel");
+  plan.reorder.heuristic = parse_reorder_heuristic(config.text("reorder.heuristic"));
+  plan.reorder.curve = parse_curve_kind(config.text("reorder.curve"));
+  plan.reorder.buffer_rays = static_cast<std::size_t>(config.integer("reorder.buffer_rays"));
+
   plan.stages = config.text_list("pipeline.stages");
-  check_stage_order(plan.stages);
+  if (plan.stages == std::vector<std::string>{"auto"}) plan.stages = stages_for(plan.reorder.heuristic);
+  if (std::count(plan.stages.begin(), plan.stages.end(), "auto") > 0) {
+    throw ConfigError("pipeline.stages: 'auto' stands alone");
+  }
+  check_stage_order(plan.stages, plan.reorder.heuristic);
   return plan;
+}
+
+bool RenderPlan::needs_proxy() const { return std::find(stages.begin(), stages.end(), "approx_hit") != stages.end(); }
+
+std::vector<std::string> stages_for(ReorderHeuristic heuristic) {
+  std::vector<std::string> stages = {"generate"};
+  if (uses_hit_points(heuristic)) stages.push_back("approx_hit");
+  if (heuristic != ReorderHeuristic::none) stages.push_back("zsort");
+  stages.insert(stages.end(), {"trace", "shade", "spawn"});
+  return stages;
+}
+
+std::unique_ptr<Proxy> build_proxy(const RenderPlan& plan, const Scene& scene, const Accelerator& accelerator) {
+  if (!plan.needs_proxy()) return nullptr;
+  return std::make_unique<Proxy>(scene.mesh, plan.proxy, accelerator);
 }
 
 Camera resolve_camera(const CameraOverride& override, const Scene& scene) {
@@ -95,10 +136,19 @@ Camera resolve_camera(const CameraOverride& override, const Scene& scene) {
   return camera;
 }
 
-StageChain::StageChain(const std::vector<std::string>& names, const World& world, Film& film, const PathRules& rules,
-                       const MemoryObservers* observers) {
-  for (const std::string& name : names) {
+StageChain::StageChain(const RenderPlan& plan, const World& world, Film& film, const MemoryObservers* observers) {
+  const PathRules& rules = plan.rules;
+  for (const std::string& name : plan.stages) {
     if (name == "generate") continue;
+    if (name == "approx_hit") {
+      if (world.proxy == nullptr) throw std::logic_error("approx_hit needs the world's proxy");
+      owned_.push_back(std::make_unique<ApproxHitStage>(*world.proxy, film, world.scene.background, &hit_rates_, observers));
+    }
+    if (name == "zsort") {
+      auto zsort = std::make_unique<ZSortStage>(plan.reorder, world.scene.mesh.bounds());
+      zsort_ = zsort.get();
+      owned_.push_back(std::move(zsort));
+    }
     if (name == "trace") owned_.push_back(std::make_unique<TraceStage>(world.accelerator, &hit_rates_, observers));
     if (name == "shade") owned_.push_back(std::make_unique<ShadeStage>(world, film, rules));
     if (name == "spawn") {
@@ -123,16 +173,21 @@ RenderOutput render_image(const RenderPlan& plan, const World& world, const Came
   if (plan.memory.enabled()) {
     if (world.accelerator.probed()) {
       const int threads = plan.pipeline.threads > 0 ? plan.pipeline.threads : tbb::info::default_concurrency();
-      observation.emplace(plan.memory, world.accelerator.memory_spans(), threads);
+      std::vector<std::span<const std::byte>> spans = world.accelerator.memory_spans();
+      if (world.proxy != nullptr && plan.needs_proxy()) {
+        for (const auto& span : world.proxy->accelerator().memory_spans()) spans.push_back(span);
+      }
+      observation.emplace(plan.memory, std::move(spans), threads);
     } else {
       output.memory_unobserved = fmt::format("accelerator '{}' cannot report its memory reads: no pager or cache counters",
                                              world.accelerator.name());
     }
   }
-  const StageChain chain(plan.stages, world, film, plan.rules, observation ? &observation->observers() : nullptr);
+  const StageChain chain(plan, world, film, observation ? &observation->observers() : nullptr);
   Pipeline pipeline(generate, chain.stages(), chain.loops(), plan.pipeline);
   output.run = pipeline.run(on_progress);
   if (observation) observation->report(output.run.stages);
+  if (chain.zsort() != nullptr) output.sort_seconds = chain.zsort()->sort_seconds();
   output.image = film.resolve(plan.image.samples_per_pixel);
   output.rejected_contributions = film.rejected_contributions();
   output.hit_rates = chain.hit_rates().snapshot();

@@ -15,6 +15,8 @@
 #include "stages/generate.hpp"
 #include "stages/hit_rates.hpp"
 #include "stages/memory_observation.hpp"
+#include "stages/zsort.hpp"
+#include "accel/proxy/proxy.hpp"
 #include "stages/path_rules.hpp"
 #include "stages/pipeline.hpp"
 #include "stages/world.hpp"
@@ -35,8 +37,19 @@ struct RenderPlan {
   PipelineOptions pipeline;
   AcceleratorOptions accelerator;
   MemoryPlan memory;
+  ProxyOptions proxy;
+  ZSortOptions reorder;
   std::vector<std::string> stages;
+  bool needs_proxy() const;
 };
+
+// The chain pipeline.stages = auto stands for: generate, [approx_hit], [zsort], trace,
+// shade, spawn, with approx_hit for hit-point heuristics and zsort for any but none.
+std::vector<std::string> stages_for(ReorderHeuristic heuristic);
+
+// The proxy the plan's chain needs (approx_hit), built against the scene's accelerator;
+// null when the chain has no approx_hit.
+std::unique_ptr<Proxy> build_proxy(const RenderPlan& plan, const Scene& scene, const Accelerator& accelerator);
 
 // The accel.* keys as options for make_accelerator.
 AcceleratorOptions accelerator_options(const Config& config);
@@ -50,15 +63,16 @@ Camera resolve_camera(const CameraOverride& override, const Scene& scene);
 // Owns the stage objects a plan names, in chain order (generate excluded).
 class StageChain {
  public:
-  StageChain(const std::vector<std::string>& names, const World& world, Film& film, const PathRules& rules,
-             const MemoryObservers* observers = nullptr);
+  StageChain(const RenderPlan& plan, const World& world, Film& film, const MemoryObservers* observers = nullptr);
   std::vector<const Stage*> stages() const;
   bool loops() const { return loops_; }
   const HitRateCounters& hit_rates() const { return hit_rates_; }
+  const ZSortStage* zsort() const { return zsort_; }
 
  private:
   std::vector<std::unique_ptr<Stage>> owned_;
   HitRateCounters hit_rates_;
+  const ZSortStage* zsort_ = nullptr;
   bool loops_ = false;
 };
 
@@ -68,6 +82,7 @@ struct RenderOutput {
   std::vector<DepthHitRate> hit_rates;  // closest-hit rays per path depth
   // Set when [memory] asks for observation but the accelerator's reads cannot be seen.
   std::optional<std::string> memory_unobserved;
+  double sort_seconds = 0.0;  // zsort's sorting alone (within its stage seconds)
   std::uint64_t rejected_contributions = 0;
 };
 

@@ -4,6 +4,7 @@
 #include <glm/geometric.hpp>
 
 #include "kernels/random.hpp"
+#include "stages/escaped_light.hpp"
 
 namespace wavetrace {
 
@@ -14,18 +15,16 @@ void ShadeStage::process(Batch* batch, StageOutput& out) const {
   std::size_t survivors = 0;
   for (std::size_t i = 0; i < rays.count; ++i) {
     if (!(rays.flags[i] & ray_flags::alive)) continue;
-    const glm::vec3 throughput(rays.throughput_r[i], rays.throughput_g[i], rays.throughput_b[i]);
-    if (rays.kind[i] == RayKind::shadow) {
-      if (!hits.is_hit(i)) film_.add(rays.pixel[i], throughput.r, throughput.g, throughput.b);
-      rays.flags[i] = 0;
-      continue;
-    }
     if (!hits.is_hit(i)) {
-      const glm::vec3 sky = throughput * scene.background;
-      film_.add(rays.pixel[i], sky.r, sky.g, sky.b);
+      add_escaped_ray_light(film_, rays, i, scene.background);
       rays.flags[i] = 0;
       continue;
     }
+    if (rays.kind[i] == RayKind::shadow) {  // occluded
+      rays.flags[i] = 0;
+      continue;
+    }
+    const glm::vec3 throughput(rays.throughput_r[i], rays.throughput_g[i], rays.throughput_b[i]);
     const std::uint32_t triangle = hits.primitive[i];
     const Material& material = scene.materials[scene.mesh.material(triangle)];
     if (material.emissive() && rays.kind[i] == RayKind::camera) {

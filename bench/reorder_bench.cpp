@@ -1,0 +1,155 @@
+// One scene, accelerator and proxy shared by every heuristic's render.
+#include "bench/reorder_bench.hpp"
+
+#include <fmt/format.h>
+
+#include "accel/registry.hpp"
+#include "scene/lights.hpp"
+#include "stages/render_setup.hpp"
+
+namespace wavetrace {
+namespace {
+
+const StageStats* find_stage(const PipelineRun& run, std::string_view name) {
+  for (const StageStats& stage : run.stages) {
+    if (stage.name == name) return &stage;
+  }
+  return nullptr;
+}
+
+}  // namespace
+
+ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<ReorderHeuristic>& heuristics) {
+  if (heuristics.empty()) throw ConfigError("--heuristics names no heuristic");
+  const RenderPlan base = plan_render(config);
+  if (base.rules.max_depth < 3) {
+    throw ConfigError(fmt::format("render.max_depth = {}: the reorder benchmark path traces to depth 3 or more",
+                                  base.rules.max_depth));
+  }
+  const Scene scene = load_scene(base.scene);
+  const Camera camera = resolve_camera(base.camera, scene);
+  const auto accelerator = make_accelerator(scene.mesh, base.accelerator);
+  const LightSampler lights(scene);
+  std::unique_ptr<Proxy> proxy;
+  for (ReorderHeuristic heuristic : heuristics) {
+    if (uses_hit_points(heuristic) && !proxy) proxy = std::make_unique<Proxy>(scene.mesh, base.proxy, *accelerator);
+  }
+  const World world{scene, *accelerator, lights, proxy.get()};
+
+  ReorderBenchReport report;
+  report.scene = scene.name;
+  report.triangles = scene.mesh.triangle_count();
+  report.accel = accelerator->name();
+  report.curve = to_string(base.reorder.curve);
+  report.image = fmt::format("{}x{}, {} spp, depth {}", base.image.width, base.image.height,
+                             base.image.samples_per_pixel, base.rules.max_depth);
+  if (proxy) {
+    const ProxyReport& p = proxy->report();
+    report.proxy = fmt::format("{} triangles ({:.4g}% of the scene) by {} on {}; hit overlap {:.1f}%", p.triangles,
+                               100.0 * double(p.triangles) / double(report.triangles), to_string(p.method),
+                               proxy->accelerator().name(), 100.0 * p.quality.hit_overlap);
+  }
+  report.memory = "off";
+  if (base.memory.budget) report.memory = "pager " + config.text("memory.budget") + " of " +
+                                          std::to_string(base.memory.page_bytes >> 10) + " KiB pages";
+  if (base.memory.cache) report.memory += (base.memory.budget ? ", cache " : "cache ") + base.memory.cache->name;
+
+  std::vector<float> first_image;
+  for (ReorderHeuristic heuristic : heuristics) {
+    Config variant = config;
+    variant.set_value("reorder.heuristic", to_string(heuristic));
+    const RenderPlan plan = plan_render(variant);
+    const RenderOutput output = render_image(plan, world, camera);
+    report.threads = output.run.threads;
+
+    ReorderBenchResult result;
+    result.heuristic = to_string(heuristic);
+    result.render_seconds = output.run.seconds;
+    const double thread_seconds = output.run.seconds * output.run.threads;
+    if (const StageStats* trace = find_stage(output.run, "trace")) {
+      result.trace_seconds = trace->seconds;
+      result.trace_mrays_per_s = trace->mrays_per_s();
+      result.rays_traced = trace->rays_in;
+      if (trace->pager) {
+        result.page_faults = trace->pager->counters.faults;
+        result.bytes_loaded = trace->pager->counters.bytes_loaded;
+        result.simulated_io_seconds = trace->pager->counters.simulated_io_seconds;
+      }
+      if (trace->cache) result.cache_misses = trace->cache->counters.misses;
+    }
+    if (const StageStats* approx = find_stage(output.run, "approx_hit")) {
+      result.approx_hit_seconds = approx->seconds;
+      result.rays_retired_by_approx_hit = approx->rays_in - approx->rays_out;
+      // The proxy's traffic counts too: it is the price of the ordering.
+      if (approx->pager && result.page_faults) {
+        *result.page_faults += approx->pager->counters.faults;
+        *result.bytes_loaded += approx->pager->counters.bytes_loaded;
+        *result.simulated_io_seconds += approx->pager->counters.simulated_io_seconds;
+      }
+      if (approx->cache && result.cache_misses) *result.cache_misses += approx->cache->counters.misses;
+    }
+    if (const StageStats* zsort = find_stage(output.run, "zsort")) result.sort_seconds = zsort->seconds;
+    result.overhead_share = (result.approx_hit_seconds + result.sort_seconds) / thread_seconds;
+    if (first_image.empty()) first_image = output.image;
+    result.image_identical = output.image == first_image;
+    report.results.push_back(result);
+  }
+  return report;
+}
+
+nlohmann::json to_json(const ReorderBenchReport& report) {
+  const auto optional = [](const auto& value) { return value ? nlohmann::json(*value) : nlohmann::json(nullptr); };
+  nlohmann::json results = nlohmann::json::array();
+  for (const ReorderBenchResult& r : report.results) {
+    results.push_back({{"heuristic", r.heuristic},
+                       {"render_seconds", r.render_seconds},
+                       {"trace_seconds", r.trace_seconds},
+                       {"trace_mrays_per_s", r.trace_mrays_per_s},
+                       {"approx_hit_seconds", r.approx_hit_seconds},
+                       {"sort_seconds", r.sort_seconds},
+                       {"overhead_share", r.overhead_share},
+                       {"rays_traced", r.rays_traced},
+                       {"rays_retired_by_approx_hit", r.rays_retired_by_approx_hit},
+                       {"page_faults", optional(r.page_faults)},
+                       {"bytes_loaded", optional(r.bytes_loaded)},
+                       {"simulated_io_seconds", optional(r.simulated_io_seconds)},
+                       {"cache_misses", optional(r.cache_misses)},
+                       {"image_identical", r.image_identical}});
+  }
+  return {{"scene", {{"source", report.scene}, {"triangles", report.triangles}}},
+          {"accel", report.accel},
+          {"curve", report.curve},
+          {"image", report.image},
+          {"threads", report.threads},
+          {"proxy", optional(report.proxy)},
+          {"memory", report.memory},
+          {"results", results}};
+}
+
+std::string to_table(const ReorderBenchReport& report) {
+  std::string table = fmt::format("{}: {} triangles; {} on {}; {} curve; {} threads; memory {}\n", report.scene,
+                                  report.triangles, report.image, report.accel, report.curve, report.threads, report.memory);
+  if (report.proxy) table += "proxy: " + *report.proxy + "\n";
+  table += fmt::format("{:<11} {:>9} {:>9} {:>9} {:>9} {:>8} {:>9} {:>10} {:>9} {:>11} {:>11} {:>9} {:>10}\n", "heuristic",
+                       "render s", "trace s", "Mr/s/thr", "approx s", "sort s", "overhead", "faults", "sim I/O s",
+                       "misses", "vs first", "speedup", "identical");
+  const ReorderBenchResult* first = report.results.empty() ? nullptr : &report.results.front();
+  const auto optional = [](const auto& value, const char* format) {
+    return value ? fmt::format(fmt::runtime(format), *value) : std::string("-");
+  };
+  for (const ReorderBenchResult& r : report.results) {
+    const std::string fault_ratio =
+        r.page_faults && first->page_faults && *r.page_faults > 0
+            ? fmt::format("{:.2f}x", double(*first->page_faults) / double(*r.page_faults))
+            : std::string("-");
+    table += fmt::format("{:<11} {:>9.3f} {:>9.3f} {:>9.2f} {:>9.3f} {:>8.3f} {:>8.1f}% {:>10} {:>9} {:>11} {:>11} {:>8.2f}x {:>10}\n",
+                         r.heuristic, r.render_seconds, r.trace_seconds, r.trace_mrays_per_s, r.approx_hit_seconds,
+                         r.sort_seconds, 100.0 * r.overhead_share, optional(r.page_faults, "{}"),
+                         optional(r.simulated_io_seconds, "{:.1f}"), optional(r.cache_misses, "{}"), fault_ratio,
+                         first->render_seconds / r.render_seconds, r.image_identical ? "yes" : "NO");
+  }
+  table += "vs first: the first heuristic's page faults over this one's; speedup: its render seconds over this one's\n";
+  return table;
+}
+
+}  // namespace wavetrace

@@ -1,0 +1,49 @@
+// zsort (the reordering paper, §4.3): a ray buffer that, when full or when the chain has
+// nothing more to give it, computes every buffered ray's key with the configured heuristic
+// and curve, sorts the rays by key in parallel and emits them in key order. The one
+// stateful, serial stage: its pipeline node (make_zsort_node) runs one call at a time.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <vector>
+
+#include "stages/reorder_keys.hpp"
+#include "stages/stage.hpp"
+
+namespace wavetrace {
+
+struct ZSortOptions {
+  ReorderHeuristic heuristic = ReorderHeuristic::hph;
+  CurveKind curve = CurveKind::morton;
+  std::size_t buffer_rays = std::size_t{1} << 18;
+};
+
+class ZSortStage final : public Stage {
+ public:
+  ZSortStage(const ZSortOptions& options, const Bounds3& scene_bounds) : options_(options), bounds_(scene_bounds) {}
+  std::string name() const override { return "zsort"; }
+  // Outside the pipeline's zsort node (a hand-wired chain): sorts one batch on its own.
+  void process(Batch* batch, StageOutput& out) const override;
+
+  // Called by the serial node: holds the batch; true when the buffer is full.
+  bool buffer(Batch* batch) const;
+  // Sorts and emits every buffered ray in key order through `out` (acquiring batches from
+  // it and releasing the buffered ones); returns the rays emitted.
+  std::size_t flush(StageOutput& out) const;
+  // Rays held now; read by the pipeline to decide that everything alive is waiting here.
+  std::size_t buffered_rays() const { return buffered_rays_.load(std::memory_order_seq_cst); }
+  double sort_seconds() const { return sort_seconds_; }  // sorting alone, summed over flushes
+  std::size_t flushes() const { return flushes_; }
+  const ZSortOptions& options() const { return options_; }
+
+ private:
+  ZSortOptions options_;
+  Bounds3 bounds_;
+  mutable std::vector<Batch*> held_;
+  mutable std::atomic<std::size_t> buffered_rays_{0};
+  mutable double sort_seconds_ = 0.0;
+  mutable std::size_t flushes_ = 0;
+};
+
+}  // namespace wavetrace
