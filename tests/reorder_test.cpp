@@ -1,0 +1,261 @@
+// Ray reordering: curve keys, the proxy, approx_hit's retirement of box misses, zsort's
+// order, and the image that no heuristic or curve may change.
+#include <gtest/gtest.h>
+
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <map>
+#include <set>
+
+#include "accel/proxy/cluster_simplify.hpp"
+#include "accel/proxy/proxy.hpp"
+#include "accel/proxy/stochastic_simplify.hpp"
+#include "accel/registry.hpp"
+#include "kernels/random.hpp"
+#include "kernels/space_filling_curve.hpp"
+#include "scene/builtin_scenes.hpp"
+#include "scene/lights.hpp"
+#include "stages/render_setup.hpp"
+#include "stages/zsort.hpp"
+
+namespace wavetrace {
+namespace {
+
+template <int D, int kBits, typename KeyFunction>
+void expect_curve_visits_every_cell_once(KeyFunction key, bool adjacent_steps) {
+  std::map<std::uint64_t, std::array<std::uint32_t, D>> by_key;
+  const std::uint32_t side = 1u << kBits;
+  std::array<std::uint32_t, D> cell{};
+  std::size_t cells = 1;
+  for (int d = 0; d < D; ++d) cells *= side;
+  for (std::size_t n = 0; n < cells; ++n) {
+    std::size_t rest = n;
+    for (int d = 0; d < D; ++d) {
+      cell[d] = std::uint32_t(rest % side);
+      rest /= side;
+    }
+    by_key[key(cell)] = cell;
+  }
+  ASSERT_EQ(by_key.size(), cells);  // a bijection
+  EXPECT_EQ(by_key.begin()->first, 0u);
+  EXPECT_EQ(by_key.rbegin()->first, cells - 1);
+  if (!adjacent_steps) return;
+  const std::array<std::uint32_t, D>* previous = nullptr;
+  for (const auto& [k, c] : by_key) {
+    if (previous != nullptr) {
+      std::uint32_t distance = 0;
+      for (int d = 0; d < D; ++d) distance += c[d] > (*previous)[d] ? c[d] - (*previous)[d] : (*previous)[d] - c[d];
+      ASSERT_EQ(distance, 1u) << "key " << k;  // each Hilbert step moves to a neighbouring cell
+    }
+    previous = &c;
+  }
+}
+
+TEST(SpaceFillingCurve, MortonInterleavesWithTheFirstDimensionHighest) {
+  EXPECT_EQ((morton_key<3, 20>({1, 0, 0})), 4u);
+  EXPECT_EQ((morton_key<3, 20>({0, 0, 1})), 1u);
+  EXPECT_EQ((morton_key<3, 20>({0, 1, 0})), 2u);
+  EXPECT_EQ((morton_key<3, 20>({2, 0, 0})), 32u);
+  EXPECT_EQ((morton_key<3, 20>({(1u << 20) - 1, (1u << 20) - 1, (1u << 20) - 1})), (std::uint64_t{1} << 60) - 1);
+  EXPECT_EQ((morton_key<5, 12>({0, 0, 0, 0, 1})), 1u);
+  expect_curve_visits_every_cell_once<3, 3>([](auto c) { return morton_key<3, 3>(c); }, false);
+  expect_curve_visits_every_cell_once<6, 2>([](auto c) { return morton_key<6, 2>(c); }, false);
+}
+
+TEST(SpaceFillingCurve, HilbertStepsBetweenNeighbouringCells) {
+  expect_curve_visits_every_cell_once<2, 4>([](auto c) { return hilbert_key<2, 4>(c); }, true);
+  expect_curve_visits_every_cell_once<3, 3>([](auto c) { return hilbert_key<3, 3>(c); }, true);
+  expect_curve_visits_every_cell_once<5, 2>([](auto c) { return hilbert_key<5, 2>(c); }, true);
+}
+
+TEST(Proxy, ClusteringMeetsItsTargetInsideTheBoundsAndWorksOnSoups) {
+  for (const char* source : {"builtin:sphere:200k", "builtin:soup:200k", "builtin:terrain:200k"}) {
+    const Scene scene = make_builtin_scene(source);
+    const ClusterSimplification simplified = simplify_by_clustering(scene.mesh, 4000);
+    EXPECT_NEAR(double(simplified.mesh.triangle_count()), 4000.0, 4000.0 * 0.2) << source;
+    const Bounds3 original = scene.mesh.bounds(), proxy = simplified.mesh.bounds();
+    const float slack = 0.02f * original.diagonal();
+    for (int axis = 0; axis < 3; ++axis) {
+      EXPECT_GE(proxy.lower[axis], original.lower[axis] - slack) << source;
+      EXPECT_LE(proxy.upper[axis], original.upper[axis] + slack) << source;
+    }
+  }
+}
+
+TEST(Proxy, StandsInForTheSceneAndKeepsTheScenesBox) {
+  const Scene scene = make_builtin_scene("builtin:sphere:200k");
+  const auto accelerator = make_accelerator(scene.mesh, AcceleratorOptions{});
+  ProxyOptions options;
+  const Proxy proxy(scene.mesh, options, *accelerator);
+  EXPECT_EQ(proxy.report().method, ProxyMethod::cluster);
+  EXPECT_NEAR(double(proxy.report().triangles), 4000.0, 800.0);
+  EXPECT_GT(proxy.report().quality.hit_overlap, 0.97);
+  EXPECT_LT(proxy.report().quality.mean_distance_error, 0.01);
+  ASSERT_TRUE(proxy.report().stochastic_quality.has_value());
+  EXPECT_LT(proxy.report().stochastic_quality->hit_overlap, proxy.report().quality.hit_overlap);
+  EXPECT_EQ(proxy.scene_bounds().lower, scene.mesh.bounds().lower);
+  EXPECT_EQ(proxy.scene_bounds().upper, scene.mesh.bounds().upper);
+  options.share = 0.0;
+  EXPECT_THROW(Proxy(scene.mesh, options, *accelerator), SceneError);
+}
+
+TEST(Proxy, StochasticPruningKeepsItsShareAndTheExpectedArea) {
+  const Scene scene = make_builtin_scene("builtin:fur:100k");
+  const TriangleMesh pruned = simplify_stochastically(scene.mesh, 0.04);
+  EXPECT_NEAR(double(pruned.triangle_count()), 0.04 * double(scene.mesh.triangle_count()), 400.0);
+  const auto area = [](const TriangleMesh& mesh) {
+    double sum = 0.0;
+    for (const glm::uvec3& t : mesh.triangles) {
+      sum += 0.5 * glm::length(glm::cross(glm::dvec3(mesh.positions[t.y] - mesh.positions[t.x]),
+                                          glm::dvec3(mesh.positions[t.z] - mesh.positions[t.x])));
+    }
+    return sum;
+  };
+  EXPECT_NEAR(area(pruned) / area(scene.mesh), 1.0, 0.1);
+}
+
+// Hand-wired use of zsort: everything StageOutput sees.
+class CollectingOutput final : public StageOutput {
+ public:
+  explicit CollectingOutput(BatchPool& pool) : pool_(pool) {}
+  void emit(Batch* batch) override { emitted.push_back(batch); }
+  Batch* acquire() override { return pool_.acquire(); }
+  void release(Batch* batch) override { pool_.release(batch); }
+  std::vector<Batch*> emitted;
+
+ private:
+  BatchPool& pool_;
+};
+
+TEST(ZSort, EmitsEveryRayOnceInKeyOrderWithShadowRaysLast) {
+  BatchPool pool(64);
+  Bounds3 box;
+  box.extend(glm::vec3(-1.0f));
+  box.extend(glm::vec3(1.0f));
+  ZSortOptions options;
+  options.heuristic = ReorderHeuristic::origin;
+  options.curve = CurveKind::hilbert;
+  options.buffer_rays = 1000;
+  const ZSortStage zsort(options, box);
+  std::uint32_t pixel = 0;
+  for (int b = 0; b < 5; ++b) {
+    Batch* batch = pool.acquire();
+    batch->rays.count = 50;
+    for (std::size_t i = 0; i < 50; ++i, ++pixel) {
+      const UnitPair xy = unit_pair(random_bits(pixel, 0, 0, RandomPurpose::benchmark));
+      batch->rays.set_geometry(i, glm::vec3(xy.first * 2 - 1, xy.second * 2 - 1, 0.0f), glm::vec3(0, 0, 1), 0, 1);
+      batch->rays.pixel[i] = pixel;
+      batch->rays.kind[i] = pixel % 7 == 0 ? RayKind::shadow : RayKind::bounce;
+      batch->rays.flags[i] = ray_flags::alive;
+    }
+    EXPECT_FALSE(zsort.buffer(batch));
+  }
+  EXPECT_EQ(zsort.buffered_rays(), 250u);
+  CollectingOutput out(pool);
+  EXPECT_EQ(zsort.flush(out), 250u);
+  EXPECT_EQ(zsort.buffered_rays(), 0u);
+  ASSERT_EQ(out.emitted.size(), 4u);  // 64-ray batches
+  std::set<std::uint32_t> pixels;
+  std::uint64_t previous = 0;
+  bool seen_shadow = false;
+  for (Batch* batch : out.emitted) {
+    for (std::size_t i = 0; i < batch->rays.count; ++i) {
+      EXPECT_GE(batch->rays.sort_key[i], previous);
+      previous = batch->rays.sort_key[i];
+      const bool shadow = batch->rays.kind[i] == RayKind::shadow;
+      EXPECT_FALSE(seen_shadow && !shadow);
+      seen_shadow |= shadow;
+      pixels.insert(batch->rays.pixel[i]);
+    }
+  }
+  EXPECT_EQ(pixels.size(), 250u);
+}
+
+struct Rendered {
+  RenderOutput output;
+  std::uint64_t approx_in = 0, approx_out = 0, traced = 0;
+};
+
+Rendered render(const Scene& scene, const Proxy* proxy, const std::vector<std::string>& settings) {
+  Config config;
+  for (const char* setting : {"render.width=40", "render.height=30", "render.spp=2", "render.max_depth=4",
+                              "render.batch_size=256", "render.rays_in_flight=4096", "reorder.buffer_rays=3000"}) {
+    config.set(setting);
+  }
+  for (const std::string& setting : settings) config.set(setting);
+  const RenderPlan plan = plan_render(config);
+  const auto accelerator = make_accelerator(scene.mesh, plan.accelerator);
+  const LightSampler lights(scene);
+  Rendered rendered;
+  rendered.output = render_image(plan, World{scene, *accelerator, lights, proxy}, resolve_camera(plan.camera, scene));
+  for (const StageStats& stage : rendered.output.run.stages) {
+    if (stage.name == "approx_hit") {
+      rendered.approx_in = stage.rays_in;
+      rendered.approx_out = stage.rays_out;
+    }
+    if (stage.name == "trace") rendered.traced = stage.rays_in;
+  }
+  return rendered;
+}
+
+TEST(Reordering, ImageIsBitIdenticalForEveryHeuristicAndCurve) {
+  const Scene scene = make_builtin_scene("builtin:room:20k");
+  const auto accelerator = make_accelerator(scene.mesh, AcceleratorOptions{});
+  const Proxy proxy(scene.mesh, ProxyOptions{}, *accelerator);
+  const Rendered reference = render(scene, nullptr, {"render.threads=1"});
+  double sum = 0.0;
+  for (float value : reference.output.image) sum += value;
+  EXPECT_GT(sum, 0.0);
+  for (const char* heuristic : {"origin", "origin_dir", "hph", "hph_origin", "hph_dir"}) {
+    for (const char* curve : {"morton", "hilbert"}) {
+      const Rendered other = render(scene, &proxy, {std::string("reorder.heuristic=") + heuristic,
+                                                    std::string("reorder.curve=") + curve, "render.threads=2"});
+      EXPECT_TRUE(other.output.image == reference.output.image) << heuristic << " " << curve;
+      ASSERT_EQ(other.output.hit_rates.size(), reference.output.hit_rates.size());
+      for (std::size_t d = 0; d < other.output.hit_rates.size(); ++d) {
+        EXPECT_EQ(other.output.hit_rates[d].rays, reference.output.hit_rates[d].rays);
+        EXPECT_EQ(other.output.hit_rates[d].hits, reference.output.hit_rates[d].hits);
+      }
+    }
+  }
+}
+
+TEST(Reordering, ApproxHitRetiresRaysMissingTheSceneBoxWithTheirSkyLight) {
+  const Scene scene = make_builtin_scene("builtin:sphere:5000");  // a white sky all around
+  const auto accelerator = make_accelerator(scene.mesh, AcceleratorOptions{});
+  const Proxy proxy(scene.mesh, ProxyOptions{}, *accelerator);
+  const Rendered plain = render(scene, nullptr, {});
+  const Rendered ordered = render(scene, &proxy, {"reorder.heuristic=hph"});
+  EXPECT_TRUE(ordered.output.image == plain.output.image);
+  EXPECT_LT(ordered.approx_out, ordered.approx_in);  // camera rays past the sphere, escaping bounces
+  EXPECT_EQ(ordered.traced, ordered.approx_out);
+  EXPECT_EQ(plain.traced - ordered.traced, ordered.approx_in - ordered.approx_out);
+  for (std::size_t d = 0; d < plain.output.hit_rates.size(); ++d) {
+    EXPECT_EQ(ordered.output.hit_rates[d].rays, plain.output.hit_rates[d].rays) << d;
+    EXPECT_EQ(ordered.output.hit_rates[d].hits, plain.output.hit_rates[d].hits) << d;
+  }
+}
+
+TEST(Reordering, ChainsFollowTheHeuristicAndBadChainsAreErrors) {
+  Config config;
+  EXPECT_EQ(plan_render(config).stages, (std::vector<std::string>{"generate", "trace", "shade", "spawn"}));
+  config.set("reorder.heuristic=origin");
+  EXPECT_EQ(plan_render(config).stages, (std::vector<std::string>{"generate", "zsort", "trace", "shade", "spawn"}));
+  config.set("reorder.heuristic=hph_dir");
+  EXPECT_EQ(plan_render(config).stages,
+            (std::vector<std::string>{"generate", "approx_hit", "zsort", "trace", "shade", "spawn"}));
+  EXPECT_TRUE(plan_render(config).needs_proxy());
+  config.set("pipeline.stages=generate,zsort,trace,shade,spawn");
+  EXPECT_THROW(plan_render(config), ConfigError);  // hph_dir without approx_hit
+  config.set("pipeline.stages=generate,zsort,approx_hit,trace,shade,spawn");
+  EXPECT_THROW(plan_render(config), ConfigError);
+  config.set("pipeline.stages=generate,trace,zsort,shade,spawn");
+  EXPECT_THROW(plan_render(config), ConfigError);
+  EXPECT_THROW(config.set("reorder.heuristic=random"), ConfigError);
+  EXPECT_THROW(config.set("reorder.curve=peano"), ConfigError);
+  EXPECT_THROW(config.set("proxy.share=0"), ConfigError);
+}
+
+}  // namespace
+}  // namespace wavetrace
