@@ -140,6 +140,11 @@ std::string render_table(const RenderFacts& facts) {
     }
     table += "\n";
   }
+  if (facts.plan.reorder.heuristic != ReorderHeuristic::none) {
+    table += fmt::format("reorder: {} keys on a {} curve, buffer of {} rays; sorting alone {:.3f} s\n",
+                         to_string(facts.plan.reorder.heuristic), to_string(facts.plan.reorder.curve),
+                         facts.plan.reorder.buffer_rays, facts.output.sort_seconds);
+  }
   if (facts.proxy != nullptr) {
     const ProxyReport& proxy = facts.proxy->report();
     table += fmt::format("proxy: {} triangles by {} in {:.2f} s (+{:.2f} s {} build); hits overlap the scene's on "

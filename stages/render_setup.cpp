@@ -101,6 +101,7 @@ RenderPlan plan_render(const Config& config) {
   plan.reorder.heuristic = parse_reorder_heuristic(config.text("reorder.heuristic"));
   plan.reorder.curve = parse_curve_kind(config.text("reorder.curve"));
   plan.reorder.buffer_rays = static_cast<std::size_t>(config.integer("reorder.buffer_rays"));
+  plan.reorder.sort = config.text("reorder.sort") == "radix" ? SortAlgorithm::radix : SortAlgorithm::parallel;
 
   plan.stages = config.text_list("pipeline.stages");
   if (plan.stages == std::vector<std::string>{"auto"}) plan.stages = stages_for(plan.reorder.heuristic);

@@ -7,22 +7,9 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 
+#include "kernels/radix_sort.hpp"
+
 namespace wavetrace {
-namespace {
-
-struct SortEntry {
-  std::uint64_t key;
-  std::uint32_t batch;
-  std::uint32_t ray;
-  // Ties keep arrival order, so the output is the same on every run.
-  bool operator<(const SortEntry& other) const {
-    if (key != other.key) return key < other.key;
-    if (batch != other.batch) return batch < other.batch;
-    return ray < other.ray;
-  }
-};
-
-}  // namespace
 
 bool ZSortStage::buffer(Batch* batch) const {
   held_.push_back(batch);
@@ -36,7 +23,8 @@ std::size_t ZSortStage::flush(StageOutput& out) const {
   std::vector<std::size_t> first(held_.size() + 1, 0);
   for (std::size_t b = 0; b < held_.size(); ++b) first[b + 1] = first[b] + held_[b]->rays.count;
   const std::size_t total = first.back();
-  std::vector<SortEntry> entries(total);
+  std::vector<SortEntry>& entries = entries_;
+  entries.resize(total);
   const bool sorts = options_.heuristic != ReorderHeuristic::none;
   tbb::parallel_for(std::size_t{0}, held_.size(), [&](std::size_t b) {
     RayBatch& rays = held_[b]->rays;
@@ -46,7 +34,10 @@ std::size_t ZSortStage::flush(StageOutput& out) const {
     }
   });
   const auto start = std::chrono::steady_clock::now();
-  if (sorts) tbb::parallel_sort(entries.begin(), entries.end());
+  // Both keep arrival order among equal keys (radix is stable, the comparison breaks ties
+  // by arrival), so the output is the same on every run and with either algorithm.
+  if (sorts && options_.sort == SortAlgorithm::radix) radix_sort_by_key(entries, scratch_);
+  if (sorts && options_.sort == SortAlgorithm::parallel) tbb::parallel_sort(entries.begin(), entries.end());
   sort_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ++flushes_;
 

@@ -12,6 +12,7 @@
 #include "accel/proxy/proxy.hpp"
 #include "accel/proxy/stochastic_simplify.hpp"
 #include "accel/registry.hpp"
+#include "kernels/radix_sort.hpp"
 #include "kernels/random.hpp"
 #include "kernels/space_filling_curve.hpp"
 #include "scene/builtin_scenes.hpp"
@@ -67,6 +68,23 @@ TEST(SpaceFillingCurve, HilbertStepsBetweenNeighbouringCells) {
   expect_curve_visits_every_cell_once<2, 4>([](auto c) { return hilbert_key<2, 4>(c); }, true);
   expect_curve_visits_every_cell_once<3, 3>([](auto c) { return hilbert_key<3, 3>(c); }, true);
   expect_curve_visits_every_cell_once<5, 2>([](auto c) { return hilbert_key<5, 2>(c); }, true);
+}
+
+TEST(RadixSort, SortsStablyLikeAStableComparisonSort) {
+  for (const std::uint64_t key_mask : {std::uint64_t{0xF}, std::uint64_t{0xFFFF0000FF}, ~std::uint64_t{0}}) {
+    std::vector<SortEntry> entries;
+    for (std::uint32_t i = 0; i < 5000; ++i) {
+      entries.push_back({random_bits(i, 1, 0, RandomPurpose::benchmark) & key_mask, i / 100, i % 100});
+    }
+    std::vector<SortEntry> expected = entries, scratch;
+    std::stable_sort(expected.begin(), expected.end(), [](const SortEntry& a, const SortEntry& b) { return a.key < b.key; });
+    radix_sort_by_key(entries, scratch);
+    for (std::size_t i = 0; i < entries.size(); ++i) {
+      ASSERT_EQ(entries[i].key, expected[i].key);
+      ASSERT_EQ(entries[i].batch, expected[i].batch);
+      ASSERT_EQ(entries[i].ray, expected[i].ray);
+    }
+  }
 }
 
 TEST(Proxy, ClusteringMeetsItsTargetInsideTheBoundsAndWorksOnSoups) {
@@ -210,7 +228,8 @@ TEST(Reordering, ImageIsBitIdenticalForEveryHeuristicAndCurve) {
   for (const char* heuristic : {"origin", "origin_dir", "hph", "hph_origin", "hph_dir"}) {
     for (const char* curve : {"morton", "hilbert"}) {
       const Rendered other = render(scene, &proxy, {std::string("reorder.heuristic=") + heuristic,
-                                                    std::string("reorder.curve=") + curve, "render.threads=2"});
+                                                    std::string("reorder.curve=") + curve, "render.threads=2",
+                                                    curve[0] == 'm' ? "reorder.sort=radix" : "reorder.sort=parallel"});
       EXPECT_TRUE(other.output.image == reference.output.image) << heuristic << " " << curve;
       ASSERT_EQ(other.output.hit_rates.size(), reference.output.hit_rates.size());
       for (std::size_t d = 0; d < other.output.hit_rates.size(); ++d) {
