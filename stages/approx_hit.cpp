@@ -1,6 +1,7 @@
 // Box clip, retirement of box misses (with compaction), proxy query, approximate points.
 #include "stages/approx_hit.hpp"
 
+#include <algorithm>
 #include <optional>
 
 #include <tbb/task_arena.h>
@@ -57,8 +58,11 @@ void ApproxHitStage::process(Batch* batch, StageOutput& out) const {
     return;
   }
 
-  // The proxy's closest hits, into the hit columns trace will overwrite.
+  // The proxy's closest hits, into the hit columns trace will overwrite, from one surface
+  // tolerance past each origin (restored after).
   HitBatch& hits = batch->hits;
+  std::vector<float> tmin(rays.tmin, rays.tmin + kept);
+  for (std::size_t i = 0; i < kept; ++i) rays.tmin[i] += proxy_.surface_tolerance();
   if (observers_ != nullptr) {
     RecordingProbe probe(*observers_, std::size_t(ObservedStage::approx_hit),
                          std::size_t(tbb::this_task_arena::current_thread_index()));
@@ -66,9 +70,13 @@ void ApproxHitStage::process(Batch* batch, StageOutput& out) const {
   } else {
     proxy_.accelerator().intersect_closest(rays, hits, rays.all());
   }
+  std::copy(tmin.begin(), tmin.end(), rays.tmin);
   for (std::size_t i = 0; i < kept; ++i) {
-    // A virtual hit: where the ray enters the box, or leaves it when it starts inside.
+    // A virtual hit: where the ray enters the box, or leaves it when it starts inside. A
+    // shadow ray that meets no proxy surface before its light has no hit at all; its
+    // traversal works hardest where it starts, so its origin stands for it.
     float t = hits.is_hit(i) ? hits.t[i] : (box_near[i] > rays.tmin[i] ? box_near[i] : box_far[i]);
+    if (!hits.is_hit(i) && rays.kind[i] == RayKind::shadow) t = rays.tmin[i];
     if (!std::isfinite(t)) t = box_near[i];
     rays.approx_hit_x[i] = rays.origin_x[i] + t * rays.direction_x[i];
     rays.approx_hit_y[i] = rays.origin_y[i] + t * rays.direction_y[i];

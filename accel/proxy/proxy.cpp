@@ -102,7 +102,12 @@ Proxy::Proxy(const TriangleMesh& mesh, const ProxyOptions& options, const Accele
     }
     return simplified;
   };
-  const auto clustered = [&] { return cleaned(simplify_by_clustering(mesh, target).mesh); };
+  double cell_size = 0.0;
+  const auto clustered = [&] {
+    ClusterSimplification simplified = simplify_by_clustering(mesh, target);
+    cell_size = simplified.cell_size;
+    return cleaned(std::move(simplified.mesh));
+  };
   const auto pruned = [&] { return cleaned(simplify_stochastically(mesh, options.share)); };
 
   if (options.method == ProxyMethod::automatic) {
@@ -126,6 +131,8 @@ Proxy::Proxy(const TriangleMesh& mesh, const ProxyOptions& options, const Accele
     report_.simplify_seconds = seconds_since(start);
   }
   if (mesh_.triangles.empty()) throw SceneError("the proxy lost every triangle: raise proxy.share");
+  if (cell_size == 0.0) cell_size = simplify_by_clustering(mesh, target).cell_size;  // the scale of either method
+  surface_tolerance_ = static_cast<float>(cell_size);
   const auto build_start = std::chrono::steady_clock::now();
   accelerator_ = make_accelerator(mesh_, options.accelerator);
   report_.build_seconds = seconds_since(build_start);

@@ -55,12 +55,17 @@ class Proxy {
   const Bounds3& scene_bounds() const { return scene_bounds_; }
   const TriangleMesh& mesh() const { return mesh_; }
   const ProxyReport& report() const { return report_; }
+  // How far the proxy's surface may lie from the scene's: about one simplification cell.
+  // A ray leaving the scene's surface would hit the proxy right there; approx_hit skips
+  // this distance from each origin so the approximate hit is the one further along.
+  float surface_tolerance() const { return surface_tolerance_; }
 
  private:
   TriangleMesh mesh_;
   std::unique_ptr<Accelerator> accelerator_;
   Bounds3 scene_bounds_;
   ProxyReport report_;
+  float surface_tolerance_ = 0.0f;
 };
 
 // Hit agreement of `candidate` with `scene_accelerator` on `rays` test rays.
