@@ -84,7 +84,14 @@ INSTANTIATE_TEST_SUITE_P(
                       BadInput{"render --size 10by10", "--size '10by10'"},
                       BadInput{"render --set pipeline.stages=generate,shade", "'shade' needs 'trace'"},
                       BadInput{"render --set camera.look_at=0,2.4,5.8", "look_at equals position"},
-                      BadInput{"render --config /nonexistent.toml", "/nonexistent.toml"}),
+                      BadInput{"render --config /nonexistent.toml", "/nonexistent.toml"},
+                      BadInput{"render /nonexistent/scene.toml", "/nonexistent/scene.toml: no such scene file"},
+                      BadInput{"render --set memory.budget=lots", "memory.budget"},
+                      BadInput{"render --set memory.cache=l3", "memory.cache = 'l3' is not one of"},
+                      BadInput{"render --set reorder.heuristic=magic", "reorder.heuristic = 'magic' is not one of"},
+                      BadInput{"render --set proxy.share=2", "proxy.share = 2 is out of range"},
+                      BadInput{"render --set reorder.heuristic=hph --set pipeline.stages=generate,zsort,trace",
+                               "needs 'approx_hit' before 'zsort'"}),
     [](const ::testing::TestParamInfo<BadInput>& info) { return "case" + std::to_string(info.index); });
 
 TEST(Cli, InfoReportsTopology) {
@@ -103,6 +110,34 @@ TEST(Cli, InfoCountsDroppedDegenerates) {
   const auto result = run_wavetrace("info " + path + " --json");
   ASSERT_EQ(result.exit_code, 0) << result.output;
   EXPECT_EQ(nlohmann::json::parse(result.output)["degenerate_dropped"], 1);
+}
+
+}  // namespace
+}  // namespace wavetrace
+
+namespace wavetrace {
+namespace {
+
+TEST(Cli, BenchReorderReportsEveryHeuristicWithTheIssuesKeys) {
+  const std::string json_path = testing::write_temp_file("reorder.json", "");
+  const auto result = testing::run_wavetrace(
+      "bench reorder --scene builtin:room:5000 --accel bvh --size 16x12 --spp 1 --threads 1 --heuristics none,origin,hph "
+      "--set memory.budget=50% --set memory.page_bytes=4096 --set memory.cache=l1d --set proxy.accel=bvh --json " +
+      json_path);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const nlohmann::json json = nlohmann::json::parse(std::ifstream(json_path));
+  ASSERT_EQ(json["results"].size(), 3u);
+  for (const auto& entry : json["results"]) {
+    for (const char* key : {"heuristic", "render_seconds", "trace_seconds", "trace_mrays_per_s", "approx_hit_seconds",
+                            "sort_seconds", "overhead_share", "page_faults", "simulated_io_seconds", "cache_misses",
+                            "image_identical"}) {
+      EXPECT_TRUE(entry.contains(key)) << key;
+    }
+    EXPECT_TRUE(entry["image_identical"].get<bool>()) << entry["heuristic"];
+    EXPECT_GT(entry["page_faults"].get<std::uint64_t>(), 0u);
+  }
+  EXPECT_EQ(json["results"][0]["approx_hit_seconds"].get<double>(), 0.0);  // none has no approx_hit
+  EXPECT_GT(json["results"][2]["approx_hit_seconds"].get<double>(), 0.0);
 }
 
 }  // namespace
