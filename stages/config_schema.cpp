@@ -71,6 +71,8 @@ const std::vector<ConfigKey>& config_schema() {
       {"reorder.curve", T::text, std::string("morton"), 0, 0, {"morton", "hilbert"}, "space-filling curve of the keys"},
       {"reorder.buffer_rays", T::integer, std::int64_t{1} << 18, 1, std::int64_t{1} << 32, {},
        "rays zsort holds before it sorts (it also flushes when it holds every live ray)"},
+      {"reorder.buffer_bytes", T::integer, std::nullopt, 1024, std::int64_t{1} << 40, {},
+       "the buffer given in bytes instead (overrides buffer_rays; the paper: 88 MB)"},
       {"reorder.sort", T::text, std::string("radix"), 0, 0, {"radix", "parallel"},
        "zsort's sort: a stable LSD radix sort or tbb::parallel_sort"},
 

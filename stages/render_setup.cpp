@@ -101,6 +101,10 @@ RenderPlan plan_render(const Config& config) {
   plan.reorder.heuristic = parse_reorder_heuristic(config.text("reorder.heuristic"));
   plan.reorder.curve = parse_curve_kind(config.text("reorder.curve"));
   plan.reorder.buffer_rays = static_cast<std::size_t>(config.integer("reorder.buffer_rays"));
+  if (config.has("reorder.buffer_bytes")) {
+    plan.reorder.buffer_rays = std::max<std::size_t>(
+        1, static_cast<std::size_t>(config.integer("reorder.buffer_bytes")) / ZSortStage::kBytesPerBufferedRay);
+  }
   plan.reorder.sort = config.text("reorder.sort") == "radix" ? SortAlgorithm::radix : SortAlgorithm::parallel;
 
   plan.stages = config.text_list("pipeline.stages");

@@ -38,6 +38,11 @@ struct SortEntry {
 
 class ZSortStage final : public Stage {
  public:
+  // What one buffered ray holds: its RayBatch columns (origin, direction, tmin, tmax,
+  // pixel, sample, throughput: 4 bytes each; depth 2, kind 1, flags 1), the approximate hit
+  // (12) and key (8) columns, its HitBatch slot (16) and its sort entry (16).
+  static constexpr std::size_t kBytesPerBufferedRay = 13 * 4 + 2 + 1 + 1 + 12 + 8 + 16 + sizeof(SortEntry);
+
   ZSortStage(const ZSortOptions& options, const Bounds3& scene_bounds) : options_(options), bounds_(scene_bounds) {}
   std::string name() const override { return "zsort"; }
   // Outside the pipeline's zsort node (a hand-wired chain): sorts one batch on its own.

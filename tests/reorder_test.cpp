@@ -265,6 +265,8 @@ TEST(Reordering, ChainsFollowTheHeuristicAndBadChainsAreErrors) {
   EXPECT_EQ(plan_render(config).stages,
             (std::vector<std::string>{"generate", "approx_hit", "zsort", "trace", "shade", "spawn"}));
   EXPECT_TRUE(plan_render(config).needs_proxy());
+  config.set("reorder.buffer_bytes=88000000");
+  EXPECT_EQ(plan_render(config).reorder.buffer_rays, 88000000u / ZSortStage::kBytesPerBufferedRay);
   config.set("pipeline.stages=generate,zsort,trace,shade,spawn");
   EXPECT_THROW(plan_render(config), ConfigError);  // hph_dir without approx_hit
   config.set("pipeline.stages=generate,zsort,approx_hit,trace,shade,spawn");

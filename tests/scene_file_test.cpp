@@ -2,6 +2,8 @@
 // object, and a scene of several real meshes that renders.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <glm/geometric.hpp>
 
 #include "accel/registry.hpp"
@@ -154,7 +156,10 @@ struct BadScene {
 class SceneFileErrors : public ::testing::TestWithParam<BadScene> {};
 
 TEST_P(SceneFileErrors, NameTheObjectAndTheProblem) {
-  const std::string path = scene_file("bad.toml", GetParam().body);
+  // One file per case: ctest runs the cases in parallel.
+  std::string name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  std::replace(name.begin(), name.end(), '/', '_');
+  const std::string path = scene_file(name + ".toml", GetParam().body);
   try {
     load_scene_file(path);
     FAIL() << "no error for:\n" << GetParam().body;
@@ -185,7 +190,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadScene{"lights = 3\n", "unknown key 'lights'"}, BadScene{"background = 1\n", "the scene has no [[object]]"},
         BadScene{"[camera]\nposition = [0, 0, 0]\nlook_at = [0, 0, 0]\n[[object]]\nmesh = \"tetrahedron.off\"\n",
                  "camera: "},
-        BadScene{"[[object]\nmesh = 1\n", "bad.toml:1:"}),
+        BadScene{"[[object]\nmesh = 1\n", ".toml:1:"}),
     [](const ::testing::TestParamInfo<BadScene>& info) { return "case" + std::to_string(info.index); });
 
 TEST(SceneFile, MissingFileIsAnError) {

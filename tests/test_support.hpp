@@ -6,6 +6,8 @@
 #include <fstream>
 #include <string>
 
+#include <unistd.h>
+
 namespace wavetrace::testing {
 
 inline std::string data_path(const std::string& name) { return std::string(WAVETRACE_DATA_DIR) + "/" + name; }
@@ -15,7 +17,11 @@ inline std::string write_temp_file(const std::string& name, const std::string& c
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / "wavetrace_tests";
   std::filesystem::create_directories(dir);
   const std::filesystem::path path = dir / name;
-  std::ofstream(path, std::ios::binary) << contents;
+  // ctest runs tests in parallel processes: write aside, then rename over atomically, so
+  // a test never reads a file another is halfway through writing.
+  const std::filesystem::path partial = dir / (name + "." + std::to_string(::getpid()) + ".partial");
+  std::ofstream(partial, std::ios::binary) << contents;
+  std::filesystem::rename(partial, path);
   return path.string();
 }
 
