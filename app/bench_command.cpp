@@ -15,7 +15,7 @@ namespace wavetrace {
 namespace {
 
 struct BenchArguments {
-  std::string scene = "builtin:sphere:1M";
+  std::string scene = "builtin:room:1M";
   std::string accel = "embree,bvh";
   std::string rays = "primary";
   std::string reference = "embree";

@@ -25,7 +25,7 @@ void ApproxHitStage::process(Batch* batch, StageOutput& out) const {
   rays.enable_approx_hit();
   const Bounds3& box = proxy_.scene_bounds();
   // Rays inside the box keep their slot; others are finished here. Survivors move down in
-  // order, and where each survivor's box interval begins and ends is kept for step 3.
+  // order, keeping where each survivor enters and leaves the box for its virtual hit.
   std::vector<float> box_near(rays.count), box_far(rays.count);
   std::array<std::uint32_t, HitRateCounters::kDepths> missed_by_depth{};
   bool any_missed = false;
