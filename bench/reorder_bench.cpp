@@ -65,6 +65,8 @@ ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<Reo
     ReorderBenchResult result;
     result.heuristic = to_string(heuristic);
     result.render_seconds = output.run.seconds;
+    result.closest_mrays_per_s = output.closest_mrays_per_s;
+    result.shadow_mrays_per_s = output.any_mrays_per_s;
     const double thread_seconds = output.run.seconds * output.run.threads;
     if (const StageStats* trace = find_stage(output.run, "trace")) {
       result.trace_seconds = trace->seconds;
@@ -105,6 +107,8 @@ nlohmann::json to_json(const ReorderBenchReport& report) {
                        {"render_seconds", r.render_seconds},
                        {"trace_seconds", r.trace_seconds},
                        {"trace_mrays_per_s", r.trace_mrays_per_s},
+                       {"closest_mrays_per_s", r.closest_mrays_per_s},
+                       {"shadow_mrays_per_s", r.shadow_mrays_per_s},
                        {"approx_hit_seconds", r.approx_hit_seconds},
                        {"sort_seconds", r.sort_seconds},
                        {"overhead_share", r.overhead_share},
@@ -130,9 +134,9 @@ std::string to_table(const ReorderBenchReport& report) {
   std::string table = fmt::format("{}: {} triangles; {} on {}; {} curve; {} threads; memory {}\n", report.scene,
                                   report.triangles, report.image, report.accel, report.curve, report.threads, report.memory);
   if (report.proxy) table += "proxy: " + *report.proxy + "\n";
-  table += fmt::format("{:<11} {:>9} {:>9} {:>9} {:>9} {:>8} {:>9} {:>10} {:>9} {:>11} {:>11} {:>9} {:>10}\n", "heuristic",
-                       "render s", "trace s", "Mr/s/thr", "approx s", "sort s", "overhead", "faults", "sim I/O s",
-                       "misses", "vs first", "speedup", "identical");
+  table += fmt::format("{:<11} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>8} {:>9} {:>10} {:>9} {:>11} {:>11} {:>9} {:>10}\n",
+                       "heuristic", "render s", "trace s", "Mr/s/thr", "closest", "shadow", "approx s", "sort s",
+                       "overhead", "faults", "sim I/O s", "misses", "vs first", "speedup", "identical");
   const ReorderBenchResult* first = report.results.empty() ? nullptr : &report.results.front();
   const auto optional = [](const auto& value, const char* format) {
     return value ? fmt::format(fmt::runtime(format), *value) : std::string("-");
@@ -142,13 +146,16 @@ std::string to_table(const ReorderBenchReport& report) {
         r.page_faults && first->page_faults && *r.page_faults > 0
             ? fmt::format("{:.2f}x", double(*first->page_faults) / double(*r.page_faults))
             : std::string("-");
-    table += fmt::format("{:<11} {:>9.3f} {:>9.3f} {:>9.2f} {:>9.3f} {:>8.3f} {:>8.1f}% {:>10} {:>9} {:>11} {:>11} {:>8.2f}x {:>10}\n",
-                         r.heuristic, r.render_seconds, r.trace_seconds, r.trace_mrays_per_s, r.approx_hit_seconds,
+    table += fmt::format("{:<11} {:>9.3f} {:>9.3f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.3f} {:>8.3f} {:>8.1f}% {:>10} {:>9} {:>11} {:>11} "
+                         "{:>8.2f}x {:>10}\n",
+                         r.heuristic, r.render_seconds, r.trace_seconds, r.trace_mrays_per_s, r.closest_mrays_per_s,
+                         r.shadow_mrays_per_s, r.approx_hit_seconds,
                          r.sort_seconds, 100.0 * r.overhead_share, optional(r.page_faults, "{}"),
                          optional(r.simulated_io_seconds, "{:.1f}"), optional(r.cache_misses, "{}"), fault_ratio,
                          first->render_seconds / r.render_seconds, r.image_identical ? "yes" : "NO");
   }
-  table += "vs first: the first heuristic's page faults over this one's; speedup: its render seconds over this one's\n";
+  table += "Mr/s/thr: trace's rays per busy thread-second (closest: camera and bounce rays; shadow: any-hit rays)\n"
+           "vs first: the first heuristic's page faults over this one's; speedup: its render seconds over this one's\n";
   return table;
 }
 

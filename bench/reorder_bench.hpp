@@ -20,6 +20,8 @@ struct ReorderBenchResult {
   double render_seconds = 0.0;
   double trace_seconds = 0.0;       // thread-seconds in trace
   double trace_mrays_per_s = 0.0;   // per trace thread-second
+  double closest_mrays_per_s = 0.0; // camera and bounce rays alone
+  double shadow_mrays_per_s = 0.0;  // shadow rays alone
   double approx_hit_seconds = 0.0;
   double sort_seconds = 0.0;        // the zsort stage: keys, sort, gather
   double overhead_share = 0.0;      // (approx_hit + zsort) / all thread-seconds

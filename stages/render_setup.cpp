@@ -154,7 +154,7 @@ StageChain::StageChain(const RenderPlan& plan, const World& world, Film& film, c
       zsort_ = zsort.get();
       owned_.push_back(std::move(zsort));
     }
-    if (name == "trace") owned_.push_back(std::make_unique<TraceStage>(world.accelerator, &hit_rates_, observers));
+    if (name == "trace") owned_.push_back(std::make_unique<TraceStage>(world.accelerator, TraceInstruments{&hit_rates_, observers, &trace_times_}));
     if (name == "shade") owned_.push_back(std::make_unique<ShadeStage>(world, film, rules));
     if (name == "spawn") {
       owned_.push_back(std::make_unique<SpawnStage>(world, rules));
@@ -193,6 +193,8 @@ RenderOutput render_image(const RenderPlan& plan, const World& world, const Came
   output.run = pipeline.run(on_progress);
   if (observation) observation->report(output.run.stages);
   if (chain.zsort() != nullptr) output.sort_seconds = chain.zsort()->sort_seconds();
+  output.closest_mrays_per_s = chain.trace_times().closest_mrays_per_s();
+  output.any_mrays_per_s = chain.trace_times().any_mrays_per_s();
   output.image = film.resolve(plan.image.samples_per_pixel);
   output.rejected_contributions = film.rejected_contributions();
   output.hit_rates = chain.hit_rates().snapshot();

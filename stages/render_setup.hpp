@@ -14,6 +14,7 @@
 #include "stages/film.hpp"
 #include "stages/generate.hpp"
 #include "stages/hit_rates.hpp"
+#include "stages/trace.hpp"
 #include "stages/memory_observation.hpp"
 #include "stages/zsort.hpp"
 #include "accel/proxy/proxy.hpp"
@@ -68,10 +69,12 @@ class StageChain {
   bool loops() const { return loops_; }
   const HitRateCounters& hit_rates() const { return hit_rates_; }
   const ZSortStage* zsort() const { return zsort_; }
+  const TraceTimes& trace_times() const { return trace_times_; }
 
  private:
   std::vector<std::unique_ptr<Stage>> owned_;
   HitRateCounters hit_rates_;
+  TraceTimes trace_times_;
   const ZSortStage* zsort_ = nullptr;
   bool loops_ = false;
 };
@@ -83,6 +86,8 @@ struct RenderOutput {
   // Set when [memory] asks for observation but the accelerator's reads cannot be seen.
   std::optional<std::string> memory_unobserved;
   double sort_seconds = 0.0;  // zsort's sorting alone (within its stage seconds)
+  double closest_mrays_per_s = 0.0;  // trace's closest-hit (camera and bounce) rays per busy second
+  double any_mrays_per_s = 0.0;      // trace's shadow rays per busy second
   std::uint64_t rejected_contributions = 0;
 };
 

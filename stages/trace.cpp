@@ -1,6 +1,7 @@
 // Splits a batch into runs of one ray kind and hands each run to the accelerator.
 #include "stages/trace.hpp"
 
+#include <chrono>
 #include <optional>
 
 #include <tbb/task_arena.h>
@@ -12,8 +13,9 @@ namespace wavetrace {
 void TraceStage::process(Batch* batch, StageOutput& out) const {
   const RayBatch& rays = batch->rays;
   std::optional<RecordingProbe> probe;
-  if (observers_ != nullptr) {
-    probe.emplace(*observers_, std::size_t(ObservedStage::trace), std::size_t(tbb::this_task_arena::current_thread_index()));
+  if (instruments_.observers != nullptr) {
+    probe.emplace(*instruments_.observers, std::size_t(ObservedStage::trace),
+                  std::size_t(tbb::this_task_arena::current_thread_index()));
   }
   std::uint32_t begin = 0;
   const auto count = static_cast<std::uint32_t>(rays.count);
@@ -21,6 +23,7 @@ void TraceStage::process(Batch* batch, StageOutput& out) const {
     const bool shadow = rays.kind[begin] == RayKind::shadow;
     std::uint32_t end = begin + 1;
     while (end < count && (rays.kind[end] == RayKind::shadow) == shadow) ++end;
+    const auto start = std::chrono::steady_clock::now();
     if (shadow) {
       if (probe) {
         accelerator_.intersect_any_probed(rays, batch->hits, {begin, end}, *probe);
@@ -33,8 +36,14 @@ void TraceStage::process(Batch* batch, StageOutput& out) const {
       } else {
         accelerator_.intersect_closest(rays, batch->hits, {begin, end});
       }
-      if (hit_rates_ != nullptr) hit_rates_->record(rays, batch->hits, {begin, end});
     }
+    if (instruments_.times != nullptr) {
+      const auto nanoseconds = static_cast<std::uint64_t>(
+          std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count());
+      (shadow ? instruments_.times->any_rays : instruments_.times->closest_rays).fetch_add(end - begin);
+      (shadow ? instruments_.times->any_nanoseconds : instruments_.times->closest_nanoseconds).fetch_add(nanoseconds);
+    }
+    if (!shadow && instruments_.hit_rates != nullptr) instruments_.hit_rates->record(rays, batch->hits, {begin, end});
     begin = end;
   }
   out.emit(batch);

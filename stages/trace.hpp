@@ -1,28 +1,50 @@
 // trace: closest hit for camera and bounce rays, any hit for shadow rays, on the main accelerator.
 #pragma once
 
+#include <atomic>
+#include <cstdint>
+
 #include "accel/accelerator.hpp"
 #include "stages/hit_rates.hpp"
 #include "stages/stage.hpp"
 
 namespace wavetrace {
 
+// Rays and busy nanoseconds by query kind: closest hit (camera and bounce rays) apart from
+// any hit (shadow rays), so reordering's effect on each shows.
+struct TraceTimes {
+  std::atomic<std::uint64_t> closest_rays{0}, closest_nanoseconds{0};
+  std::atomic<std::uint64_t> any_rays{0}, any_nanoseconds{0};
+  double closest_mrays_per_s() const { return rate(closest_rays, closest_nanoseconds); }
+  double any_mrays_per_s() const { return rate(any_rays, any_nanoseconds); }
+
+ private:
+  static double rate(const std::atomic<std::uint64_t>& rays, const std::atomic<std::uint64_t>& nanoseconds) {
+    return nanoseconds.load() ? double(rays.load()) / double(nanoseconds.load()) * 1e3 : 0.0;
+  }
+};
+
+// What a trace stage may count besides its own rays and seconds; each optional.
+struct TraceInstruments {
+  HitRateCounters* hit_rates = nullptr;        // hits per depth of closest-hit rays
+  const MemoryObservers* observers = nullptr;  // see every traversal read, if the accelerator can be probed
+  TraceTimes* times = nullptr;                 // seconds by query kind
+};
+
 class TraceStage final : public Stage {
  public:
-  // `hit_rates`, if given, counts hits per depth of the closest-hit rays. `observers`, if
-  // given and the accelerator can be probed, see every read of its traversal.
-  explicit TraceStage(const Accelerator& accelerator, HitRateCounters* hit_rates = nullptr,
-                      const MemoryObservers* observers = nullptr)
-      : accelerator_(accelerator),
-        hit_rates_(hit_rates),
-        observers_(observers != nullptr && observers->any() && accelerator.probed() ? observers : nullptr) {}
+  explicit TraceStage(const Accelerator& accelerator, const TraceInstruments& instruments = {})
+      : accelerator_(accelerator), instruments_(instruments) {
+    if (instruments_.observers != nullptr && !(instruments_.observers->any() && accelerator.probed())) {
+      instruments_.observers = nullptr;
+    }
+  }
   std::string name() const override { return "trace"; }
   void process(Batch* batch, StageOutput& out) const override;
 
  private:
   const Accelerator& accelerator_;
-  HitRateCounters* hit_rates_;
-  const MemoryObservers* observers_;
+  TraceInstruments instruments_;
 };
 
 }  // namespace wavetrace
