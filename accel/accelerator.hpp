@@ -52,6 +52,8 @@ class Accelerator {
 
   virtual MemoryReport memory() const = 0;
   virtual BuildReport build() const = 0;
+  // What the build chose that a user should know (resolution, guards that fired); may be empty.
+  virtual std::string build_notes() const { return {}; }
 
   // The byte ranges traversal reads, for the pager; empty where memory cannot be observed.
   virtual std::vector<std::span<const std::byte>> memory_spans() const { return {}; }

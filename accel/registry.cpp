@@ -1,4 +1,5 @@
-// Name-to-builder table of the accelerators that exist today.
+// Name-to-builder table of the accelerators that exist today (arraygrid, mlgrid, raystrips
+// and hmq are not written yet).
 #include "accel/registry.hpp"
 
 #include <stdexcept>
@@ -7,11 +8,12 @@
 
 namespace wavetrace {
 
-std::vector<std::string> accelerator_names() { return {"embree", "bvh"}; }
+std::vector<std::string> accelerator_names() { return {"embree", "bvh", "grid"}; }
 
 std::unique_ptr<Accelerator> make_accelerator(const TriangleMesh& mesh, const AcceleratorOptions& options) {
   if (options.type == "embree") return make_embree_accelerator(mesh, options.embree);
   if (options.type == "bvh") return make_bvh_accelerator(mesh, options.bvh);
+  if (options.type == "grid") return make_hashed_grid_accelerator(mesh, options.grid);
   std::string known;
   for (const std::string& name : accelerator_names()) known += (known.empty() ? "" : ", ") + name;
   throw std::invalid_argument(fmt::format("unknown accelerator '{}' (available: {})", options.type, known));

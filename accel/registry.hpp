@@ -8,6 +8,7 @@
 #include "accel/accelerator.hpp"
 #include "accel/bvh/bvh_accelerator.hpp"
 #include "accel/embree/embree_accelerator.hpp"
+#include "accel/grid/hashed_grid.hpp"
 #include "scene/triangle_mesh.hpp"
 
 namespace wavetrace {
@@ -16,6 +17,7 @@ struct AcceleratorOptions {
   std::string type = "embree";
   EmbreeOptions embree;
   BvhOptions bvh;
+  HashedGridOptions grid;
 };
 
 std::vector<std::string> accelerator_names();

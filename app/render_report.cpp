@@ -108,7 +108,8 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
         {"bytes_per_triangle", double(memory.total()) / triangles},
         {"parts", {{"hierarchy", memory.hierarchy}, {"geometry", memory.geometry}, {"other", memory.other}}},
         {"build_seconds", build.seconds},
-        {"build_peak_bytes", build.peak_bytes}}},
+        {"build_peak_bytes", build.peak_bytes},
+        {"build_notes", facts.accelerator.build_notes()}}},
       {"stages", stages},
       {"hit_rates", hit_rates},
       {"render", render},
@@ -162,6 +163,9 @@ std::string render_table(const RenderFacts& facts) {
                        double(memory.total()) / double(facts.scene.mesh.triangle_count()),
                        double(memory.hierarchy) / double(facts.scene.mesh.triangle_count()),
                        double(memory.geometry) / double(facts.scene.mesh.triangle_count()), build.seconds);
+  if (const std::string notes = facts.accelerator.build_notes(); !notes.empty()) {
+    table += fmt::format("accel {}: {}\n", facts.accelerator.name(), notes);
+  }
   table += memory_lines(run.stages);
   if (facts.output.memory_unobserved) table += "memory: " + *facts.output.memory_unobserved + "\n";
   if (facts.output.rejected_contributions > 0) {

@@ -120,6 +120,7 @@ AccelBenchReport run_accel_bench(const Scene& scene, const AccelBenchRequest& re
       result.memory = accelerator->memory();
       result.bytes_per_triangle = double(result.memory.total()) / double(scene.mesh.triangle_count());
       result.build = accelerator->build();
+      result.build_notes = accelerator->build_notes();
       std::vector<std::unique_ptr<HitBatch>> hits;
       for (int run = 0; run < std::max(1, request.repeats); ++run) {
         const auto start = std::chrono::steady_clock::now();
@@ -176,6 +177,7 @@ nlohmann::json to_json(const AccelBenchReport& report) {
                        {"parts", {{"hierarchy", r.memory.hierarchy}, {"geometry", r.memory.geometry}, {"other", r.memory.other}}},
                        {"build_seconds", r.build.seconds},
                        {"build_peak_bytes", r.build.peak_bytes},
+                       {"build_notes", r.build_notes},
                        {"mrays_per_s", r.mrays_per_s},
                        {"mrays_per_s_runs", r.mrays_per_s_runs},
                        {"hit_agreement", r.hit_agreement},
@@ -253,6 +255,9 @@ std::string to_table(const AccelBenchReport& report) {
                          100.0 * r.hit_agreement,
                          r.prim_agreement ? fmt::format("{:.4f}%", 100.0 * *r.prim_agreement) : std::string("-"),
                          r.t_error_max ? fmt::format("{:.2e}", *r.t_error_max) : std::string("-"));
+  }
+  for (const AccelBenchResult& r : report.results) {
+    if (!r.build_notes.empty()) table += fmt::format("{}: {}\n", r.label, r.build_notes);
   }
   if (report.memory_observed) table += memory_table(report);
   return table;

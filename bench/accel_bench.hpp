@@ -39,6 +39,7 @@ struct AccelBenchResult {
   MemoryReport memory;
   double bytes_per_triangle = 0.0;
   BuildReport build;
+  std::string build_notes;
   std::vector<double> mrays_per_s_runs;
   double mrays_per_s = 0.0;      // median of the runs
   double hit_agreement = 0.0;    // same hit / miss as the reference

@@ -36,7 +36,7 @@ const std::vector<ConfigKey>& config_schema() {
       {"render.pixel_order", T::text, std::string("scanline"), 0, 0, {"scanline", "zcurve"},
        "order in which camera rays are generated"},
 
-      {"accel.type", T::text, std::string("embree"), 0, 0, {"embree", "bvh"}, "main accelerator"},
+      {"accel.type", T::text, std::string("embree"), 0, 0, {"embree", "bvh", "grid"}, "main accelerator"},
       {"accel.embree.mode", T::text, std::string("default"), 0, 0, {"default", "compact", "robust"},
        "Embree scene flags"},
       {"accel.bvh.leaf_size", T::integer, std::int64_t{4}, 1, 16, {}, "most triangles per BVH leaf"},
@@ -45,6 +45,9 @@ const std::vector<ConfigKey>& config_schema() {
       {"accel.bvh.triangle_order", T::text, std::string("input"), 0, 0, {"input", "morton", "leaf"},
        "the BVH's indexed face set: the mesh's (input), a Morton-sorted copy, or a copy in leaf order"},
       {"accel.bvh.bins", T::integer, std::int64_t{16}, 2, 64, {}, "SAH bins per axis"},
+      {"accel.grid.density", T::real, 32.0, 0.01, 4096.0, {}, "cells per triangle (Woo's heuristic; the paper: 32)"},
+      {"accel.grid.max_cells", T::integer, std::int64_t{1} << 30, 1, std::int64_t{1} << 36, {},
+       "resolution guard: most cells of the grid (the density is lowered to fit)"},
       {"accel.bvh.width", T::integer, std::int64_t{2}, 2, 8, {}, "2: binary 32-byte nodes; 8: AVX2 8-wide nodes"},
 
       {"memory.budget", T::text, std::string("none"), 0, 0, {},

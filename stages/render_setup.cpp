@@ -63,6 +63,8 @@ AcceleratorOptions accelerator_options(const Config& config) {
   options.bvh.triangle_order = parse_triangle_order(config.text("accel.bvh.triangle_order"));
   options.bvh.bins = static_cast<std::uint32_t>(config.integer("accel.bvh.bins"));
   options.bvh.width = static_cast<std::uint32_t>(config.integer("accel.bvh.width"));
+  options.grid.density = config.real("accel.grid.density");
+  options.grid.max_cells = static_cast<std::size_t>(config.integer("accel.grid.max_cells"));
   if (options.bvh.width != 2 && options.bvh.width != 8) {
     throw ConfigError(fmt::format("accel.bvh.width = {}: must be 2 or 8", options.bvh.width));
   }

@@ -1,0 +1,301 @@
+// Counting construction of the hashed grid (D bits, first-fit row displacement for O, counts
+// and prefix sums for H, reverse insertion for L) and 3D-DDA traversal that stops once the
+// nearest hit found lies before the next cell.
+#include "accel/grid/hashed_grid.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+
+#include "kernels/ray_box.hpp"
+#include "kernels/triangle_intersect.hpp"
+#include "memory/cache_aligned_allocator.hpp"
+
+namespace wavetrace {
+namespace {
+
+constexpr float kInfinity = std::numeric_limits<float>::infinity();
+
+struct CellRange {
+  glm::uvec3 lower, upper;  // inclusive
+};
+
+class HashedGridAccelerator final : public Accelerator {
+ public:
+  HashedGridAccelerator(const TriangleMesh& mesh, const HashedGridOptions& options) : mesh_(mesh) {
+    const auto start = std::chrono::steady_clock::now();
+    choose_resolution(options);
+    const std::vector<CellRange> ranges = cell_ranges();
+    mark_cells(ranges);
+    displace_rows();
+    fill_lists(ranges);
+    build_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    build_.peak_bytes = memory().total() + ranges.size() * sizeof(CellRange) + row_scratch_bytes_;
+  }
+
+  std::string name() const override { return "grid"; }
+
+  void intersect_closest(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
+    traverse<false>(rays, hits, range);
+  }
+  void intersect_any(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
+    traverse<true>(rays, hits, range);
+  }
+
+  MemoryReport memory() const override {
+    MemoryReport report;
+    report.hierarchy = domain_.size() * sizeof(std::uint64_t) + offsets_.size() * sizeof(std::uint32_t) +
+                       starts_.size() * sizeof(std::uint32_t) + items_.size() * sizeof(std::uint32_t);
+    report.geometry = mesh_.positions.size() * sizeof(glm::vec3) + mesh_.triangles.size() * sizeof(glm::uvec3);
+    return report;
+  }
+  BuildReport build() const override { return build_; }
+  std::string build_notes() const override {
+    std::size_t occupied_cells = 0;
+    for (std::uint64_t word : domain_) occupied_cells += std::size_t(std::popcount(word));
+    std::string notes = fmt::format("{}x{}x{} cells, {} non-empty, {} slots in H, {:.2f} entries per triangle",
+                                    cells_.x, cells_.y, cells_.z, occupied_cells, slot_count_,
+                                    double(items_.size()) / double(mesh_.triangle_count()));
+    if (capped_) notes += fmt::format("; resolution guard: density lowered to {:.3g} to stay under {} cells",
+                                      effective_density_, max_cells_);
+    return notes;
+  }
+
+  std::vector<std::span<const std::byte>> memory_spans() const override {
+    return {std::as_bytes(std::span(domain_)), std::as_bytes(std::span(offsets_)), std::as_bytes(std::span(starts_)),
+            std::as_bytes(std::span(items_)), std::as_bytes(std::span(mesh_.positions)),
+            std::as_bytes(std::span(mesh_.triangles))};
+  }
+
+ private:
+  // Woo's heuristic: M_i = S_i · cbrt(ρN / V), capped so that Mx·My·Mz stays in the guard.
+  void choose_resolution(const HashedGridOptions& options) {
+    bounds_ = mesh_.bounds();
+    const glm::vec3 extent = bounds_.extent();
+    const float floor_extent = std::max(1e-6f * bounds_.diagonal(), 1e-30f);
+    const glm::dvec3 size(std::max(extent.x, floor_extent), std::max(extent.y, floor_extent),
+                          std::max(extent.z, floor_extent));
+    double scale = std::cbrt(options.density * double(mesh_.triangle_count()) / (size.x * size.y * size.z));
+    for (int attempt = 0; attempt < 64; ++attempt) {
+      for (int axis = 0; axis < 3; ++axis) {
+        cells_[axis] = static_cast<std::uint32_t>(std::clamp(std::ceil(size[axis] * scale), 1.0, double(1 << 21)));
+      }
+      if (double(cells_.x) * cells_.y * cells_.z <= double(options.max_cells)) break;
+      capped_ = true;
+      scale *= 0.97 * std::cbrt(double(options.max_cells) / (double(cells_.x) * cells_.y * cells_.z));
+    }
+    max_cells_ = options.max_cells;
+    effective_density_ = double(cells_.x) * cells_.y * cells_.z / double(mesh_.triangle_count());
+    cell_size_ = glm::vec3(size) / glm::vec3(cells_);
+    inverse_cell_size_ = 1.0f / cell_size_;
+    // Pad the box by a cell's thousandth so points on its upper faces fall inside.
+    upper_ = bounds_.lower + cell_size_ * glm::vec3(cells_) * (1.0f + 1e-6f) + cell_size_ * 1e-3f;
+  }
+
+  glm::uvec3 cell_of(const glm::vec3& point) const {
+    const glm::vec3 index = glm::floor((point - bounds_.lower) * inverse_cell_size_);
+    return glm::uvec3(glm::clamp(index, glm::vec3(0.0f), glm::vec3(cells_) - 1.0f));
+  }
+
+  // The cells each triangle's box overlaps, the box grown by a thousandth of a cell so that
+  // DDA rounding at cell faces never skips a cell holding a triangle it passes.
+  std::vector<CellRange> cell_ranges() const {
+    std::vector<CellRange> ranges(mesh_.triangle_count());
+    const glm::vec3 slack = cell_size_ * 1e-3f;
+    tbb::parallel_for(std::size_t{0}, mesh_.triangle_count(), [&](std::size_t t) {
+      const glm::uvec3& tri = mesh_.triangles[t];
+      const glm::vec3 a = mesh_.positions[tri.x], b = mesh_.positions[tri.y], c = mesh_.positions[tri.z];
+      ranges[t] = {cell_of(glm::min(a, glm::min(b, c)) - slack), cell_of(glm::max(a, glm::max(b, c)) + slack)};
+    });
+    return ranges;
+  }
+
+  std::size_t cell_index(std::uint32_t x, std::uint32_t y, std::uint32_t z) const {
+    return (std::size_t(z) * cells_.y + y) * cells_.x + x;
+  }
+
+  void mark_cells(const std::vector<CellRange>& ranges) {
+    const std::size_t cell_count = std::size_t(cells_.x) * cells_.y * cells_.z;
+    domain_.assign((cell_count + 63) / 64, 0);
+    tbb::parallel_for(std::size_t{0}, ranges.size(), [&](std::size_t t) {
+      const CellRange& r = ranges[t];
+      for (std::uint32_t z = r.lower.z; z <= r.upper.z; ++z) {
+        for (std::uint32_t y = r.lower.y; y <= r.upper.y; ++y) {
+          for (std::uint32_t x = r.lower.x; x <= r.upper.x; ++x) {
+            const std::size_t d = cell_index(x, y, z);
+            std::atomic_ref<std::uint64_t>(domain_[d / 64]).fetch_or(std::uint64_t{1} << (d % 64), std::memory_order_relaxed);
+          }
+        }
+      }
+    });
+  }
+
+  bool occupied(std::size_t d) const { return (domain_[d / 64] >> (d % 64)) & 1u; }
+
+  // First fit from the last row's offset, as the paper builds O: each row's set cells land on
+  // slots of the shared bit array bH that no earlier row took.
+  void displace_rows() {
+    offsets_.assign(std::size_t(cells_.y) * cells_.z, 0);
+    std::vector<std::uint64_t> taken(1024, 0);
+    const auto is_taken = [&](std::size_t slot) { return slot / 64 < taken.size() && ((taken[slot / 64] >> (slot % 64)) & 1u); };
+    std::vector<std::uint32_t> row;
+    std::size_t last_offset = 0, used_slots = 0;
+    for (std::uint32_t z = 0; z < cells_.z; ++z) {
+      for (std::uint32_t y = 0; y < cells_.y; ++y) {
+        row.clear();
+        const std::size_t first = cell_index(0, y, z);
+        for (std::uint32_t x = 0; x < cells_.x; ++x) {
+          if (occupied(first + x)) row.push_back(x);
+        }
+        if (row.empty()) continue;  // never read: its D bits are all clear
+        std::size_t offset = last_offset;
+        while (std::any_of(row.begin(), row.end(), [&](std::uint32_t x) { return is_taken(offset + x); })) ++offset;
+        const std::size_t end = offset + row.back() + 1;
+        if ((end + 63) / 64 > taken.size()) taken.resize(std::max(taken.size() * 2, (end + 63) / 64), 0);
+        for (std::uint32_t x : row) taken[(offset + x) / 64] |= std::uint64_t{1} << ((offset + x) % 64);
+        offsets_[std::size_t(z) * cells_.y + y] = static_cast<std::uint32_t>(offset);
+        used_slots = std::max(used_slots, end);
+        last_offset = offset;
+      }
+    }
+    slot_count_ = used_slots;
+    row_scratch_bytes_ = taken.size() * sizeof(std::uint64_t);
+  }
+
+  std::size_t slot_of(std::uint32_t x, std::uint32_t y, std::uint32_t z) const {
+    return offsets_[std::size_t(z) * cells_.y + y] + x;
+  }
+
+  // Counts per slot, prefix sums, then the paper's reverse insertion, which leaves each
+  // cell's list ascending and H[slot] at its start.
+  void fill_lists(const std::vector<CellRange>& ranges) {
+    starts_.assign(slot_count_ + 1, 0);
+    tbb::parallel_for(std::size_t{0}, ranges.size(), [&](std::size_t t) {
+      const CellRange& r = ranges[t];
+      for (std::uint32_t z = r.lower.z; z <= r.upper.z; ++z) {
+        for (std::uint32_t y = r.lower.y; y <= r.upper.y; ++y) {
+          for (std::uint32_t x = r.lower.x; x <= r.upper.x; ++x) {
+            std::atomic_ref<std::uint32_t>(starts_[slot_of(x, y, z)]).fetch_add(1, std::memory_order_relaxed);
+          }
+        }
+      }
+    });
+    std::uint64_t total = 0;
+    for (std::uint32_t& start : starts_) total = (start += static_cast<std::uint32_t>(total));
+    if (total > std::numeric_limits<std::uint32_t>::max()) {
+      throw std::runtime_error("grid: more than 2^32 cell entries; lower accel.grid.density");
+    }
+    items_.resize(total);
+    for (std::size_t t = ranges.size(); t-- > 0;) {
+      const CellRange& r = ranges[t];
+      for (std::uint32_t z = r.lower.z; z <= r.upper.z; ++z) {
+        for (std::uint32_t y = r.lower.y; y <= r.upper.y; ++y) {
+          for (std::uint32_t x = r.lower.x; x <= r.upper.x; ++x) items_[--starts_[slot_of(x, y, z)]] = std::uint32_t(t);
+        }
+      }
+    }
+  }
+
+  template <bool kAnyHit>
+  void traverse(const RayBatch& rays, HitBatch& hits, RayRange range) const {
+    const glm::vec3* positions = mesh_.positions.data();
+    const glm::uvec3* triangles = mesh_.triangles.data();
+    for (std::uint32_t i = range.begin; i < range.end; ++i) {
+      hits.t[i] = kInfinity;
+      hits.primitive[i] = kInvalidPrimitive;
+      hits.u[i] = hits.v[i] = 0.0f;
+      if (!(rays.flags[i] & ray_flags::alive)) continue;
+      const glm::vec3 origin(rays.origin_x[i], rays.origin_y[i], rays.origin_z[i]);
+      const glm::vec3 direction(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]);
+      const float tmin = rays.tmin[i];
+      float near = 0.0f, far = 0.0f;
+      if (!clip_to_box(make_box_ray(origin, direction), bounds_.lower, upper_, tmin, rays.tmax[i], near, far)) continue;
+
+      // Amanatides & Woo: the first cell, where each axis next crosses a cell face, and how
+      // far apart those crossings are.
+      glm::ivec3 cell(cell_of(origin + direction * near));
+      glm::ivec3 step;
+      glm::vec3 next_crossing, crossing_interval;
+      for (int axis = 0; axis < 3; ++axis) {
+        if (direction[axis] > 0.0f) {
+          step[axis] = 1;
+          next_crossing[axis] = (bounds_.lower[axis] + float(cell[axis] + 1) * cell_size_[axis] - origin[axis]) / direction[axis];
+          crossing_interval[axis] = cell_size_[axis] / direction[axis];
+        } else if (direction[axis] < 0.0f) {
+          step[axis] = -1;
+          next_crossing[axis] = (bounds_.lower[axis] + float(cell[axis]) * cell_size_[axis] - origin[axis]) / direction[axis];
+          crossing_interval[axis] = -cell_size_[axis] / direction[axis];
+        } else {
+          step[axis] = 0;
+          next_crossing[axis] = kInfinity;
+          crossing_interval[axis] = kInfinity;
+        }
+      }
+      const WatertightRay ray = make_watertight_ray(origin, direction);
+      float best = rays.tmax[i];
+      TriangleHit found{kInfinity, 0.0f, 0.0f};
+      std::uint32_t found_triangle = kInvalidPrimitive;
+      while (true) {
+        const std::size_t d = cell_index(std::uint32_t(cell.x), std::uint32_t(cell.y), std::uint32_t(cell.z));
+        if (occupied(d)) {
+          const std::size_t slot = slot_of(std::uint32_t(cell.x), std::uint32_t(cell.y), std::uint32_t(cell.z));
+          for (std::uint32_t k = starts_[slot]; k < starts_[slot + 1]; ++k) {
+            const glm::uvec3& tri = triangles[items_[k]];
+            TriangleHit hit;
+            if (intersect_watertight(ray, positions[tri.x], positions[tri.y], positions[tri.z], tmin, best, hit)) {
+              best = hit.t;
+              found = hit;
+              found_triangle = items_[k];
+              if constexpr (kAnyHit) break;
+            }
+          }
+          if (kAnyHit && found_triangle != kInvalidPrimitive) break;
+        }
+        // Leave the cell: done once the nearest hit lies before the next cell begins.
+        const int axis = next_crossing.x < next_crossing.y ? (next_crossing.x < next_crossing.z ? 0 : 2)
+                                                            : (next_crossing.y < next_crossing.z ? 1 : 2);
+        const float exit = next_crossing[axis];
+        if (exit >= best || exit > far) break;
+        cell[axis] += step[axis];
+        if (cell[axis] < 0 || cell[axis] >= int(cells_[axis])) break;
+        next_crossing[axis] += crossing_interval[axis];
+      }
+      if (found_triangle != kInvalidPrimitive) {
+        hits.t[i] = found.t;
+        hits.primitive[i] = found_triangle;
+        hits.u[i] = found.u;
+        hits.v[i] = found.v;
+      }
+    }
+  }
+
+  const TriangleMesh& mesh_;
+  Bounds3 bounds_;
+  glm::vec3 upper_{0.0f};
+  glm::uvec3 cells_{1};
+  glm::vec3 cell_size_{1.0f}, inverse_cell_size_{1.0f};
+  bool capped_ = false;
+  double effective_density_ = 0.0;
+  std::size_t max_cells_ = 0;
+  std::size_t slot_count_ = 0;
+  std::size_t row_scratch_bytes_ = 0;
+  LargeArray<std::uint64_t> domain_;   // D
+  LargeArray<std::uint32_t> offsets_;  // O
+  LargeArray<std::uint32_t> starts_;   // H
+  LargeArray<std::uint32_t> items_;    // L
+  BuildReport build_;
+};
+
+}  // namespace
+
+std::unique_ptr<Accelerator> make_hashed_grid_accelerator(const TriangleMesh& mesh, const HashedGridOptions& options) {
+  return std::make_unique<HashedGridAccelerator>(mesh, options);
+}
+
+}  // namespace wavetrace

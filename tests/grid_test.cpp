@@ -1,0 +1,165 @@
+// The one-level hashed grid: agreement with Embree (robust) on closed, soup, scanned,
+// open and sparse scenes, axis-parallel rays on cell faces, any hit, no leaks, the
+// resolution guard, and its memory report.
+#include <gtest/gtest.h>
+
+#include "accel/grid/hashed_grid.hpp"
+#include "accel/registry.hpp"
+#include "bench/leak_bench.hpp"
+#include "bench/ray_sets.hpp"
+#include "scene/builtin_scenes.hpp"
+
+namespace wavetrace {
+namespace {
+
+struct Disagreement {
+  std::size_t rays = 0, hit_differs = 0, far_t = 0;
+};
+
+Disagreement compare_with_robust_embree(const Scene& scene, const Accelerator& grid, RaySetKind kind, std::size_t count) {
+  AcceleratorOptions robust;
+  robust.embree.mode = EmbreeMode::robust;
+  const auto reference = make_accelerator(scene.mesh, robust);
+  const RaySet rays = make_ray_set(kind, scene, *reference, count);
+  const auto expected = trace_ray_set(*reference, rays);
+  const auto actual = trace_ray_set(grid, rays);
+  Disagreement result;
+  const float diagonal = scene.mesh.bounds().diagonal();
+  for (std::size_t b = 0; b < rays.batches.size(); ++b) {
+    for (std::size_t i = 0; i < rays.batches[b]->count; ++i) {
+      ++result.rays;
+      result.hit_differs += expected[b]->is_hit(i) != actual[b]->is_hit(i);
+      if (!rays.any_hit() && expected[b]->is_hit(i) && actual[b]->is_hit(i)) {
+        result.far_t += std::fabs(expected[b]->t[i] - actual[b]->t[i]) > 1e-4f * diagonal;
+      }
+    }
+  }
+  return result;
+}
+
+class GridAgreesWithEmbree : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(GridAgreesWithEmbree, OnAtLeast9999PerMyriadOfRays) {
+  const Scene scene = load_scene({GetParam(), 0});
+  for (const double density : {32.0, 4.0}) {
+    HashedGridOptions options;
+    options.density = density;
+    const auto grid = make_hashed_grid_accelerator(scene.mesh, options);
+    for (const RaySetKind kind : {RaySetKind::primary, RaySetKind::random, RaySetKind::diffuse, RaySetKind::shadow}) {
+      const Disagreement result = compare_with_robust_embree(scene, *grid, kind, 20000);
+      EXPECT_LE(double(result.hit_differs), 1e-4 * double(result.rays)) << to_string(kind) << " density " << density;
+      EXPECT_LE(double(result.far_t), 1e-4 * double(result.rays)) << to_string(kind) << " density " << density;
+    }
+  }
+}
+
+std::string scene_label(const ::testing::TestParamInfo<std::string>& info) {
+  static const std::vector<std::string> names = {"sphere", "soup", "terrain", "stadium", "bunny"};
+  return names[info.index];
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, GridAgreesWithEmbree,
+                         ::testing::Values("builtin:sphere:100k", "builtin:soup:50k", "builtin:terrain:50k",
+                                           "builtin:stadium:2000", std::string(WAVETRACE_DATA_DIR) + "/bunny00.off"),
+                         scene_label);
+
+TEST(Grid, AxisParallelRaysAlongCellFacesFromInsideAndOutside) {
+  // An axis-aligned box mesh on a grid whose cell faces it shares: rays along the axes,
+  // many of them exactly in face and edge planes, starting inside and outside the grid.
+  // A ray running along a box edge lies in two triangles' planes, where "hit" is a matter of
+  // convention (robust Embree says miss, our watertight test hit), so the reference is the
+  // BVH: the same triangle test, so any difference is the grid missing a cell.
+  const Scene stadium = make_builtin_scene("builtin:stadium:2000");
+  const auto reference = make_bvh_accelerator(stadium.mesh, BvhOptions{});
+  const auto grid = make_hashed_grid_accelerator(stadium.mesh, HashedGridOptions{});
+  RayBatch rays(4096);
+  const float coordinates[] = {-500.0f, -250.0f, 0.0f, 0.5f, 250.0f, 500.0f};
+  for (int axis = 0; axis < 3; ++axis) {
+    for (const float sign : {-1.0f, 1.0f}) {
+      for (const float start : {0.0f, -2000.0f * sign}) {  // inside the box, then outside the grid
+        for (const float a : coordinates) {
+          for (const float b : coordinates) {
+            const std::size_t i = rays.count++;
+            glm::vec3 origin(0.0f), direction(0.0f);
+            origin[axis] = start;
+            origin[(axis + 1) % 3] = a;
+            origin[(axis + 2) % 3] = b;
+            direction[axis] = sign;
+            rays.set_geometry(i, origin, direction, 0.0f, std::numeric_limits<float>::infinity());
+            rays.flags[i] = ray_flags::alive;
+            rays.kind[i] = RayKind::camera;
+          }
+        }
+      }
+    }
+  }
+  HitBatch expected(4096), actual(4096);
+  reference->intersect_closest(rays, expected, rays.all());
+  grid->intersect_closest(rays, actual, rays.all());
+  std::size_t inside_hits = 0;
+  for (std::size_t i = 0; i < rays.count; ++i) {
+    ASSERT_EQ(actual.is_hit(i), expected.is_hit(i)) << "ray " << i;
+    if (expected.is_hit(i)) {
+      EXPECT_NEAR(actual.t[i], expected.t[i], 1e-3f) << "ray " << i;
+      ++inside_hits;
+    }
+  }
+  EXPECT_GE(inside_hits, rays.count / 2);  // every ray from inside the closed box hits it
+}
+
+TEST(Grid, AnyHitMatchesClosestHitOnOcclusion) {
+  const Scene scene = make_builtin_scene("builtin:default:20000");
+  const auto grid = make_hashed_grid_accelerator(scene.mesh, HashedGridOptions{});
+  const auto reference = make_accelerator(scene.mesh, AcceleratorOptions{});
+  const RaySet shadows = make_ray_set(RaySetKind::shadow, scene, *reference, 20000);
+  const auto occluded = trace_ray_set(*grid, shadows);
+  std::size_t blocked = 0;
+  for (std::size_t b = 0; b < shadows.batches.size(); ++b) {
+    HitBatch closest(shadows.batches[b]->capacity());
+    grid->intersect_closest(*shadows.batches[b], closest, shadows.batches[b]->all());
+    for (std::size_t i = 0; i < shadows.batches[b]->count; ++i) {
+      ASSERT_EQ(occluded[b]->is_hit(i), closest.is_hit(i));
+      blocked += closest.is_hit(i);
+    }
+  }
+  EXPECT_GT(blocked, 0u);
+}
+
+TEST(Grid, NoRayEscapesTheClosedSphereOrTheRoom) {
+  for (const char* source : {"builtin:sphere:200k", "builtin:room:50k"}) {
+    const Scene scene = make_builtin_scene(source);
+    const LeakReport report = run_leak_bench(scene, {parse_accelerator_spec("grid", Config{})}, 200000, 0);
+    ASSERT_EQ(report.results.size(), 1u);
+    EXPECT_EQ(report.results[0].escaped, 0u) << source;
+  }
+}
+
+TEST(Grid, ResolutionGuardCapsTheCellsAndStaysCorrect) {
+  const Scene stadium = make_builtin_scene("builtin:stadium:5000");
+  HashedGridOptions options;
+  options.max_cells = 2000;
+  const auto guarded = make_hashed_grid_accelerator(stadium.mesh, options);
+  EXPECT_NE(guarded->build_notes().find("resolution guard"), std::string::npos) << guarded->build_notes();
+  const auto free = make_hashed_grid_accelerator(stadium.mesh, HashedGridOptions{});
+  EXPECT_EQ(free->build_notes().find("resolution guard"), std::string::npos) << free->build_notes();
+  EXPECT_LT(guarded->memory().hierarchy, free->memory().hierarchy);
+  const Disagreement result = compare_with_robust_embree(stadium, *guarded, RaySetKind::primary, 5000);
+  EXPECT_EQ(result.hit_differs, 0u);
+}
+
+TEST(Grid, MemoryIsItsFourArraysAndTheMeshItReadsInPlace) {
+  const Scene scene = make_builtin_scene("builtin:sphere:50k");
+  const auto grid = make_hashed_grid_accelerator(scene.mesh, HashedGridOptions{});
+  const MemoryReport memory = grid->memory();
+  EXPECT_EQ(memory.geometry, scene.mesh.vertex_count() * 12 + scene.mesh.triangle_count() * 12);
+  std::size_t spans = 0;
+  for (const auto& span : grid->memory_spans()) spans += span.size();
+  EXPECT_EQ(spans, memory.total());
+  // Every triangle is listed at least once: L holds at least N entries.
+  EXPECT_GE(memory.hierarchy, scene.mesh.triangle_count() * sizeof(std::uint32_t));
+  EXPECT_GT(grid->build().seconds, 0.0);
+  EXPECT_GE(grid->build().peak_bytes, memory.total());
+}
+
+}  // namespace
+}  // namespace wavetrace
