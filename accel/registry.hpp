@@ -18,6 +18,7 @@ struct AcceleratorOptions {
   EmbreeOptions embree;
   BvhOptions bvh;
   HashedGridOptions grid;
+  HashedGridOptions mlgrid{32.0, std::size_t{1} << 30, 6};
 };
 
 std::vector<std::string> accelerator_names();

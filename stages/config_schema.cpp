@@ -36,7 +36,7 @@ const std::vector<ConfigKey>& config_schema() {
       {"render.pixel_order", T::text, std::string("scanline"), 0, 0, {"scanline", "zcurve"},
        "order in which camera rays are generated"},
 
-      {"accel.type", T::text, std::string("embree"), 0, 0, {"embree", "bvh", "grid"}, "main accelerator"},
+      {"accel.type", T::text, std::string("embree"), 0, 0, {"embree", "bvh", "grid", "mlgrid"}, "main accelerator"},
       {"accel.embree.mode", T::text, std::string("default"), 0, 0, {"default", "compact", "robust"},
        "Embree scene flags"},
       {"accel.bvh.leaf_size", T::integer, std::int64_t{4}, 1, 16, {}, "most triangles per BVH leaf"},
@@ -48,6 +48,11 @@ const std::vector<ConfigKey>& config_schema() {
       {"accel.grid.density", T::real, 32.0, 0.01, 4096.0, {}, "cells per triangle (Woo's heuristic; the paper: 32)"},
       {"accel.grid.max_cells", T::integer, std::int64_t{1} << 30, 1, std::int64_t{1} << 36, {},
        "resolution guard: most cells of the grid (the density is lowered to fit)"},
+      {"accel.mlgrid.density", T::real, 32.0, 0.01, 4096.0, {}, "cells per triangle of mlgrid's fine grid"},
+      {"accel.mlgrid.max_cells", T::integer, std::int64_t{1} << 30, 1, std::int64_t{1} << 36, {},
+       "resolution guard of mlgrid"},
+      {"accel.mlgrid.macrocell_factor", T::integer, std::int64_t{6}, 2, 64, {},
+       "fine cells per macrocell side, per level (the paper: 6)"},
       {"accel.bvh.width", T::integer, std::int64_t{2}, 2, 8, {}, "2: binary 32-byte nodes; 8: AVX2 8-wide nodes"},
 
       {"memory.budget", T::text, std::string("none"), 0, 0, {},

@@ -65,6 +65,9 @@ AcceleratorOptions accelerator_options(const Config& config) {
   options.bvh.width = static_cast<std::uint32_t>(config.integer("accel.bvh.width"));
   options.grid.density = config.real("accel.grid.density");
   options.grid.max_cells = static_cast<std::size_t>(config.integer("accel.grid.max_cells"));
+  options.mlgrid.density = config.real("accel.mlgrid.density");
+  options.mlgrid.max_cells = static_cast<std::size_t>(config.integer("accel.mlgrid.max_cells"));
+  options.mlgrid.macrocell_factor = static_cast<std::uint32_t>(config.integer("accel.mlgrid.macrocell_factor"));
   if (options.bvh.width != 2 && options.bvh.width != 8) {
     throw ConfigError(fmt::format("accel.bvh.width = {}: must be 2 or 8", options.bvh.width));
   }

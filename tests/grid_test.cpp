@@ -5,6 +5,7 @@
 
 #include "accel/grid/hashed_grid.hpp"
 #include "accel/registry.hpp"
+#include "bench/accel_bench.hpp"
 #include "bench/leak_bench.hpp"
 #include "bench/ray_sets.hpp"
 #include "scene/builtin_scenes.hpp"
@@ -41,14 +42,19 @@ class GridAgreesWithEmbree : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(GridAgreesWithEmbree, OnAtLeast9999PerMyriadOfRays) {
   const Scene scene = load_scene({GetParam(), 0});
-  for (const double density : {32.0, 4.0}) {
-    HashedGridOptions options;
-    options.density = density;
-    const auto grid = make_hashed_grid_accelerator(scene.mesh, options);
-    for (const RaySetKind kind : {RaySetKind::primary, RaySetKind::random, RaySetKind::diffuse, RaySetKind::shadow}) {
-      const Disagreement result = compare_with_robust_embree(scene, *grid, kind, 20000);
-      EXPECT_LE(double(result.hit_differs), 1e-4 * double(result.rays)) << to_string(kind) << " density " << density;
-      EXPECT_LE(double(result.far_t), 1e-4 * double(result.rays)) << to_string(kind) << " density " << density;
+  for (const std::uint32_t macrocells : {0u, 6u, 2u}) {  // grid, mlgrid, mlgrid with many levels
+    for (const double density : {32.0, 4.0}) {
+      HashedGridOptions options;
+      options.density = density;
+      options.macrocell_factor = macrocells;
+      const auto grid = make_hashed_grid_accelerator(scene.mesh, options);
+      for (const RaySetKind kind : {RaySetKind::primary, RaySetKind::random, RaySetKind::diffuse, RaySetKind::shadow}) {
+        const Disagreement result = compare_with_robust_embree(scene, *grid, kind, 10000);
+        EXPECT_LE(double(result.hit_differs), 1e-4 * double(result.rays))
+            << to_string(kind) << " density " << density << " macrocells " << macrocells;
+        EXPECT_LE(double(result.far_t), 1e-4 * double(result.rays))
+            << to_string(kind) << " density " << density << " macrocells " << macrocells;
+      }
     }
   }
 }
@@ -71,7 +77,10 @@ TEST(Grid, AxisParallelRaysAlongCellFacesFromInsideAndOutside) {
   // BVH: the same triangle test, so any difference is the grid missing a cell.
   const Scene stadium = make_builtin_scene("builtin:stadium:2000");
   const auto reference = make_bvh_accelerator(stadium.mesh, BvhOptions{});
+  HashedGridOptions with_macrocells;
+  with_macrocells.macrocell_factor = 6;
   const auto grid = make_hashed_grid_accelerator(stadium.mesh, HashedGridOptions{});
+  const auto mlgrid = make_hashed_grid_accelerator(stadium.mesh, with_macrocells);
   RayBatch rays(4096);
   const float coordinates[] = {-500.0f, -250.0f, 0.0f, 0.5f, 250.0f, 500.0f};
   for (int axis = 0; axis < 3; ++axis) {
@@ -93,9 +102,16 @@ TEST(Grid, AxisParallelRaysAlongCellFacesFromInsideAndOutside) {
       }
     }
   }
-  HitBatch expected(4096), actual(4096);
+  HitBatch expected(4096), actual(4096), macro(4096);
   reference->intersect_closest(rays, expected, rays.all());
   grid->intersect_closest(rays, actual, rays.all());
+  mlgrid->intersect_closest(rays, macro, rays.all());
+  for (std::size_t i = 0; i < rays.count; ++i) {
+    ASSERT_EQ(macro.is_hit(i), expected.is_hit(i)) << "mlgrid ray " << i;
+    if (expected.is_hit(i)) {
+      EXPECT_NEAR(macro.t[i], expected.t[i], 1e-3f) << "mlgrid ray " << i;
+    }
+  }
   std::size_t inside_hits = 0;
   for (std::size_t i = 0; i < rays.count; ++i) {
     ASSERT_EQ(actual.is_hit(i), expected.is_hit(i)) << "ray " << i;
@@ -128,9 +144,11 @@ TEST(Grid, AnyHitMatchesClosestHitOnOcclusion) {
 TEST(Grid, NoRayEscapesTheClosedSphereOrTheRoom) {
   for (const char* source : {"builtin:sphere:200k", "builtin:room:50k"}) {
     const Scene scene = make_builtin_scene(source);
-    const LeakReport report = run_leak_bench(scene, {parse_accelerator_spec("grid", Config{})}, 200000, 0);
-    ASSERT_EQ(report.results.size(), 1u);
+    const LeakReport report = run_leak_bench(
+        scene, {parse_accelerator_spec("grid", Config{}), parse_accelerator_spec("mlgrid", Config{})}, 200000, 0);
+    ASSERT_EQ(report.results.size(), 2u);
     EXPECT_EQ(report.results[0].escaped, 0u) << source;
+    EXPECT_EQ(report.results[1].escaped, 0u) << source;
   }
 }
 
@@ -145,6 +163,19 @@ TEST(Grid, ResolutionGuardCapsTheCellsAndStaysCorrect) {
   EXPECT_LT(guarded->memory().hierarchy, free->memory().hierarchy);
   const Disagreement result = compare_with_robust_embree(stadium, *guarded, RaySetKind::primary, 5000);
   EXPECT_EQ(result.hit_differs, 0u);
+}
+
+TEST(Grid, MacrocellLevelsCoverTheGridAndCostLittle) {
+  const Scene scene = make_builtin_scene("builtin:sphere:50k");
+  HashedGridOptions options;
+  options.macrocell_factor = 6;
+  const auto grid = make_hashed_grid_accelerator(scene.mesh, HashedGridOptions{});
+  const auto mlgrid = make_hashed_grid_accelerator(scene.mesh, options);
+  EXPECT_EQ(mlgrid->name(), "mlgrid");
+  EXPECT_NE(mlgrid->build_notes().find("macrocells level 1"), std::string::npos) << mlgrid->build_notes();
+  EXPECT_GT(mlgrid->memory().hierarchy, grid->memory().hierarchy);
+  EXPECT_LT(mlgrid->memory().hierarchy, grid->memory().hierarchy * 11 / 10);  // a bit per 216 cells and up
+  EXPECT_THROW(parse_accelerator_spec("mlgrid:macrocell_factor=1", Config{}), ConfigError);
 }
 
 TEST(Grid, MemoryIsItsFourArraysAndTheMeshItReadsInPlace) {

@@ -35,11 +35,12 @@ class HashedGridAccelerator final : public Accelerator {
     mark_cells(ranges);
     displace_rows();
     fill_lists(ranges);
+    build_macrocells(options.macrocell_factor);
     build_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     build_.peak_bytes = memory().total() + ranges.size() * sizeof(CellRange) + row_scratch_bytes_;
   }
 
-  std::string name() const override { return "grid"; }
+  std::string name() const override { return macrocell_factor_ > 0 ? "mlgrid" : "grid"; }
 
   void intersect_closest(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
     traverse<false>(rays, hits, range);
@@ -52,6 +53,7 @@ class HashedGridAccelerator final : public Accelerator {
     MemoryReport report;
     report.hierarchy = domain_.size() * sizeof(std::uint64_t) + offsets_.size() * sizeof(std::uint32_t) +
                        starts_.size() * sizeof(std::uint32_t) + items_.size() * sizeof(std::uint32_t);
+    for (const MacrocellLevel& level : macrocells_) report.hierarchy += level.bits.size() * sizeof(std::uint64_t);
     report.geometry = mesh_.positions.size() * sizeof(glm::vec3) + mesh_.triangles.size() * sizeof(glm::uvec3);
     return report;
   }
@@ -62,15 +64,22 @@ class HashedGridAccelerator final : public Accelerator {
     std::string notes = fmt::format("{}x{}x{} cells, {} non-empty, {} slots in H, {:.2f} entries per triangle",
                                     cells_.x, cells_.y, cells_.z, occupied_cells, slot_count_,
                                     double(items_.size()) / double(mesh_.triangle_count()));
+    for (std::size_t k = 0; k < macrocells_.size(); ++k) {
+      notes += fmt::format("; macrocells level {}: {}x{}x{}", k + 1, macrocells_[k].cells.x, macrocells_[k].cells.y,
+                           macrocells_[k].cells.z);
+    }
     if (capped_) notes += fmt::format("; resolution guard: density lowered to {:.3g} to stay under {} cells",
                                       effective_density_, max_cells_);
     return notes;
   }
 
   std::vector<std::span<const std::byte>> memory_spans() const override {
-    return {std::as_bytes(std::span(domain_)), std::as_bytes(std::span(offsets_)), std::as_bytes(std::span(starts_)),
-            std::as_bytes(std::span(items_)), std::as_bytes(std::span(mesh_.positions)),
-            std::as_bytes(std::span(mesh_.triangles))};
+    std::vector<std::span<const std::byte>> spans = {
+        std::as_bytes(std::span(domain_)), std::as_bytes(std::span(offsets_)), std::as_bytes(std::span(starts_)),
+        std::as_bytes(std::span(items_)), std::as_bytes(std::span(mesh_.positions)),
+        std::as_bytes(std::span(mesh_.triangles))};
+    for (const MacrocellLevel& level : macrocells_) spans.push_back(std::as_bytes(std::span(level.bits)));
+    return spans;
   }
 
  private:
@@ -202,6 +211,33 @@ class HashedGridAccelerator final : public Accelerator {
     }
   }
 
+  // Macrocells (Wald et al. 2006, as the paper uses them): level k is a bit per block of
+  // factor^k fine cells, set when any cell in the block holds items; levels stop at one block.
+  void build_macrocells(std::uint32_t factor) {
+    macrocell_factor_ = factor;
+    if (factor < 2) return;
+    std::uint32_t span = 1;
+    glm::uvec3 cells = cells_;
+    while (macrocells_.size() < 4 && (cells.x > 1 || cells.y > 1 || cells.z > 1)) {
+      span *= factor;
+      MacrocellLevel level;
+      level.span = span;
+      level.cells = (cells_ + span - 1u) / span;
+      level.bits.assign((std::size_t(level.cells.x) * level.cells.y * level.cells.z + 63) / 64, 0);
+      for (std::size_t word = 0; word < domain_.size(); ++word) {
+        for (std::uint64_t bits = domain_[word]; bits != 0; bits &= bits - 1) {
+          const std::size_t d = word * 64 + std::size_t(std::countr_zero(bits));
+          const std::uint32_t x = std::uint32_t(d % cells_.x), y = std::uint32_t(d / cells_.x % cells_.y),
+                              z = std::uint32_t(d / (std::size_t(cells_.x) * cells_.y));
+          const std::size_t m = level.index(glm::uvec3(x, y, z) / span);
+          level.bits[m / 64] |= std::uint64_t{1} << (m % 64);
+        }
+      }
+      cells = level.cells;
+      macrocells_.push_back(std::move(level));
+    }
+  }
+
   template <bool kAnyHit>
   void traverse(const RayBatch& rays, HitBatch& hits, RayRange range) const {
     const glm::vec3* positions = mesh_.positions.data();
@@ -222,26 +258,44 @@ class HashedGridAccelerator final : public Accelerator {
       glm::ivec3 cell(cell_of(origin + direction * near));
       glm::ivec3 step;
       glm::vec3 next_crossing, crossing_interval;
+      // Where the ray next crosses a face of `cell` on each axis (also after a macrocell jump).
+      const auto face_crossing = [&](int axis, int face) {
+        return (bounds_.lower[axis] + float(face) * cell_size_[axis] - origin[axis]) / direction[axis];
+      };
       for (int axis = 0; axis < 3; ++axis) {
-        if (direction[axis] > 0.0f) {
-          step[axis] = 1;
-          next_crossing[axis] = (bounds_.lower[axis] + float(cell[axis] + 1) * cell_size_[axis] - origin[axis]) / direction[axis];
-          crossing_interval[axis] = cell_size_[axis] / direction[axis];
-        } else if (direction[axis] < 0.0f) {
-          step[axis] = -1;
-          next_crossing[axis] = (bounds_.lower[axis] + float(cell[axis]) * cell_size_[axis] - origin[axis]) / direction[axis];
-          crossing_interval[axis] = -cell_size_[axis] / direction[axis];
-        } else {
-          step[axis] = 0;
-          next_crossing[axis] = kInfinity;
-          crossing_interval[axis] = kInfinity;
-        }
+        step[axis] = direction[axis] > 0.0f ? 1 : direction[axis] < 0.0f ? -1 : 0;
+        crossing_interval[axis] = step[axis] != 0 ? cell_size_[axis] / std::fabs(direction[axis]) : kInfinity;
       }
+      const auto start_in_cell = [&] {
+        for (int axis = 0; axis < 3; ++axis) {
+          next_crossing[axis] = step[axis] == 0 ? kInfinity : face_crossing(axis, cell[axis] + (step[axis] > 0 ? 1 : 0));
+        }
+      };
+      start_in_cell();
       const WatertightRay ray = make_watertight_ray(origin, direction);
       float best = rays.tmax[i];
       TriangleHit found{kInfinity, 0.0f, 0.0f};
       std::uint32_t found_triangle = kInvalidPrimitive;
       while (true) {
+        // In an empty macrocell, jump past its block: out through the face the ray leaves by.
+        if (const MacrocellLevel* empty = coarsest_empty_macrocell(glm::uvec3(cell))) {
+          const glm::ivec3 lower = glm::ivec3(glm::uvec3(cell) / empty->span * empty->span);
+          const glm::ivec3 upper = glm::min(lower + int(empty->span) - 1, glm::ivec3(cells_) - 1);
+          float exit = kInfinity;
+          int exit_axis = 0;
+          for (int axis = 0; axis < 3; ++axis) {
+            if (step[axis] == 0) continue;
+            const float t = face_crossing(axis, step[axis] > 0 ? upper[axis] + 1 : lower[axis]);
+            if (t < exit) exit = t, exit_axis = axis;
+          }
+          if (exit >= best || exit > far) break;
+          const glm::ivec3 landing(cell_of(origin + direction * exit));
+          for (int axis = 0; axis < 3; ++axis) cell[axis] = std::clamp(landing[axis], lower[axis], upper[axis]);
+          cell[exit_axis] = step[exit_axis] > 0 ? upper[exit_axis] + 1 : lower[exit_axis] - 1;
+          if (cell[exit_axis] < 0 || cell[exit_axis] >= int(cells_[exit_axis])) break;
+          start_in_cell();
+          continue;
+        }
         const std::size_t d = cell_index(std::uint32_t(cell.x), std::uint32_t(cell.y), std::uint32_t(cell.z));
         if (occupied(d)) {
           const std::size_t slot = slot_of(std::uint32_t(cell.x), std::uint32_t(cell.y), std::uint32_t(cell.z));
@@ -285,6 +339,29 @@ class HashedGridAccelerator final : public Accelerator {
   std::size_t max_cells_ = 0;
   std::size_t slot_count_ = 0;
   std::size_t row_scratch_bytes_ = 0;
+  struct MacrocellLevel {
+    std::uint32_t span = 1;  // fine cells per block side
+    glm::uvec3 cells{1};
+    std::vector<std::uint64_t> bits;
+    std::size_t index(const glm::uvec3& block) const { return (std::size_t(block.z) * cells.y + block.y) * cells.x + block.x; }
+    bool occupied(const glm::uvec3& block) const {
+      const std::size_t m = index(block);
+      return (bits[m / 64] >> (m % 64)) & 1u;
+    }
+  };
+  // The coarsest level whose block around `cell` is empty (levels nest, so checking from the
+  // finest up stops at the first occupied one); null when the finest block holds items.
+  const MacrocellLevel* coarsest_empty_macrocell(const glm::uvec3& cell) const {
+    const MacrocellLevel* empty = nullptr;
+    for (const MacrocellLevel& level : macrocells_) {
+      if (level.occupied(cell / level.span)) break;
+      empty = &level;
+    }
+    return empty;
+  }
+
+  std::uint32_t macrocell_factor_ = 0;
+  std::vector<MacrocellLevel> macrocells_;
   LargeArray<std::uint64_t> domain_;   // D
   LargeArray<std::uint32_t> offsets_;  // O
   LargeArray<std::uint32_t> starts_;   // H

@@ -1,6 +1,8 @@
 // `grid`: the one-level hashed grid of Costa and Pereira (2010, §3.1–3.2) — a uniform grid
 // of density ρ (Woo's heuristic) whose empty cells cost one bit each, the non-empty ones
 // found through row displacement hashing (Lagae and Dutré 2008) — traversed by 3D-DDA.
+// `mlgrid` (§3.3) is the same grid with levels of macrocell bits that traversal uses to jump
+// over empty blocks; a level-k bit covers factor^k cells per side (x fastest, like D).
 //
 // Layout (all arrays 32-bit words except D), for a grid of Mx × My × Mz cells:
 //   D  Mx·My·Mz bits          bit d(x,y,z) = (Mz... ) ((z·My + y)·Mx + x): the cell holds items
@@ -24,6 +26,9 @@ struct HashedGridOptions {
   // The resolution guard: cells in all are capped here (the density is lowered to fit, and
   // the build reports it), since a scene like builtin:stadium would otherwise explode.
   std::size_t max_cells = std::size_t{1} << 30;
+  // mlgrid (§3.3): levels of macrocells, each a bit per block of factor^k cells, so that
+  // traversal jumps over empty space; 0 for the plain one-level grid. The paper: 6.
+  std::uint32_t macrocell_factor = 0;
 };
 
 // `mesh` must outlive the accelerator (its arrays are read in place).
