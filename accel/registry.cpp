@@ -1,5 +1,5 @@
-// Name-to-builder table of the accelerators that exist today (arraygrid, raystrips and hmq
-// are not written yet).
+// Name-to-builder table of the accelerators that exist today (raystrips and hmq are not
+// written yet).
 #include "accel/registry.hpp"
 
 #include <stdexcept>
@@ -8,12 +8,13 @@
 
 namespace wavetrace {
 
-std::vector<std::string> accelerator_names() { return {"embree", "bvh", "grid", "mlgrid"}; }
+std::vector<std::string> accelerator_names() { return {"embree", "bvh", "grid", "mlgrid", "arraygrid"}; }
 
 std::unique_ptr<Accelerator> make_accelerator(const TriangleMesh& mesh, const AcceleratorOptions& options) {
   if (options.type == "embree") return make_embree_accelerator(mesh, options.embree);
   if (options.type == "bvh") return make_bvh_accelerator(mesh, options.bvh);
   if (options.type == "grid") return make_hashed_grid_accelerator(mesh, options.grid);
+  if (options.type == "arraygrid") return make_array_grid_accelerator(mesh, options.arraygrid);
   if (options.type == "mlgrid") {
     HashedGridOptions grid = options.mlgrid;
     if (grid.macrocell_factor < 2) throw std::invalid_argument("mlgrid needs a macrocell factor of 2 or more");

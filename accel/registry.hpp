@@ -8,6 +8,7 @@
 #include "accel/accelerator.hpp"
 #include "accel/bvh/bvh_accelerator.hpp"
 #include "accel/embree/embree_accelerator.hpp"
+#include "accel/grid/array_grid.hpp"
 #include "accel/grid/hashed_grid.hpp"
 #include "scene/triangle_mesh.hpp"
 
@@ -19,6 +20,7 @@ struct AcceleratorOptions {
   BvhOptions bvh;
   HashedGridOptions grid;
   HashedGridOptions mlgrid{32.0, std::size_t{1} << 30, 6};
+  ArrayGridOptions arraygrid;
 };
 
 std::vector<std::string> accelerator_names();

@@ -36,7 +36,7 @@ const std::vector<ConfigKey>& config_schema() {
       {"render.pixel_order", T::text, std::string("scanline"), 0, 0, {"scanline", "zcurve"},
        "order in which camera rays are generated"},
 
-      {"accel.type", T::text, std::string("embree"), 0, 0, {"embree", "bvh", "grid", "mlgrid"}, "main accelerator"},
+      {"accel.type", T::text, std::string("embree"), 0, 0, {"embree", "bvh", "grid", "mlgrid", "arraygrid"}, "main accelerator"},
       {"accel.embree.mode", T::text, std::string("default"), 0, 0, {"default", "compact", "robust"},
        "Embree scene flags"},
       {"accel.bvh.leaf_size", T::integer, std::int64_t{4}, 1, 16, {}, "most triangles per BVH leaf"},
@@ -53,6 +53,12 @@ const std::vector<ConfigKey>& config_schema() {
        "resolution guard of mlgrid"},
       {"accel.mlgrid.macrocell_factor", T::integer, std::int64_t{6}, 2, 64, {},
        "fine cells per macrocell side, per level (the paper: 6)"},
+      {"accel.arraygrid.density", T::real, 4.0, 0.01, 4096.0, {}, "cells per triangle of each nested grid (the paper: 4)"},
+      {"accel.arraygrid.refine_items", T::integer, std::int64_t{8}, 2, 1 << 20, {},
+       "a cell holding this many triangles is refined"},
+      {"accel.arraygrid.max_depth", T::integer, std::int64_t{2}, 0, 4, {}, "deepest nested grid (root: 0)"},
+      {"accel.arraygrid.max_cells", T::integer, std::int64_t{1} << 28, 1, std::int64_t{1} << 34, {},
+       "resolution guard: refinement stops once the grids hold this many cells"},
       {"accel.bvh.width", T::integer, std::int64_t{2}, 2, 8, {}, "2: binary 32-byte nodes; 8: AVX2 8-wide nodes"},
 
       {"memory.budget", T::text, std::string("none"), 0, 0, {},

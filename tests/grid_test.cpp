@@ -3,6 +3,7 @@
 // resolution guard, and its memory report.
 #include <gtest/gtest.h>
 
+#include "accel/grid/array_grid.hpp"
 #include "accel/grid/hashed_grid.hpp"
 #include "accel/registry.hpp"
 #include "bench/accel_bench.hpp"
@@ -42,6 +43,12 @@ class GridAgreesWithEmbree : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(GridAgreesWithEmbree, OnAtLeast9999PerMyriadOfRays) {
   const Scene scene = load_scene({GetParam(), 0});
+  const auto arraygrid = make_array_grid_accelerator(scene.mesh, ArrayGridOptions{});
+  for (const RaySetKind kind : {RaySetKind::primary, RaySetKind::random, RaySetKind::diffuse, RaySetKind::shadow}) {
+    const Disagreement result = compare_with_robust_embree(scene, *arraygrid, kind, 10000);
+    EXPECT_LE(double(result.hit_differs), 1e-4 * double(result.rays)) << to_string(kind) << " arraygrid";
+    EXPECT_LE(double(result.far_t), 1e-4 * double(result.rays)) << to_string(kind) << " arraygrid";
+  }
   for (const std::uint32_t macrocells : {0u, 6u, 2u}) {  // grid, mlgrid, mlgrid with many levels
     for (const double density : {32.0, 4.0}) {
       HashedGridOptions options;
@@ -81,6 +88,7 @@ TEST(Grid, AxisParallelRaysAlongCellFacesFromInsideAndOutside) {
   with_macrocells.macrocell_factor = 6;
   const auto grid = make_hashed_grid_accelerator(stadium.mesh, HashedGridOptions{});
   const auto mlgrid = make_hashed_grid_accelerator(stadium.mesh, with_macrocells);
+  const auto arraygrid = make_array_grid_accelerator(stadium.mesh, ArrayGridOptions{});
   RayBatch rays(4096);
   const float coordinates[] = {-500.0f, -250.0f, 0.0f, 0.5f, 250.0f, 500.0f};
   for (int axis = 0; axis < 3; ++axis) {
@@ -102,14 +110,17 @@ TEST(Grid, AxisParallelRaysAlongCellFacesFromInsideAndOutside) {
       }
     }
   }
-  HitBatch expected(4096), actual(4096), macro(4096);
+  HitBatch expected(4096), actual(4096), macro(4096), nested(4096);
   reference->intersect_closest(rays, expected, rays.all());
   grid->intersect_closest(rays, actual, rays.all());
   mlgrid->intersect_closest(rays, macro, rays.all());
+  arraygrid->intersect_closest(rays, nested, rays.all());
   for (std::size_t i = 0; i < rays.count; ++i) {
     ASSERT_EQ(macro.is_hit(i), expected.is_hit(i)) << "mlgrid ray " << i;
+    ASSERT_EQ(nested.is_hit(i), expected.is_hit(i)) << "arraygrid ray " << i;
     if (expected.is_hit(i)) {
       EXPECT_NEAR(macro.t[i], expected.t[i], 1e-3f) << "mlgrid ray " << i;
+      EXPECT_NEAR(nested.t[i], expected.t[i], 1e-3f) << "arraygrid ray " << i;
     }
   }
   std::size_t inside_hits = 0;
@@ -145,10 +156,12 @@ TEST(Grid, NoRayEscapesTheClosedSphereOrTheRoom) {
   for (const char* source : {"builtin:sphere:200k", "builtin:room:50k"}) {
     const Scene scene = make_builtin_scene(source);
     const LeakReport report = run_leak_bench(
-        scene, {parse_accelerator_spec("grid", Config{}), parse_accelerator_spec("mlgrid", Config{})}, 200000, 0);
-    ASSERT_EQ(report.results.size(), 2u);
-    EXPECT_EQ(report.results[0].escaped, 0u) << source;
-    EXPECT_EQ(report.results[1].escaped, 0u) << source;
+        scene,
+        {parse_accelerator_spec("grid", Config{}), parse_accelerator_spec("mlgrid", Config{}),
+         parse_accelerator_spec("arraygrid", Config{})},
+        200000, 0);
+    ASSERT_EQ(report.results.size(), 3u);
+    for (const LeakResult& result : report.results) EXPECT_EQ(result.escaped, 0u) << source << " " << result.label;
   }
 }
 
@@ -176,6 +189,25 @@ TEST(Grid, MacrocellLevelsCoverTheGridAndCostLittle) {
   EXPECT_GT(mlgrid->memory().hierarchy, grid->memory().hierarchy);
   EXPECT_LT(mlgrid->memory().hierarchy, grid->memory().hierarchy * 11 / 10);  // a bit per 216 cells and up
   EXPECT_THROW(parse_accelerator_spec("mlgrid:macrocell_factor=1", Config{}), ConfigError);
+}
+
+TEST(ArrayGrid, NestsCrowdedCellsAndItsGuardStopsRefinement) {
+  const Scene scene = make_builtin_scene("builtin:sphere:50k");
+  const auto nested = make_array_grid_accelerator(scene.mesh, ArrayGridOptions{});
+  ArrayGridOptions flat_options;
+  flat_options.max_depth = 0;
+  const auto flat = make_array_grid_accelerator(scene.mesh, flat_options);
+  EXPECT_NE(flat->build_notes().find("1 grids"), std::string::npos) << flat->build_notes();
+  EXPECT_EQ(nested->build_notes().find("1 grids"), std::string::npos) << nested->build_notes();
+  ArrayGridOptions guarded_options;
+  guarded_options.max_cells = 1000;
+  const auto guarded = make_array_grid_accelerator(scene.mesh, guarded_options);
+  EXPECT_NE(guarded->build_notes().find("resolution guard"), std::string::npos) << guarded->build_notes();
+  const Disagreement result = compare_with_robust_embree(scene, *guarded, RaySetKind::primary, 5000);
+  EXPECT_LE(double(result.hit_differs), 1e-4 * double(result.rays));
+  std::size_t spans = 0;
+  for (const auto& span : nested->memory_spans()) spans += span.size();
+  EXPECT_EQ(spans, nested->memory().total());
 }
 
 TEST(Grid, MemoryIsItsFourArraysAndTheMeshItReadsInPlace) {
