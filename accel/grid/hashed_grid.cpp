@@ -31,13 +31,12 @@ class HashedGridAccelerator final : public Accelerator {
   HashedGridAccelerator(const TriangleMesh& mesh, const HashedGridOptions& options) : mesh_(mesh) {
     const auto start = std::chrono::steady_clock::now();
     choose_resolution(options);
-    const std::vector<CellRange> ranges = cell_ranges();
-    mark_cells(ranges);
+    mark_cells();
     displace_rows();
-    fill_lists(ranges);
+    fill_lists();
     build_macrocells(options.macrocell_factor);
     build_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    build_.peak_bytes = memory().total() + ranges.size() * sizeof(CellRange) + row_scratch_bytes_;
+    build_.peak_bytes = memory().total() + row_scratch_bytes_ + slot_count_ * sizeof(std::uint32_t);  // + fill cursors
   }
 
   std::string name() const override { return macrocell_factor_ > 0 ? "mlgrid" : "grid"; }
@@ -112,28 +111,25 @@ class HashedGridAccelerator final : public Accelerator {
     return glm::uvec3(glm::clamp(index, glm::vec3(0.0f), glm::vec3(cells_) - 1.0f));
   }
 
-  // The cells each triangle's box overlaps, the box grown by a thousandth of a cell so that
-  // DDA rounding at cell faces never skips a cell holding a triangle it passes.
-  std::vector<CellRange> cell_ranges() const {
-    std::vector<CellRange> ranges(mesh_.triangle_count());
+  // The cells triangle t's box overlaps, the box grown by a thousandth of a cell so that
+  // DDA rounding at cell faces never skips a cell holding a triangle it passes. Recomputed
+  // in each pass rather than stored: cheaper than 24 bytes per triangle of fresh memory.
+  CellRange range_of(std::size_t t) const {
+    const glm::uvec3& tri = mesh_.triangles[t];
+    const glm::vec3 a = mesh_.positions[tri.x], b = mesh_.positions[tri.y], c = mesh_.positions[tri.z];
     const glm::vec3 slack = cell_size_ * 1e-3f;
-    tbb::parallel_for(std::size_t{0}, mesh_.triangle_count(), [&](std::size_t t) {
-      const glm::uvec3& tri = mesh_.triangles[t];
-      const glm::vec3 a = mesh_.positions[tri.x], b = mesh_.positions[tri.y], c = mesh_.positions[tri.z];
-      ranges[t] = {cell_of(glm::min(a, glm::min(b, c)) - slack), cell_of(glm::max(a, glm::max(b, c)) + slack)};
-    });
-    return ranges;
+    return {cell_of(glm::min(a, glm::min(b, c)) - slack), cell_of(glm::max(a, glm::max(b, c)) + slack)};
   }
 
   std::size_t cell_index(std::uint32_t x, std::uint32_t y, std::uint32_t z) const {
     return (std::size_t(z) * cells_.y + y) * cells_.x + x;
   }
 
-  void mark_cells(const std::vector<CellRange>& ranges) {
+  void mark_cells() {
     const std::size_t cell_count = std::size_t(cells_.x) * cells_.y * cells_.z;
     domain_.assign((cell_count + 63) / 64, 0);
-    tbb::parallel_for(std::size_t{0}, ranges.size(), [&](std::size_t t) {
-      const CellRange& r = ranges[t];
+    tbb::parallel_for(std::size_t{0}, mesh_.triangle_count(), [&](std::size_t t) {
+      const CellRange r = range_of(t);
       for (std::uint32_t z = r.lower.z; z <= r.upper.z; ++z) {
         for (std::uint32_t y = r.lower.y; y <= r.upper.y; ++y) {
           for (std::uint32_t x = r.lower.x; x <= r.upper.x; ++x) {
@@ -158,9 +154,13 @@ class HashedGridAccelerator final : public Accelerator {
     for (std::uint32_t z = 0; z < cells_.z; ++z) {
       for (std::uint32_t y = 0; y < cells_.y; ++y) {
         row.clear();
-        const std::size_t first = cell_index(0, y, z);
-        for (std::uint32_t x = 0; x < cells_.x; ++x) {
-          if (occupied(first + x)) row.push_back(x);
+        // The row's D bits, a word at a time: rows are mostly empty.
+        const std::size_t first = cell_index(0, y, z), row_end = first + cells_.x;
+        for (std::size_t word = first / 64; word * 64 < row_end; ++word) {
+          std::uint64_t bits = domain_[word];
+          if (word * 64 < first) bits &= ~std::uint64_t{0} << (first - word * 64);
+          if ((word + 1) * 64 > row_end) bits &= ~std::uint64_t{0} >> ((word + 1) * 64 - row_end);
+          for (; bits != 0; bits &= bits - 1) row.push_back(std::uint32_t(word * 64 + std::countr_zero(bits) - first));
         }
         if (row.empty()) continue;  // never read: its D bits are all clear
         std::size_t offset = last_offset;
@@ -181,12 +181,11 @@ class HashedGridAccelerator final : public Accelerator {
     return offsets_[std::size_t(z) * cells_.y + y] + x;
   }
 
-  // Counts per slot, prefix sums, then the paper's reverse insertion, which leaves each
-  // cell's list ascending and H[slot] at its start.
-  void fill_lists(const std::vector<CellRange>& ranges) {
+  // Counts per slot and prefix sums (H[slot] = where its list starts), then the lists.
+  void fill_lists() {
     starts_.assign(slot_count_ + 1, 0);
-    tbb::parallel_for(std::size_t{0}, ranges.size(), [&](std::size_t t) {
-      const CellRange& r = ranges[t];
+    tbb::parallel_for(std::size_t{0}, mesh_.triangle_count(), [&](std::size_t t) {
+      const CellRange r = range_of(t);
       for (std::uint32_t z = r.lower.z; z <= r.upper.z; ++z) {
         for (std::uint32_t y = r.lower.y; y <= r.upper.y; ++y) {
           for (std::uint32_t x = r.lower.x; x <= r.upper.x; ++x) {
@@ -195,20 +194,34 @@ class HashedGridAccelerator final : public Accelerator {
         }
       }
     });
+    // Exclusive prefix sums: H[slot] becomes the start of its list, H[NH] the total.
     std::uint64_t total = 0;
-    for (std::uint32_t& start : starts_) total = (start += static_cast<std::uint32_t>(total));
+    for (std::uint32_t& start : starts_) {
+      const std::uint32_t count = start;
+      start = static_cast<std::uint32_t>(total);
+      total += count;
+    }
     if (total > std::numeric_limits<std::uint32_t>::max()) {
       throw std::runtime_error("grid: more than 2^32 cell entries; lower accel.grid.density");
     }
     items_.resize(total);
-    for (std::size_t t = ranges.size(); t-- > 0;) {
-      const CellRange& r = ranges[t];
+    // The paper inserts serially in reverse (L[--H[j]] = i) to leave each list ascending;
+    // in parallel, claim slots with atomic cursors, then sort each (short) list.
+    std::vector<std::uint32_t> cursor(starts_.begin(), starts_.end() - 1);
+    tbb::parallel_for(std::size_t{0}, mesh_.triangle_count(), [&](std::size_t t) {
+      const CellRange r = range_of(t);
       for (std::uint32_t z = r.lower.z; z <= r.upper.z; ++z) {
         for (std::uint32_t y = r.lower.y; y <= r.upper.y; ++y) {
-          for (std::uint32_t x = r.lower.x; x <= r.upper.x; ++x) items_[--starts_[slot_of(x, y, z)]] = std::uint32_t(t);
+          for (std::uint32_t x = r.lower.x; x <= r.upper.x; ++x) {
+            items_[std::atomic_ref<std::uint32_t>(cursor[slot_of(x, y, z)]).fetch_add(1, std::memory_order_relaxed)] =
+                std::uint32_t(t);
+          }
         }
       }
-    }
+    });
+    tbb::parallel_for(std::size_t{0}, slot_count_, [&](std::size_t slot) {
+      std::sort(items_.begin() + starts_[slot], items_.begin() + starts_[slot + 1]);
+    });
   }
 
   // Macrocells (Wald et al. 2006, as the paper uses them): level k is a bit per block of
