@@ -113,10 +113,7 @@ LeakReport run_leak_bench(const Scene& scene, const std::vector<AcceleratorSpec>
         const auto id = static_cast<std::uint32_t>(b * kBatch + i);
         const glm::vec3& origin = points[id % points.size()];
         const UnitPair u = unit_pair(random_bits(id, 0, 3, RandomPurpose::benchmark));
-        const float z = 1.0f - 2.0f * u.first, phi = 2.0f * kPi * u.second;
-        const float ring = std::sqrt(std::max(0.0f, 1.0f - z * z));
-        rays.set_geometry(i, origin, glm::vec3(ring * std::cos(phi), ring * std::sin(phi), z), 0.0f,
-                          std::numeric_limits<float>::infinity());
+        rays.set_geometry(i, origin, uniform_sphere(u.first, u.second), 0.0f, std::numeric_limits<float>::infinity());
         rays.flags[i] = ray_flags::alive;
         rays.kind[i] = RayKind::camera;
       }

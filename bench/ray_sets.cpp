@@ -157,9 +157,7 @@ RaySet make_ray_set(RaySetKind kind, const Scene& scene, const Accelerator& refe
         const UnitPair on_sphere = unit_pair(random_bits(id, 0, 0, RandomPurpose::benchmark));
         const UnitPair inside = unit_pair(random_bits(id, 0, 1, RandomPurpose::benchmark));
         const float inside_z = unit_float(random_bits(id, 0, 2, RandomPurpose::benchmark));
-        const float z = 1.0f - 2.0f * on_sphere.first, phi = 2.0f * kPi * on_sphere.second;
-        const float ring = std::sqrt(std::max(0.0f, 1.0f - z * z));
-        const glm::vec3 origin = center + radius * glm::vec3(ring * std::cos(phi), ring * std::sin(phi), z);
+        const glm::vec3 origin = center + radius * uniform_sphere(on_sphere.first, on_sphere.second);
         const glm::vec3 target = bounds.lower + bounds.extent() * glm::vec3(inside.first, inside.second, inside_z);
         writer.add(origin, glm::normalize(target - origin), kInfinity, RayKind::camera, id);
       }

@@ -40,18 +40,6 @@ inline void clip_slab(float t0, float t1, float& near, float& far) {
   far = t1 < far ? t1 : far;
 }
 
-// Entry distance of the ray into [lower, upper] clipped to [tmin, tmax], or +inf on a miss.
-inline float intersect_box(const BoxRay& ray, const glm::vec3& lower, const glm::vec3& upper, float tmin, float tmax) {
-  float near = tmin, far = tmax;
-  clip_slab((lower.x - ray.origin.x) * ray.inverse_direction.x, (upper.x - ray.origin.x) * ray.inverse_direction.x,
-            near, far);
-  clip_slab((lower.y - ray.origin.y) * ray.inverse_direction.y, (upper.y - ray.origin.y) * ray.inverse_direction.y,
-            near, far);
-  clip_slab((lower.z - ray.origin.z) * ray.inverse_direction.z, (upper.z - ray.origin.z) * ray.inverse_direction.z,
-            near, far);
-  return near <= far ? near : std::numeric_limits<float>::infinity();
-}
-
 // The part [near, far] of [tmin, tmax] inside the box; false on a miss.
 inline bool clip_to_box(const BoxRay& ray, const glm::vec3& lower, const glm::vec3& upper, float tmin, float tmax,
                         float& near, float& far) {
@@ -64,6 +52,12 @@ inline bool clip_to_box(const BoxRay& ray, const glm::vec3& lower, const glm::ve
   clip_slab((lower.z - ray.origin.z) * ray.inverse_direction.z, (upper.z - ray.origin.z) * ray.inverse_direction.z,
             near, far);
   return near <= far;
+}
+
+// Entry distance of the ray into [lower, upper] clipped to [tmin, tmax], or +inf on a miss.
+inline float intersect_box(const BoxRay& ray, const glm::vec3& lower, const glm::vec3& upper, float tmin, float tmax) {
+  float near = tmin, far = tmax;
+  return clip_to_box(ray, lower, upper, tmin, tmax, near, far) ? near : std::numeric_limits<float>::infinity();
 }
 
 // The same test for `count` rays in SoA columns against one box; writes entry distances

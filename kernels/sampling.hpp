@@ -1,7 +1,8 @@
-// Sample warps used by the path tracer: cosine-weighted hemisphere, uniform triangle points,
-// and an orthonormal basis around a normal.
+// Sample warps used by the path tracer and the benchmarks: cosine-weighted hemisphere,
+// uniform sphere and triangle points, and an orthonormal basis around a normal.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 
 #include <glm/vec3.hpp>
@@ -33,6 +34,13 @@ inline glm::vec3 cosine_hemisphere(const glm::vec3& n, float u1, float u2) {
   const float z = std::sqrt(std::fmax(0.0f, 1.0f - u1));
   const OrthonormalBasis basis = basis_around(n);
   return basis.tangent * x + basis.bitangent * y + basis.normal * z;
+}
+
+// A uniformly distributed unit vector (Archimedes: z uniform in [-1, 1], longitude uniform).
+inline glm::vec3 uniform_sphere(float u1, float u2) {
+  const float z = 1.0f - 2.0f * u1, phi = 2.0f * kPi * u2;
+  const float ring = std::sqrt(std::max(0.0f, 1.0f - z * z));
+  return {ring * std::cos(phi), ring * std::sin(phi), z};
 }
 
 // Barycentric coordinates (b1, b2) of a uniformly distributed point on a triangle.

@@ -12,6 +12,7 @@
 #include <tbb/parallel_for.h>
 
 #include "kernels/random.hpp"
+#include "kernels/sampling.hpp"
 #include "scene/noise.hpp"
 
 namespace wavetrace {
@@ -185,9 +186,7 @@ TriangleMesh make_strands(std::size_t triangles, float radius, float length, flo
   tbb::parallel_for(std::size_t{0}, strands, [&](std::size_t s) {
     const UnitPair root = unit_pair(random_bits(std::uint32_t(s), seed, 0, RandomPurpose::scene_generation));
     const UnitPair bend = unit_pair(random_bits(std::uint32_t(s), seed, 1, RandomPurpose::scene_generation));
-    const float z = 1.0f - 2.0f * root.first, phi = 2.0f * 3.14159265f * root.second;
-    const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
-    const glm::vec3 normal(r * std::cos(phi), r * std::sin(phi), z);
+    const glm::vec3 normal = uniform_sphere(root.first, root.second);
     const glm::vec3 tangent = glm::normalize(glm::cross(normal, std::fabs(normal.y) < 0.9f ? glm::vec3(0, 1, 0)
                                                                                           : glm::vec3(1, 0, 0)));
     const glm::vec3 bitangent = glm::cross(normal, tangent);

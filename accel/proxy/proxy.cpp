@@ -55,10 +55,7 @@ ProxyQuality measure_proxy_quality(const Accelerator& candidate, const Accelerat
       const UnitPair zd = unit_pair(random_bits(id, 0, 1, RandomPurpose::simplification));
       const UnitPair d = unit_pair(random_bits(id, 0, 2, RandomPurpose::simplification));
       const glm::vec3 origin = scene_bounds.lower + scene_bounds.extent() * glm::vec3(xy.first, xy.second, zd.first);
-      const float z = 1.0f - 2.0f * d.first, phi = 2.0f * kPi * d.second;
-      const float ring = std::sqrt(std::max(0.0f, 1.0f - z * z));
-      batch.set_geometry(i, origin, glm::vec3(ring * std::cos(phi), ring * std::sin(phi), z), 0.0f,
-                         std::numeric_limits<float>::infinity());
+      batch.set_geometry(i, origin, uniform_sphere(d.first, d.second), 0.0f, std::numeric_limits<float>::infinity());
       batch.flags[i] = ray_flags::alive;
       batch.kind[i] = RayKind::bounce;
     }
