@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
 
+#include "accel/grid/grid_walk.hpp"
 #include "kernels/ray_box.hpp"
 #include "kernels/triangle_intersect.hpp"
 #include "memory/cache_aligned_allocator.hpp"
@@ -175,29 +176,16 @@ class ArrayGridAccelerator final : public Accelerator {
     const glm::vec3 upper = node.lower + node.cell_size * glm::vec3(node.cells);
     float enter = 0.0f, leave = 0.0f;
     if (!clip_to_box(make_box_ray(state.origin, state.direction), node.lower, upper, near, far, enter, leave)) return false;
-    glm::ivec3 cell(cell_of(node, state.origin + state.direction * enter));
-    glm::ivec3 step;
-    glm::vec3 next_crossing, interval;
-    for (int axis = 0; axis < 3; ++axis) {
-      const float d = state.direction[axis];
-      step[axis] = d > 0.0f ? 1 : d < 0.0f ? -1 : 0;
-      if (step[axis] == 0) {
-        next_crossing[axis] = interval[axis] = kInfinity;
-        continue;
-      }
-      const int face = cell[axis] + (step[axis] > 0 ? 1 : 0);
-      next_crossing[axis] = (node.lower[axis] + float(face) * node.cell_size[axis] - state.origin[axis]) / d;
-      interval[axis] = node.cell_size[axis] / std::fabs(d);
-    }
+    GridWalk walk(node.lower, node.cell_size, state.origin, state.direction,
+                  glm::ivec3(cell_of(node, state.origin + state.direction * enter)));
     float cell_enter = enter;
     const glm::vec3* positions = mesh_.positions.data();
     const glm::uvec3* triangles = mesh_.triangles.data();
     while (true) {
-      const int axis = next_crossing.x < next_crossing.y ? (next_crossing.x < next_crossing.z ? 0 : 2)
-                                                          : (next_crossing.y < next_crossing.z ? 1 : 2);
-      const float cell_leave = std::min(next_crossing[axis], leave);
-      const ArrayGridCell& c =
-          cells_[node.first_cell + cell_index(node, std::uint32_t(cell.x), std::uint32_t(cell.y), std::uint32_t(cell.z))];
+      const int axis = walk.exit_axis();
+      const float cell_leave = std::min(walk.next_crossing[axis], leave);
+      const glm::uvec3 cell(walk.cell);
+      const ArrayGridCell& c = cells_[node.first_cell + cell_index(node, cell.x, cell.y, cell.z)];
       if (c.count > 0) {
         if (c.reference & 1u) {
           if (traverse_grid<kAnyHit>(nodes_[c.reference >> 1], state, cell_enter, std::min(cell_leave, state.best))) {
@@ -217,11 +205,9 @@ class ArrayGridAccelerator final : public Accelerator {
           }
         }
       }
-      if (next_crossing[axis] >= state.best || next_crossing[axis] > leave) return false;
-      cell[axis] += step[axis];
-      if (cell[axis] < 0 || cell[axis] >= int(node.cells[axis])) return false;
-      cell_enter = next_crossing[axis];
-      next_crossing[axis] += interval[axis];
+      if (walk.next_crossing[axis] >= state.best || walk.next_crossing[axis] > leave) return false;
+      cell_enter = walk.next_crossing[axis];
+      if (!walk.advance(axis, node.cells)) return false;
     }
   }
 

@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
 
+#include "accel/grid/grid_walk.hpp"
 #include "kernels/ray_box.hpp"
 #include "kernels/triangle_intersect.hpp"
 #include "memory/cache_aligned_allocator.hpp"
@@ -266,52 +267,33 @@ class HashedGridAccelerator final : public Accelerator {
       float near = 0.0f, far = 0.0f;
       if (!clip_to_box(make_box_ray(origin, direction), bounds_.lower, upper_, tmin, rays.tmax[i], near, far)) continue;
 
-      // Amanatides & Woo: the first cell, where each axis next crosses a cell face, and how
-      // far apart those crossings are.
-      glm::ivec3 cell(cell_of(origin + direction * near));
-      glm::ivec3 step;
-      glm::vec3 next_crossing, crossing_interval;
-      // Where the ray next crosses a face of `cell` on each axis (also after a macrocell jump).
-      const auto face_crossing = [&](int axis, int face) {
-        return (bounds_.lower[axis] + float(face) * cell_size_[axis] - origin[axis]) / direction[axis];
-      };
-      for (int axis = 0; axis < 3; ++axis) {
-        step[axis] = direction[axis] > 0.0f ? 1 : direction[axis] < 0.0f ? -1 : 0;
-        crossing_interval[axis] = step[axis] != 0 ? cell_size_[axis] / std::fabs(direction[axis]) : kInfinity;
-      }
-      const auto start_in_cell = [&] {
-        for (int axis = 0; axis < 3; ++axis) {
-          next_crossing[axis] = step[axis] == 0 ? kInfinity : face_crossing(axis, cell[axis] + (step[axis] > 0 ? 1 : 0));
-        }
-      };
-      start_in_cell();
+      GridWalk walk(bounds_.lower, cell_size_, origin, direction, glm::ivec3(cell_of(origin + direction * near)));
       const WatertightRay ray = make_watertight_ray(origin, direction);
       float best = rays.tmax[i];
       TriangleHit found{kInfinity, 0.0f, 0.0f};
       std::uint32_t found_triangle = kInvalidPrimitive;
       while (true) {
         // In an empty macrocell, jump past its block: out through the face the ray leaves by.
-        if (const MacrocellLevel* empty = coarsest_empty_macrocell(glm::uvec3(cell))) {
-          const glm::ivec3 lower = glm::ivec3(glm::uvec3(cell) / empty->span * empty->span);
+        const glm::uvec3 cell(walk.cell);
+        if (const MacrocellLevel* empty = coarsest_empty_macrocell(cell)) {
+          const glm::ivec3 lower = glm::ivec3(cell / empty->span * empty->span);
           const glm::ivec3 upper = glm::min(lower + int(empty->span) - 1, glm::ivec3(cells_) - 1);
           float exit = kInfinity;
           int exit_axis = 0;
           for (int axis = 0; axis < 3; ++axis) {
-            if (step[axis] == 0) continue;
-            const float t = face_crossing(axis, step[axis] > 0 ? upper[axis] + 1 : lower[axis]);
+            if (walk.step[axis] == 0) continue;
+            const float t = walk.face_crossing(axis, walk.step[axis] > 0 ? upper[axis] + 1 : lower[axis]);
             if (t < exit) exit = t, exit_axis = axis;
           }
           if (exit >= best || exit > far) break;
-          const glm::ivec3 landing(cell_of(origin + direction * exit));
-          for (int axis = 0; axis < 3; ++axis) cell[axis] = std::clamp(landing[axis], lower[axis], upper[axis]);
-          cell[exit_axis] = step[exit_axis] > 0 ? upper[exit_axis] + 1 : lower[exit_axis] - 1;
-          if (cell[exit_axis] < 0 || cell[exit_axis] >= int(cells_[exit_axis])) break;
-          start_in_cell();
+          glm::ivec3 next = glm::clamp(glm::ivec3(cell_of(origin + direction * exit)), lower, upper);
+          next[exit_axis] = walk.step[exit_axis] > 0 ? upper[exit_axis] + 1 : lower[exit_axis] - 1;
+          if (next[exit_axis] < 0 || next[exit_axis] >= int(cells_[exit_axis])) break;
+          walk.enter(next);
           continue;
         }
-        const std::size_t d = cell_index(std::uint32_t(cell.x), std::uint32_t(cell.y), std::uint32_t(cell.z));
-        if (occupied(d)) {
-          const std::size_t slot = slot_of(std::uint32_t(cell.x), std::uint32_t(cell.y), std::uint32_t(cell.z));
+        if (occupied(cell_index(cell.x, cell.y, cell.z))) {
+          const std::size_t slot = slot_of(cell.x, cell.y, cell.z);
           for (std::uint32_t k = starts_[slot]; k < starts_[slot + 1]; ++k) {
             const glm::uvec3& tri = triangles[items_[k]];
             TriangleHit hit;
@@ -325,13 +307,9 @@ class HashedGridAccelerator final : public Accelerator {
           if (kAnyHit && found_triangle != kInvalidPrimitive) break;
         }
         // Leave the cell: done once the nearest hit lies before the next cell begins.
-        const int axis = next_crossing.x < next_crossing.y ? (next_crossing.x < next_crossing.z ? 0 : 2)
-                                                            : (next_crossing.y < next_crossing.z ? 1 : 2);
-        const float exit = next_crossing[axis];
-        if (exit >= best || exit > far) break;
-        cell[axis] += step[axis];
-        if (cell[axis] < 0 || cell[axis] >= int(cells_[axis])) break;
-        next_crossing[axis] += crossing_interval[axis];
+        const int axis = walk.exit_axis();
+        if (walk.next_crossing[axis] >= best || walk.next_crossing[axis] > far) break;
+        if (!walk.advance(axis, cells_)) break;
       }
       if (found_triangle != kInvalidPrimitive) {
         hits.t[i] = found.t;
