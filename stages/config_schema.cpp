@@ -59,6 +59,8 @@ const std::vector<ConfigKey>& config_schema() {
       {"accel.arraygrid.max_depth", T::integer, std::int64_t{2}, 0, 4, {}, "deepest nested grid (root: 0)"},
       {"accel.arraygrid.max_cells", T::integer, std::int64_t{1} << 28, 1, std::int64_t{1} << 34, {},
        "resolution guard: refinement stops once the grids hold this many cells"},
+      {"accel.arraygrid.max_entries", T::integer, std::int64_t{1} << 28, 1, std::int64_t{1} << 34, {},
+       "resolution guard: refinement stops once the triangle lists made hold this many entries"},
       {"accel.bvh.width", T::integer, std::int64_t{2}, 2, 8, {}, "2: binary 32-byte nodes; 8: AVX2 8-wide nodes"},
 
       {"memory.budget", T::text, std::string("none"), 0, 0, {},

@@ -69,6 +69,7 @@ AcceleratorOptions accelerator_options(const Config& config) {
   options.arraygrid.refine_items = static_cast<std::uint32_t>(config.integer("accel.arraygrid.refine_items"));
   options.arraygrid.max_depth = static_cast<std::uint32_t>(config.integer("accel.arraygrid.max_depth"));
   options.arraygrid.max_cells = static_cast<std::size_t>(config.integer("accel.arraygrid.max_cells"));
+  options.arraygrid.max_entries = static_cast<std::size_t>(config.integer("accel.arraygrid.max_entries"));
   options.mlgrid.density = config.real("accel.mlgrid.density");
   options.mlgrid.max_cells = static_cast<std::size_t>(config.integer("accel.mlgrid.max_cells"));
   options.mlgrid.macrocell_factor = static_cast<std::uint32_t>(config.integer("accel.mlgrid.macrocell_factor"));

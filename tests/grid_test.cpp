@@ -199,12 +199,15 @@ TEST(ArrayGrid, NestsCrowdedCellsAndItsGuardStopsRefinement) {
   const auto flat = make_array_grid_accelerator(scene.mesh, flat_options);
   EXPECT_NE(flat->build_notes().find("1 grids"), std::string::npos) << flat->build_notes();
   EXPECT_EQ(nested->build_notes().find("1 grids"), std::string::npos) << nested->build_notes();
-  ArrayGridOptions guarded_options;
-  guarded_options.max_cells = 1000;
-  const auto guarded = make_array_grid_accelerator(scene.mesh, guarded_options);
-  EXPECT_NE(guarded->build_notes().find("resolution guard"), std::string::npos) << guarded->build_notes();
-  const Disagreement result = compare_with_robust_embree(scene, *guarded, RaySetKind::primary, 5000);
-  EXPECT_LE(double(result.hit_differs), 1e-4 * double(result.rays));
+  for (const bool by_entries : {false, true}) {
+    ArrayGridOptions guarded_options;
+    (by_entries ? guarded_options.max_entries : guarded_options.max_cells) = 1000;
+    const auto guarded = make_array_grid_accelerator(scene.mesh, guarded_options);
+    EXPECT_NE(guarded->build_notes().find("resolution guard"), std::string::npos) << guarded->build_notes();
+    EXPECT_LT(guarded->memory().total(), nested->memory().total());
+    const Disagreement result = compare_with_robust_embree(scene, *guarded, RaySetKind::primary, 5000);
+    EXPECT_LE(double(result.hit_differs), 1e-4 * double(result.rays));
+  }
   std::size_t spans = 0;
   for (const auto& span : nested->memory_spans()) spans += span.size();
   EXPECT_EQ(spans, nested->memory().total());

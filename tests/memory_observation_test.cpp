@@ -78,7 +78,8 @@ TEST_P(ProbedBvh, AnswersAsUnprobedAndReadsOnlyItsWorld) {
 
 INSTANTIATE_TEST_SUITE_P(Layouts, ProbedBvh,
                          ::testing::Values("", "accel.bvh.width=8", "accel.bvh.triangle_order=morton",
-                                           "accel.bvh.triangle_order=leaf", "accel.bvh.layout=veb"));
+                                           "accel.bvh.triangle_order=leaf", "accel.bvh.layout=veb", "accel.type=grid",
+                                           "accel.type=mlgrid", "accel.type=arraygrid"));
 
 TEST(MemoryObservation, SingleThreadCountsRepeatAndBudgetsOrderFaults) {
   const auto accelerator = make_accelerator(sphere().mesh, [] {

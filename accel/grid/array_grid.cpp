@@ -64,10 +64,21 @@ class ArrayGridAccelerator final : public Accelerator {
 
   std::string name() const override { return "arraygrid"; }
   void intersect_closest(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
-    traverse_batch<false>(rays, hits, range);
+    NullProbe probe;
+    traverse_batch<false>(rays, hits, range, probe);
   }
   void intersect_any(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
-    traverse_batch<true>(rays, hits, range);
+    NullProbe probe;
+    traverse_batch<true>(rays, hits, range, probe);
+  }
+  bool probed() const override { return true; }
+  void intersect_closest_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
+                                RecordingProbe& probe) const override {
+    traverse_batch<false>(rays, hits, range, probe);
+  }
+  void intersect_any_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
+                            RecordingProbe& probe) const override {
+    traverse_batch<true>(rays, hits, range, probe);
   }
   MemoryReport memory() const override {
     MemoryReport report;
@@ -80,7 +91,10 @@ class ArrayGridAccelerator final : public Accelerator {
   std::string build_notes() const override {
     std::string notes = fmt::format("{} grids, {} cells, {:.2f} entries per triangle", nodes_.size(), cells_.size(),
                                     double(items_.size()) / double(mesh_.triangle_count()));
-    if (guarded_) notes += fmt::format("; resolution guard: refinement stopped at {} cells", options_.max_cells);
+    if (guarded_) {
+      notes += fmt::format("; resolution guard: refinement stopped at {} cells or {} list entries",
+                           options_.max_cells, options_.max_entries);
+    }
     return notes;
   }
   std::vector<std::span<const std::byte>> memory_spans() const override {
@@ -130,11 +144,12 @@ class ArrayGridAccelerator final : public Accelerator {
           for (std::uint32_t x = low.x; x <= high.x; ++x) bucketed[cursor[cell_index(node, x, y, z)]++] = t;
     }
 
+    bucketed_entries_ += bucketed.size();
     for (std::size_t c = 0; c < count; ++c) {
       const std::uint32_t in_cell = start[c + 1] - start[c];
       if (in_cell == 0) continue;  // null
       const bool refine = in_cell >= options_.refine_items && depth < options_.max_depth &&
-                          cells_.size() < options_.max_cells;
+                          cells_.size() < options_.max_cells && bucketed_entries_ < options_.max_entries;
       guarded_ |= in_cell >= options_.refine_items && depth < options_.max_depth && !refine;
       if (refine) {
         const glm::uvec3 at(std::uint32_t(c % node.cells.x), std::uint32_t(c / node.cells.x % node.cells.y),
@@ -171,8 +186,9 @@ class ArrayGridAccelerator final : public Accelerator {
   };
 
   // 3D-DDA over one grid within [near, far]; true when an any-hit query may stop.
-  template <bool kAnyHit>
-  bool traverse_grid(const ArrayGridNode& node, RayState& state, float near, float far) const {
+  template <bool kAnyHit, typename Probe>
+  bool traverse_grid(const ArrayGridNode& node, RayState& state, float near, float far, Probe& probe) const {
+    probe.read(&node, sizeof node);
     const glm::vec3 upper = node.lower + node.cell_size * glm::vec3(node.cells);
     float enter = 0.0f, leave = 0.0f;
     if (!clip_to_box(make_box_ray(state.origin, state.direction), node.lower, upper, near, far, enter, leave)) return false;
@@ -186,14 +202,21 @@ class ArrayGridAccelerator final : public Accelerator {
       const float cell_leave = std::min(walk.next_crossing[axis], leave);
       const glm::uvec3 cell(walk.cell);
       const ArrayGridCell& c = cells_[node.first_cell + cell_index(node, cell.x, cell.y, cell.z)];
+      probe.read(&c, sizeof c);
       if (c.count > 0) {
         if (c.reference & 1u) {
-          if (traverse_grid<kAnyHit>(nodes_[c.reference >> 1], state, cell_enter, std::min(cell_leave, state.best))) {
+          if (traverse_grid<kAnyHit>(nodes_[c.reference >> 1], state, cell_enter, std::min(cell_leave, state.best),
+                                     probe)) {
             return true;
           }
         } else {
           for (std::uint32_t k = c.reference >> 1, end = k + c.count; k < end; ++k) {
             const glm::uvec3& tri = triangles[items_[k]];
+            if constexpr (Probe::kRecords) {
+              probe.read(&items_[k], sizeof(std::uint32_t));
+              probe.read(&tri, sizeof tri);
+              for (int corner = 0; corner < 3; ++corner) probe.read(positions + tri[corner], sizeof(glm::vec3));
+            }
             TriangleHit hit;
             if (intersect_watertight(state.ray, positions[tri.x], positions[tri.y], positions[tri.z], state.tmin,
                                      state.best, hit)) {
@@ -211,8 +234,8 @@ class ArrayGridAccelerator final : public Accelerator {
     }
   }
 
-  template <bool kAnyHit>
-  void traverse_batch(const RayBatch& rays, HitBatch& hits, RayRange range) const {
+  template <bool kAnyHit, typename Probe>
+  void traverse_batch(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
     for (std::uint32_t i = range.begin; i < range.end; ++i) {
       hits.t[i] = kInfinity;
       hits.primitive[i] = kInvalidPrimitive;
@@ -225,7 +248,7 @@ class ArrayGridAccelerator final : public Accelerator {
       state.tmin = rays.tmin[i];
       state.best = rays.tmax[i];
       state.found_triangle = kInvalidPrimitive;
-      traverse_grid<kAnyHit>(nodes_[0], state, state.tmin, state.best);
+      traverse_grid<kAnyHit>(nodes_[0], state, state.tmin, state.best, probe);
       if (state.found_triangle != kInvalidPrimitive) {
         hits.t[i] = state.found.t;
         hits.primitive[i] = state.found_triangle;
@@ -239,6 +262,7 @@ class ArrayGridAccelerator final : public Accelerator {
   ArrayGridOptions options_;
   std::vector<Bounds3> boxes_;  // build only
   bool guarded_ = false;
+  std::size_t bucketed_entries_ = 0;  // list entries made so far, at every level (build only)
   LargeArray<ArrayGridNode> nodes_;
   LargeArray<ArrayGridCell> cells_;
   LargeArray<std::uint32_t> items_;

@@ -25,7 +25,11 @@ struct ArrayGridOptions {
   double density = 4.0;             // ρ of Woo's heuristic per grid
   std::uint32_t refine_items = 8;   // a cell with at least this many triangles is refined
   std::uint32_t max_depth = 2;      // grids nest down to this depth (root grid: depth 0)
-  std::size_t max_cells = std::size_t{1} << 28;  // resolution guard over all grids' cells
+  // Resolution guards: refinement stops once all grids hold this many cells, or once the
+  // triangle lists made so far hold this many entries (thin triangles crossing many small
+  // cells, as in builtin:fur, otherwise multiply the lists at every level).
+  std::size_t max_cells = std::size_t{1} << 28;
+  std::size_t max_entries = std::size_t{1} << 28;
 };
 
 std::unique_ptr<Accelerator> make_array_grid_accelerator(const TriangleMesh& mesh, const ArrayGridOptions& options);

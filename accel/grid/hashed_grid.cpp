@@ -43,10 +43,21 @@ class HashedGridAccelerator final : public Accelerator {
   std::string name() const override { return macrocell_factor_ > 0 ? "mlgrid" : "grid"; }
 
   void intersect_closest(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
-    traverse<false>(rays, hits, range);
+    NullProbe probe;
+    traverse<false>(rays, hits, range, probe);
   }
   void intersect_any(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
-    traverse<true>(rays, hits, range);
+    NullProbe probe;
+    traverse<true>(rays, hits, range, probe);
+  }
+  bool probed() const override { return true; }
+  void intersect_closest_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
+                                RecordingProbe& probe) const override {
+    traverse<false>(rays, hits, range, probe);
+  }
+  void intersect_any_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
+                            RecordingProbe& probe) const override {
+    traverse<true>(rays, hits, range, probe);
   }
 
   MemoryReport memory() const override {
@@ -252,8 +263,8 @@ class HashedGridAccelerator final : public Accelerator {
     }
   }
 
-  template <bool kAnyHit>
-  void traverse(const RayBatch& rays, HitBatch& hits, RayRange range) const {
+  template <bool kAnyHit, typename Probe>
+  void traverse(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
     const glm::vec3* positions = mesh_.positions.data();
     const glm::uvec3* triangles = mesh_.triangles.data();
     for (std::uint32_t i = range.begin; i < range.end; ++i) {
@@ -275,7 +286,7 @@ class HashedGridAccelerator final : public Accelerator {
       while (true) {
         // In an empty macrocell, jump past its block: out through the face the ray leaves by.
         const glm::uvec3 cell(walk.cell);
-        if (const MacrocellLevel* empty = coarsest_empty_macrocell(cell)) {
+        if (const MacrocellLevel* empty = coarsest_empty_macrocell(cell, probe)) {
           const glm::ivec3 lower = glm::ivec3(cell / empty->span * empty->span);
           const glm::ivec3 upper = glm::min(lower + int(empty->span) - 1, glm::ivec3(cells_) - 1);
           float exit = kInfinity;
@@ -292,10 +303,20 @@ class HashedGridAccelerator final : public Accelerator {
           walk.enter(next);
           continue;
         }
-        if (occupied(cell_index(cell.x, cell.y, cell.z))) {
-          const std::size_t slot = slot_of(cell.x, cell.y, cell.z);
+        const std::size_t d = cell_index(cell.x, cell.y, cell.z);
+        probe.read(&domain_[d / 64], sizeof(std::uint64_t));
+        if (occupied(d)) {
+          const std::size_t row = std::size_t(cell.z) * cells_.y + cell.y;
+          probe.read(&offsets_[row], sizeof(std::uint32_t));
+          const std::size_t slot = offsets_[row] + cell.x;
+          probe.read(&starts_[slot], 2 * sizeof(std::uint32_t));
           for (std::uint32_t k = starts_[slot]; k < starts_[slot + 1]; ++k) {
             const glm::uvec3& tri = triangles[items_[k]];
+            if constexpr (Probe::kRecords) {
+              probe.read(&items_[k], sizeof(std::uint32_t));
+              probe.read(&tri, sizeof tri);
+              for (int corner = 0; corner < 3; ++corner) probe.read(positions + tri[corner], sizeof(glm::vec3));
+            }
             TriangleHit hit;
             if (intersect_watertight(ray, positions[tri.x], positions[tri.y], positions[tri.z], tmin, best, hit)) {
               best = hit.t;
@@ -342,9 +363,12 @@ class HashedGridAccelerator final : public Accelerator {
   };
   // The coarsest level whose block around `cell` is empty (levels nest, so checking from the
   // finest up stops at the first occupied one); null when the finest block holds items.
-  const MacrocellLevel* coarsest_empty_macrocell(const glm::uvec3& cell) const {
+  template <typename Probe>
+  const MacrocellLevel* coarsest_empty_macrocell(const glm::uvec3& cell, Probe& probe) const {
     const MacrocellLevel* empty = nullptr;
     for (const MacrocellLevel& level : macrocells_) {
+      const std::size_t m = level.index(cell / level.span);
+      probe.read(&level.bits[m / 64], sizeof(std::uint64_t));
       if (level.occupied(cell / level.span)) break;
       empty = &level;
     }
