@@ -102,6 +102,13 @@ class HitBatch {
   float* v;
 
   bool is_hit(std::size_t ray) const { return primitive[ray] != kInvalidPrimitive; }
+  void set_hit(std::size_t ray, float hit_t, std::uint32_t hit_primitive, float hit_u, float hit_v) {
+    t[ray] = hit_t;
+    primitive[ray] = hit_primitive;
+    u[ray] = hit_u;
+    v[ray] = hit_v;
+  }
+  void set_miss(std::size_t ray) { set_hit(ray, std::numeric_limits<float>::infinity(), kInvalidPrimitive, 0.0f, 0.0f); }
 
  private:
   std::size_t capacity_;

@@ -6,18 +6,12 @@
 #include "scene/builtin_scenes.hpp"
 #include "scene/mesh_report.hpp"
 #include "scene/subdivide.hpp"
+#include "test_support.hpp"
 
 namespace wavetrace {
 namespace {
 
-double signed_volume(const TriangleMesh& mesh) {
-  double volume = 0.0;
-  for (const glm::uvec3& t : mesh.triangles) {
-    volume += glm::dot(glm::dvec3(mesh.positions[t.x]),
-                       glm::cross(glm::dvec3(mesh.positions[t.y]), glm::dvec3(mesh.positions[t.z]))) / 6.0;
-  }
-  return volume;
-}
+using testing::signed_volume;
 
 TEST(BuiltinScenes, SphereCountsFollowTheIcosphereLattice) {
   EXPECT_EQ(make_builtin_scene("builtin:sphere:20").mesh.triangle_count(), 20u);

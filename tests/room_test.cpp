@@ -38,12 +38,7 @@ TEST(Room, ShellIsClosedManifoldFacesInwardAndNearItsCount) {
   EXPECT_TRUE(report.closed());
   EXPECT_EQ(report.connected_components, 1u);
   EXPECT_NEAR(double(shell.triangle_count()), 20000.0, 2000.0);
-  double volume = 0.0;
-  for (const glm::uvec3& t : shell.triangles) {
-    volume += glm::dot(glm::dvec3(shell.positions[t.x]),
-                       glm::cross(glm::dvec3(shell.positions[t.y]), glm::dvec3(shell.positions[t.z]))) / 6.0;
-  }
-  EXPECT_NEAR(volume, -8.0 * 3.5 * 8.0, 1e-3);  // the whole box, facing inward
+  EXPECT_NEAR(testing::signed_volume(shell), -8.0 * 3.5 * 8.0, 1e-3);  // the whole box, facing inward
   ASSERT_EQ(shell.material_of_triangle.size(), shell.triangle_count());
   for (std::size_t t = 0; t < shell.triangle_count(); ++t) {
     const glm::vec3 a = shell.positions[shell.triangles[t].x];

@@ -18,19 +18,12 @@
 namespace wavetrace {
 namespace {
 
+using testing::signed_volume;
+
 using testing::write_temp_file;
 
 // A right-angled tetrahedron with outward faces: corners at the origin and on the axes.
 const char* kTetrahedronOff = "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
-
-double signed_volume(const TriangleMesh& mesh) {
-  double volume = 0.0;
-  for (const glm::uvec3& t : mesh.triangles) {
-    volume += glm::dot(glm::dvec3(mesh.positions[t.x]),
-                       glm::cross(glm::dvec3(mesh.positions[t.y]), glm::dvec3(mesh.positions[t.z]))) / 6.0;
-  }
-  return volume;
-}
 
 std::string scene_file(const std::string& name, const std::string& body) {
   write_temp_file("tetrahedron.off", kTetrahedronOff);

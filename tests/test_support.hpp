@@ -1,4 +1,4 @@
-// Helpers shared by the tests: temporary files and running the wavetrace binary.
+// Helpers shared by the tests: temporary files, running the wavetrace binary, mesh volume.
 #pragma once
 
 #include <cstdio>
@@ -8,7 +8,21 @@
 
 #include <unistd.h>
 
+#include <glm/geometric.hpp>
+
+#include "scene/triangle_mesh.hpp"
+
 namespace wavetrace::testing {
+
+// The volume a closed mesh encloses: positive when its faces point outward.
+inline double signed_volume(const TriangleMesh& mesh) {
+  double volume = 0.0;
+  for (const glm::uvec3& t : mesh.triangles) {
+    volume += glm::dot(glm::dvec3(mesh.positions[t.x]),
+                       glm::cross(glm::dvec3(mesh.positions[t.y]), glm::dvec3(mesh.positions[t.z]))) / 6.0;
+  }
+  return volume;
+}
 
 inline std::string data_path(const std::string& name) { return std::string(WAVETRACE_DATA_DIR) + "/" + name; }
 

@@ -237,9 +237,7 @@ class ArrayGridAccelerator final : public Accelerator {
   template <bool kAnyHit, typename Probe>
   void traverse_batch(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
     for (std::uint32_t i = range.begin; i < range.end; ++i) {
-      hits.t[i] = kInfinity;
-      hits.primitive[i] = kInvalidPrimitive;
-      hits.u[i] = hits.v[i] = 0.0f;
+      hits.set_miss(i);
       if (!(rays.flags[i] & ray_flags::alive)) continue;
       RayState state;
       state.origin = glm::vec3(rays.origin_x[i], rays.origin_y[i], rays.origin_z[i]);
@@ -250,10 +248,7 @@ class ArrayGridAccelerator final : public Accelerator {
       state.found_triangle = kInvalidPrimitive;
       traverse_grid<kAnyHit>(nodes_[0], state, state.tmin, state.best, probe);
       if (state.found_triangle != kInvalidPrimitive) {
-        hits.t[i] = state.found.t;
-        hits.primitive[i] = state.found_triangle;
-        hits.u[i] = state.found.u;
-        hits.v[i] = state.found.v;
+        hits.set_hit(i, state.found.t, state.found_triangle, state.found.u, state.found.v);
       }
     }
   }

@@ -268,9 +268,7 @@ class HashedGridAccelerator final : public Accelerator {
     const glm::vec3* positions = mesh_.positions.data();
     const glm::uvec3* triangles = mesh_.triangles.data();
     for (std::uint32_t i = range.begin; i < range.end; ++i) {
-      hits.t[i] = kInfinity;
-      hits.primitive[i] = kInvalidPrimitive;
-      hits.u[i] = hits.v[i] = 0.0f;
+      hits.set_miss(i);
       if (!(rays.flags[i] & ray_flags::alive)) continue;
       const glm::vec3 origin(rays.origin_x[i], rays.origin_y[i], rays.origin_z[i]);
       const glm::vec3 direction(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]);
@@ -333,10 +331,7 @@ class HashedGridAccelerator final : public Accelerator {
         if (!walk.advance(axis, cells_)) break;
       }
       if (found_triangle != kInvalidPrimitive) {
-        hits.t[i] = found.t;
-        hits.primitive[i] = found_triangle;
-        hits.u[i] = found.u;
-        hits.v[i] = found.v;
+        hits.set_hit(i, found.t, found_triangle, found.u, found.v);
       }
     }
   }
