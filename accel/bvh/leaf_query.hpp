@@ -13,7 +13,11 @@
 
 namespace wavetrace {
 
-inline void write_miss(HitBatch& hits, std::uint32_t i) { hits.set_miss(i); }
+inline void write_miss(HitBatch& hits, std::uint32_t i) {
+  hits.t[i] = std::numeric_limits<float>::infinity();
+  hits.primitive[i] = kInvalidPrimitive;
+  hits.u[i] = hits.v[i] = 0.0f;
+}
 
 class LeafQuery {
  public:
@@ -62,7 +66,10 @@ class LeafQuery {
     if constexpr (Probe::kRecords) {
       if (const std::uint32_t* id = geometry_.input_id_address(found_)) probe.read(id, sizeof *id);
     }
-    hits.set_hit(i, best_.t, geometry_.input_id(found_), best_.u, best_.v);
+    hits.t[i] = best_.t;
+    hits.primitive[i] = geometry_.input_id(found_);
+    hits.u[i] = best_.u;
+    hits.v[i] = best_.v;
   }
 
  private:
