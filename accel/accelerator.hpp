@@ -41,6 +41,13 @@ class Accelerator {
   // valid primitive (any one it found), a free ray kInvalidPrimitive.
   virtual void intersect_any(const RayBatch& rays, HitBatch& hits, RayRange range) const = 0;
 
+  // Closest hits of coherent rays: camera rays sharing an origin, consecutive rays close
+  // in the image (2x2 blocks in the Z-curve pixel order). Accelerators with packet
+  // traversal use it; the default is intersect_closest.
+  virtual void intersect_coherent(const RayBatch& rays, HitBatch& hits, RayRange range) const {
+    intersect_closest(rays, hits, range);
+  }
+
   // The same queries with every memory read reported to `probe`, for the pager and the
   // cache simulator. Only accelerators whose traversal is ours can do this (probed() is
   // true); the defaults throw std::logic_error. Embree's traversal cannot be observed.

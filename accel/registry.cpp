@@ -1,5 +1,4 @@
-// Name-to-builder table of the accelerators that exist today (raystrips and hmq are not
-// written yet).
+// Name-to-builder table of the accelerators that exist today (hmq is not written yet).
 #include "accel/registry.hpp"
 
 #include <stdexcept>
@@ -8,11 +7,12 @@
 
 namespace wavetrace {
 
-std::vector<std::string> accelerator_names() { return {"embree", "bvh", "grid", "mlgrid", "arraygrid"}; }
+std::vector<std::string> accelerator_names() { return {"embree", "bvh", "raystrips", "grid", "mlgrid", "arraygrid"}; }
 
 std::unique_ptr<Accelerator> make_accelerator(const TriangleMesh& mesh, const AcceleratorOptions& options) {
   if (options.type == "embree") return make_embree_accelerator(mesh, options.embree);
   if (options.type == "bvh") return make_bvh_accelerator(mesh, options.bvh);
+  if (options.type == "raystrips") return make_raystrips_accelerator(mesh, options.raystrips);
   if (options.type == "grid") return make_hashed_grid_accelerator(mesh, options.grid);
   if (options.type == "arraygrid") return make_array_grid_accelerator(mesh, options.arraygrid);
   if (options.type == "mlgrid") {

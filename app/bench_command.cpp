@@ -22,6 +22,7 @@ struct BenchArguments {
   std::size_t count = 1 << 20;
   int threads = 0;
   int repeat = 3;
+  bool packets = false;
   std::string json;
   std::string budgets;
   std::vector<std::string> assignments;
@@ -74,6 +75,7 @@ int run_accel(const BenchArguments& args) {
   request.count = args.count;
   request.threads = args.threads;
   request.repeats = args.repeat;
+  request.packets = args.packets;
   request.memory = plan_memory(setup.config);
   request.budgets = split_commas(args.budgets);
   for (const std::string& budget : request.budgets) {
@@ -163,6 +165,8 @@ void add_bench_command(CLI::App& app, int& exit_code) {
   add_common_options(accel, *accel_args);
   accel->add_option("--rays", accel_args->rays, "primary, diffuse, shadow or random");
   accel->add_option("--repeat", accel_args->repeat, "timed runs per accelerator (the median is reported)");
+  accel->add_flag("--packets", accel_args->packets,
+                  "primary rays as 2x2 packets (intersect_coherent) where an accelerator has packet traversal");
   accel->add_option("--reference", accel_args->reference,
                     "accelerator the accuracy is measured against (default embree; embree:mode=robust is watertight)");
   accel->add_option("--budgets", accel_args->budgets,

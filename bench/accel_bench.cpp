@@ -99,6 +99,7 @@ AccelBenchReport run_accel_bench(const Scene& scene, const AccelBenchRequest& re
   report.reference = request.reference.label;
   report.threads = arena.threads();
   report.repeats = request.repeats;
+  report.packets = request.packets && request.rays == RaySetKind::primary;
   report.memory_observed = request.memory.enabled() || !request.budgets.empty();
   const float diagonal = scene.mesh.bounds().diagonal();
 
@@ -124,7 +125,7 @@ AccelBenchReport run_accel_bench(const Scene& scene, const AccelBenchRequest& re
       std::vector<std::unique_ptr<HitBatch>> hits;
       for (int run = 0; run < std::max(1, request.repeats); ++run) {
         const auto start = std::chrono::steady_clock::now();
-        hits = trace_ray_set(*accelerator, rays);
+        hits = trace_ray_set(*accelerator, rays, report.packets);
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         result.mrays_per_s_runs.push_back(double(report.ray_count) / seconds * 1e-6);
       }
@@ -191,6 +192,7 @@ nlohmann::json to_json(const AccelBenchReport& report) {
           {"rays", {{"kind", report.rays}, {"count", report.ray_count}, {"reference_hit_rate", report.reference_hit_rate}}},
           {"threads", report.threads},
           {"repeats", report.repeats},
+          {"packets", report.packets},
           {"results", results}};
 }
 
@@ -239,9 +241,9 @@ std::string memory_table(const AccelBenchReport& report) {
 
 std::string to_table(const AccelBenchReport& report) {
   std::string table = fmt::format(
-      "{}: {} triangles; {} {} rays ({:.1f}% hit the reference, {}); {} threads; median of {} runs\n", report.scene,
-      report.triangles, report.ray_count, report.rays, 100.0 * report.reference_hit_rate, report.reference,
-      report.threads, report.repeats);
+      "{}: {} triangles; {} {} rays{} ({:.1f}% hit the reference, {}); {} threads; median of {} runs\n", report.scene,
+      report.triangles, report.ray_count, report.rays, report.packets ? " as 2x2 packets" : "",
+      100.0 * report.reference_hit_rate, report.reference, report.threads, report.repeats);
   table += fmt::format("{:<24} {:>9} {:>8} {:>8} {:>8} {:>9} {:>10} {:>8} {:>10} {:>10} {:>10} {:>10}\n", "accel",
                        "MB", "B/tri", "hier", "geom", "build s", "peak MB", "Mrays/s", "vs first", "hit agr", "prim agr",
                        "t err max");

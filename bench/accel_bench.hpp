@@ -58,6 +58,7 @@ struct AccelBenchReport {
   std::size_t ray_count = 0;
   int threads = 0;
   int repeats = 0;
+  bool packets = false;
   double reference_hit_rate = 0.0;  // share of rays Embree finds a hit (occluded, for shadow rays)
   bool memory_observed = false;     // memory runs were asked for
   std::vector<AccelBenchResult> results;
@@ -70,6 +71,7 @@ struct AccelBenchRequest {
   std::size_t count = 1 << 20;
   int threads = 0;
   int repeats = 3;
+  bool packets = false;  // primary rays through intersect_coherent (packets where an accelerator has them)
   // Pager settings and cache; `budgets` (e.g. "100%", "20%") replace memory.budget when given.
   MemoryPlan memory;
   std::vector<std::string> budgets;

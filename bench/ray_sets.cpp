@@ -39,17 +39,21 @@ struct RayWriter {
   }
 };
 
-// Camera rays over a 4:3 image of about `count` pixels, in scanline order, one sample
-// per pixel; round `round` jitters differently so repeated rounds give new rays.
+// Camera rays over a 4:3 image of about `count` pixels, one sample per pixel, in 2x2
+// pixel quads (scanline order of the quads), so any 4 aligned consecutive rays form a
+// packet; round `round` jitters differently so repeated rounds give new rays.
 void add_primary(RayWriter& writer, const Camera& camera, std::size_t count, std::uint32_t round) {
   const auto height = static_cast<std::uint32_t>(std::max(1.0, std::round(std::sqrt(double(count) * 0.75))));
-  const auto width = static_cast<std::uint32_t>((count + height - 1) / height);
+  const auto width = static_cast<std::uint32_t>((count + height - 1) / height + 1) / 2 * 2;
   const CameraFrame frame(camera, float(width) / float(height));
+  const std::uint32_t quads_per_row = width / 2;
   for (std::size_t p = 0; p < count; ++p) {
     const auto pixel = static_cast<std::uint32_t>(p);
+    const std::uint32_t quad = pixel / 4, corner = pixel % 4;
+    const std::uint32_t column = 2 * (quad % quads_per_row) + corner % 2, row = 2 * (quad / quads_per_row) + corner / 2;
     const UnitPair jitter = unit_pair(random_bits(pixel, round, 0, RandomPurpose::pixel_jitter));
-    const float x = (float(pixel % width) + jitter.first) / float(width);
-    const float y = 1.0f - (float(pixel / width) + jitter.second) / float(height);
+    const float x = (float(column) + jitter.first) / float(width);
+    const float y = 1.0f - (float(row) + jitter.second) / float(height);
     writer.add(frame.origin, glm::normalize(frame.direction(x, y)), kInfinity, RayKind::camera, pixel);
   }
 }
@@ -167,12 +171,15 @@ RaySet make_ray_set(RaySetKind kind, const Scene& scene, const Accelerator& refe
   return set;
 }
 
-std::vector<std::unique_ptr<HitBatch>> trace_ray_set(const Accelerator& accelerator, const RaySet& rays) {
+std::vector<std::unique_ptr<HitBatch>> trace_ray_set(const Accelerator& accelerator, const RaySet& rays,
+                                                     bool coherent) {
   std::vector<std::unique_ptr<HitBatch>> hits(rays.batches.size());
   tbb::parallel_for(std::size_t{0}, rays.batches.size(), [&](std::size_t b) {
     hits[b] = std::make_unique<HitBatch>(rays.batches[b]->capacity());
     if (rays.any_hit()) {
       accelerator.intersect_any(*rays.batches[b], *hits[b], rays.batches[b]->all());
+    } else if (coherent && rays.kind == RaySetKind::primary) {
+      accelerator.intersect_coherent(*rays.batches[b], *hits[b], rays.batches[b]->all());
     } else {
       accelerator.intersect_closest(*rays.batches[b], *hits[b], rays.batches[b]->all());
     }

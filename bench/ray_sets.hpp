@@ -31,8 +31,10 @@ struct RaySet {
 RaySet make_ray_set(RaySetKind kind, const Scene& scene, const Accelerator& reference, std::size_t count,
                     std::size_t batch_size = kDefaultBatchCapacity);
 
-// Every ray of the set traced by `accelerator` into one HitBatch per ray batch.
-std::vector<std::unique_ptr<HitBatch>> trace_ray_set(const Accelerator& accelerator, const RaySet& rays);
+// Every ray of the set traced by `accelerator` into one HitBatch per ray batch. With
+// `coherent`, primary rays go through intersect_coherent (packets where there are any).
+std::vector<std::unique_ptr<HitBatch>> trace_ray_set(const Accelerator& accelerator, const RaySet& rays,
+                                                     bool coherent = false);
 // The same with every read reported to `observers` (as client 0); needs accelerator.probed().
 std::vector<std::unique_ptr<HitBatch>> trace_ray_set_probed(const Accelerator& accelerator, const RaySet& rays,
                                                             const MemoryObservers& observers);

@@ -70,6 +70,13 @@ AcceleratorOptions accelerator_options(const Config& config) {
   options.arraygrid.max_depth = static_cast<std::uint32_t>(config.integer("accel.arraygrid.max_depth"));
   options.arraygrid.max_cells = static_cast<std::size_t>(config.integer("accel.arraygrid.max_cells"));
   options.arraygrid.max_entries = static_cast<std::size_t>(config.integer("accel.arraygrid.max_entries"));
+  options.raystrips.submesh_triangles = static_cast<std::uint32_t>(config.integer("accel.raystrips.submesh_triangles"));
+  options.raystrips.stripifier = parse_stripifier(config.text("accel.raystrips.stripifier"));
+  options.raystrips.strips_per_leaf = static_cast<std::uint32_t>(config.integer("accel.raystrips.strips_per_leaf"));
+  options.raystrips.run_triangles = static_cast<std::uint32_t>(config.integer("accel.raystrips.run_triangles"));
+  options.raystrips.packets = config.boolean("accel.raystrips.packets");
+  options.raystrips.packet_min_active = static_cast<std::uint32_t>(config.integer("accel.raystrips.packet_min_active"));
+  options.raystrips.bins = options.bvh.bins;
   options.mlgrid.density = config.real("accel.mlgrid.density");
   options.mlgrid.max_cells = static_cast<std::size_t>(config.integer("accel.mlgrid.max_cells"));
   options.mlgrid.macrocell_factor = static_cast<std::uint32_t>(config.integer("accel.mlgrid.macrocell_factor"));

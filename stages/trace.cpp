@@ -1,4 +1,5 @@
-// Splits a batch into runs of one ray kind and hands each run to the accelerator.
+// Splits a batch into runs of one ray kind and hands each run to the accelerator: shadow
+// rays to any hit, camera rays to the coherent (packet) query, bounce rays to closest hit.
 #include "stages/trace.hpp"
 
 #include <chrono>
@@ -20,9 +21,10 @@ void TraceStage::process(Batch* batch, StageOutput& out) const {
   std::uint32_t begin = 0;
   const auto count = static_cast<std::uint32_t>(rays.count);
   while (begin < count) {
-    const bool shadow = rays.kind[begin] == RayKind::shadow;
+    const RayKind kind = rays.kind[begin];
+    const bool shadow = kind == RayKind::shadow;
     std::uint32_t end = begin + 1;
-    while (end < count && (rays.kind[end] == RayKind::shadow) == shadow) ++end;
+    while (end < count && rays.kind[end] == kind) ++end;
     const auto start = std::chrono::steady_clock::now();
     if (shadow) {
       if (probe) {
@@ -33,6 +35,8 @@ void TraceStage::process(Batch* batch, StageOutput& out) const {
     } else {
       if (probe) {
         accelerator_.intersect_closest_probed(rays, batch->hits, {begin, end}, *probe);
+      } else if (kind == RayKind::camera) {
+        accelerator_.intersect_coherent(rays, batch->hits, {begin, end});  // packets where the accelerator has them
       } else {
         accelerator_.intersect_closest(rays, batch->hits, {begin, end});
       }

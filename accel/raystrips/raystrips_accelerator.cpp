@@ -1,0 +1,389 @@
+// Ray-Strips build (SAH cut into sub-meshes, stripify, top SAH BVH over the strips, encode)
+// and traversal: single rays through the top BVH and each strip, and 2x2 packets for
+// coherent rays (§5.3).
+#include "accel/raystrips/raystrips_accelerator.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <numeric>
+#include <stdexcept>
+
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+
+#include "accel/bvh/bvh_node.hpp"
+#include "accel/bvh/leaf_query.hpp"
+#include "accel/bvh/node_layout.hpp"
+#include "accel/bvh/sah_builder.hpp"
+#include "accel/raystrips/strip_encode.hpp"
+#include "accel/raystrips/strip_packet.hpp"
+#include "accel/raystrips/strip_traversal.hpp"
+#include "memory/cache_aligned_allocator.hpp"
+
+namespace wavetrace {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using ray_strip::StripView;
+
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+void check_options(const RayStripsOptions& options) {
+  auto require = [](bool ok, const std::string& message) {
+    if (!ok) throw std::invalid_argument("raystrips: " + message);
+  };
+  require(options.submesh_triangles >= 2 && options.submesh_triangles <= ray_strip::kMaxTriangles,
+          fmt::format("submesh_triangles = {}: must be 2 .. {}", options.submesh_triangles, ray_strip::kMaxTriangles));
+  require(options.strips_per_leaf >= 1 && options.strips_per_leaf <= 16,
+          fmt::format("strips_per_leaf = {}: must be 1 .. 16", options.strips_per_leaf));
+  require(options.run_triangles >= 2 && options.run_triangles <= 64,
+          fmt::format("run_triangles = {}: must be 2 .. 64", options.run_triangles));
+  require(options.packet_min_active >= 1 && options.packet_min_active <= kPacketRays,
+          fmt::format("packet_min_active = {}: must be 1 .. {}", options.packet_min_active, kPacketRays));
+}
+
+// The sub-meshes: ranges of the SAH tree's primitive order under the highest nodes that
+// hold at most `threshold` triangles.
+std::vector<std::pair<std::uint32_t, std::uint32_t>> cut_submeshes(const BuildTree& tree, std::uint32_t threshold) {
+  // Subtree ranges, children before parents (the builder partitions in place, so a
+  // subtree's primitives are one contiguous range).
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> range(tree.nodes.size());
+  std::vector<std::uint32_t> order;
+  order.reserve(tree.nodes.size());
+  std::vector<std::uint32_t> stack = {0};
+  while (!stack.empty()) {
+    const std::uint32_t node = stack.back();
+    stack.pop_back();
+    order.push_back(node);
+    if (!tree.nodes[node].leaf()) {
+      stack.push_back(tree.nodes[node].left);
+      stack.push_back(tree.nodes[node].right);
+    }
+  }
+  for (auto it = order.rbegin(); it != order.rend(); ++it) {
+    const BuildNode& node = tree.nodes[*it];
+    if (node.leaf()) {
+      range[*it] = {node.first, node.count};
+    } else {
+      const auto& left = range[node.left];
+      const auto& right = range[node.right];
+      range[*it] = {std::min(left.first, right.first), left.second + right.second};
+    }
+  }
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> submeshes;
+  stack = {0};
+  while (!stack.empty()) {
+    const std::uint32_t node = stack.back();
+    stack.pop_back();
+    if (range[node].second <= threshold || tree.nodes[node].leaf()) {
+      submeshes.push_back(range[node]);
+    } else {
+      stack.push_back(tree.nodes[node].right);
+      stack.push_back(tree.nodes[node].left);
+    }
+  }
+  return submeshes;
+}
+
+class RayStripsAccelerator final : public Accelerator {
+ public:
+  RayStripsAccelerator(const TriangleMesh& mesh, const RayStripsOptions& options) : options_(options) {
+    check_options(options);
+    if (mesh.triangle_count() == 0) throw std::invalid_argument("raystrips: the mesh has no triangles");
+    const auto start = Clock::now();
+
+    // 1. SAH cut into sub-meshes.
+    LargeArray<Bounds3> triangle_bounds(mesh.triangle_count());
+    tbb::parallel_for(std::size_t{0}, mesh.triangle_count(), [&](std::size_t t) {
+      Bounds3 bounds;
+      for (int k = 0; k < 3; ++k) bounds.extend(mesh.positions[mesh.triangles[t][k]]);
+      triangle_bounds[t] = bounds;
+    });
+    SahOptions sah;
+    sah.max_leaf_size = 4;
+    sah.bins = options.bins;
+    const BuildTree cut_tree = build_sah_tree(triangle_bounds, sah);
+    std::size_t peak = cut_tree.peak_bytes + triangle_bounds.size() * sizeof(Bounds3);
+    triangle_bounds = {};
+    const auto submeshes = cut_submeshes(cut_tree, options.submesh_triangles);
+    stats_.sah_seconds = seconds_since(start);
+
+    // 2. Stripify each sub-mesh.
+    const auto stripify_start = Clock::now();
+    std::vector<std::vector<TriangleStrip>> per_submesh(submeshes.size());
+    tbb::parallel_for(std::size_t{0}, submeshes.size(), [&](std::size_t s) {
+      const auto [first, count] = submeshes[s];
+      per_submesh[s] = stripify(mesh, std::span(cut_tree.primitive_order.data() + first, count), options.stripifier,
+                                ray_strip::kMaxTriangles);
+    });
+    std::vector<TriangleStrip> strips;
+    for (auto& group : per_submesh) {
+      for (auto& strip : group) strips.push_back(std::move(strip));
+    }
+    per_submesh = {};
+    stats_.stripify_seconds = seconds_since(stripify_start);
+
+    // 3. The top BVH over the strips, and the strips in its leaf order.
+    const auto encode_start = Clock::now();
+    LargeArray<Bounds3> strip_bounds(strips.size());
+    tbb::parallel_for(std::size_t{0}, strips.size(), [&](std::size_t s) {
+      Bounds3 bounds;
+      for (const std::uint32_t vertex : strips[s].vertices) bounds.extend(mesh.positions[vertex]);
+      strip_bounds[s] = bounds;
+    });
+    sah.max_leaf_size = options.strips_per_leaf;
+    const BuildTree top = build_sah_tree(strip_bounds, sah);
+    peak = std::max(peak, top.peak_bytes + strip_bounds.size() * sizeof(Bounds3));
+    strip_bounds = {};
+    const std::vector<std::uint32_t> node_order_list = node_order(top, NodeLayout::depth_first);
+
+    // Vertices renumbered by first use in leaf order, so a strip's indices lie close together.
+    std::vector<std::uint32_t> vertex_id(mesh.vertex_count(), kNoTriangle);
+    std::vector<std::uint32_t> strip_order;  // strips in storage order
+    strip_order.reserve(strips.size());
+    std::uint32_t next_vertex = 0;
+    for (const std::uint32_t built : node_order_list) {
+      const BuildNode& node = top.nodes[built];
+      if (!node.leaf()) continue;
+      for (std::uint32_t k = 0; k < node.count; ++k) {
+        const std::uint32_t s = top.primitive_order[node.first + k];
+        strip_order.push_back(s);
+        for (const std::uint32_t vertex : strips[s].vertices) {
+          if (vertex_id[vertex] == kNoTriangle) vertex_id[vertex] = next_vertex++;
+        }
+      }
+    }
+    positions_.resize(next_vertex);
+    for (std::uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+      if (vertex_id[v] != kNoTriangle) positions_[vertex_id[v]] = mesh.positions[v];
+    }
+
+    std::vector<StripEncoding> encodings(strips.size());
+    std::vector<std::size_t> offset(strips.size() + 1, 0);
+    for (std::size_t i = 0; i < strip_order.size(); ++i) {
+      const TriangleStrip& strip = strips[strip_order[i]];
+      encodings[i] = choose_encoding(strip, vertex_id);
+      offset[i + 1] = offset[i] + encodings[i].size(static_cast<std::uint32_t>(strip.triangles.size()));
+    }
+    if (offset.back() / 4 >= BvhNode::kLeafFlag) {
+      throw std::length_error("raystrips: the strips need more than 8 GiB, beyond the top BVH's 31-bit word offsets");
+    }
+    strip_bytes_.resize(offset.back());
+    tbb::parallel_for(std::size_t{0}, strip_order.size(), [&](std::size_t i) {
+      encode_strip(strips[strip_order[i]], encodings[i], vertex_id, positions_, mesh, strip_bytes_.data() + offset[i]);
+    });
+
+    // Flatten the top BVH: a leaf's `first` is the word offset of its first strip.
+    std::vector<std::uint32_t> position_of(top.nodes.size());
+    for (std::uint32_t i = 0; i < node_order_list.size(); ++i) position_of[node_order_list[i]] = i;
+    nodes_.resize(node_order_list.size());
+    std::size_t next_strip = 0;
+    for (std::uint32_t i = 0; i < node_order_list.size(); ++i) {
+      const BuildNode& built = top.nodes[node_order_list[i]];
+      BvhNode& node = nodes_[i];
+      node.lower = built.bounds.lower;
+      node.upper = built.bounds.upper;
+      if (built.leaf()) {
+        node.first = static_cast<std::uint32_t>(offset[next_strip] / 4);
+        node.count = BvhNode::kLeafFlag | built.count;
+        next_strip += built.count;
+      } else {
+        node.first = position_of[built.left];
+        node.count = position_of[built.right];
+      }
+    }
+    stats_.encode_seconds = seconds_since(encode_start);
+    collect_stats(strips, encodings, strip_order);
+    build_.seconds = seconds_since(start);
+    const std::size_t strips_held = strips.capacity() * sizeof(TriangleStrip) + stats_.strip_vectors_bytes;
+    build_.peak_bytes = std::max(peak, strips_held + vertex_id.size() * 4) + memory().total();
+  }
+
+  std::string name() const override { return "raystrips"; }
+
+  void intersect_closest(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
+    NullProbe probe;
+    traverse<false>(rays, hits, range, probe);
+  }
+  void intersect_any(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
+    NullProbe probe;
+    traverse<true>(rays, hits, range, probe);
+  }
+  void intersect_coherent(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
+    if (!options_.packets) return intersect_closest(rays, hits, range);
+    PacketTraversal packets{nodes_.data(), strip_bytes_.data(), positions_.data(), options_.run_triangles,
+                            options_.packet_min_active};
+    for (std::uint32_t begin = range.begin; begin < range.end; begin += kPacketRays) {
+      const std::uint32_t end = std::min(begin + kPacketRays, range.end);
+      packets.trace(rays, hits, {begin, end}, [&](const StripRay& ray, std::uint32_t i) { write_hit(ray, hits, i); });
+    }
+  }
+  bool probed() const override { return true; }
+  void intersect_closest_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
+                                RecordingProbe& probe) const override {
+    traverse<false>(rays, hits, range, probe);
+  }
+  void intersect_any_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
+                            RecordingProbe& probe) const override {
+    traverse<true>(rays, hits, range, probe);
+  }
+
+  MemoryReport memory() const override {
+    MemoryReport report;
+    report.hierarchy = nodes_.size() * sizeof(BvhNode) + stats_.header_and_tree_bytes;
+    report.geometry = positions_.size() * sizeof(glm::vec3) + stats_.index_bytes;
+    report.other = stats_.record_bytes;
+    return report;
+  }
+
+  BuildReport build() const override { return build_; }
+
+  std::string build_notes() const override {
+    const RayStripStats& s = stats_;
+    return fmt::format(
+        "{} strips ({}), {:.1f} triangles per strip ({:.1f} with turn repeats), {:.2f} strips per top leaf, "
+        "{:.2f}% of triangles in strips of one, {:.1f}% turn repeats, {:.1f}% short indices, {:.1f}% short records; "
+        "build: SAH cut {:.3f} s, stripify {:.3f} s, top BVH + encode {:.3f} s",
+        s.strips, to_string(options_.stripifier), s.mean_triangles, s.mean_strip_triangles, s.strips_per_leaf,
+        100.0 * s.single_share, 100.0 * s.repeat_share, 100.0 * s.short_index_share, 100.0 * s.short_record_share,
+        s.sah_seconds, s.stripify_seconds, s.encode_seconds);
+  }
+
+  std::vector<std::span<const std::byte>> memory_spans() const override {
+    return {std::as_bytes(std::span(nodes_)), std::span<const std::byte>(strip_bytes_.data(), strip_bytes_.size()),
+            std::as_bytes(std::span(positions_))};
+  }
+
+ private:
+  struct RayStripStats {
+    std::size_t strips = 0;
+    double mean_triangles = 0, mean_strip_triangles = 0, strips_per_leaf = 0;
+    double single_share = 0, repeat_share = 0, short_index_share = 0, short_record_share = 0;
+    double sah_seconds = 0, stripify_seconds = 0, encode_seconds = 0;
+    std::size_t header_and_tree_bytes = 0, index_bytes = 0, record_bytes = 0, strip_vectors_bytes = 0;
+  };
+
+  void collect_stats(const std::vector<TriangleStrip>& strips, const std::vector<StripEncoding>& encodings,
+                     const std::vector<std::uint32_t>& strip_order) {
+    RayStripStats& s = stats_;
+    s.strips = strips.size();
+    std::size_t distinct = 0, listed = 0, in_singles = 0, short_indices = 0, short_records = 0, leaves = 0;
+    for (std::size_t i = 0; i < strip_order.size(); ++i) {
+      const TriangleStrip& strip = strips[strip_order[i]];
+      const auto n = static_cast<std::uint32_t>(strip.triangles.size());
+      std::size_t real = 0;
+      for (std::size_t k = 0; k < n; ++k) {
+        const std::uint32_t t = strip.triangles[k];
+        real += t != kNoTriangle && (k == 0 || strip.triangles[k - 1] != t);
+      }
+      distinct += real;
+      listed += n;
+      if (real == 1) ++in_singles;
+      short_indices += (encodings[i].widths & ray_strip::kShortIndices) != 0;
+      short_records += (encodings[i].widths & ray_strip::kShortRecords) != 0;
+      const ray_strip::StripLayout layout = ray_strip::strip_layout(n, encodings[i].widths);
+      s.header_and_tree_bytes += layout.indices;
+      s.index_bytes += layout.records - layout.indices;
+      s.record_bytes += layout.size - layout.records;
+      s.strip_vectors_bytes += (strip.vertices.capacity() + strip.triangles.capacity()) * 4;
+    }
+    for (const BvhNode& node : nodes_) leaves += node.leaf();
+    s.mean_triangles = double(distinct) / double(strips.size());
+    s.mean_strip_triangles = double(listed) / double(strips.size());
+    s.strips_per_leaf = double(strips.size()) / double(leaves);
+    s.single_share = double(in_singles) / double(distinct);
+    s.repeat_share = double(listed - distinct) / double(listed);
+    s.short_index_share = double(short_indices) / double(strips.size());
+    s.short_record_share = double(short_records) / double(strips.size());
+  }
+
+  // The hit in the mesh's numbering: triangle id and barycentrics in its corner order.
+  template <typename Probe = NullProbe>
+  static void write_hit(const StripRay& ray, HitBatch& hits, std::uint32_t i, Probe* probe = nullptr) {
+    if (!ray.found()) return write_miss(hits, i);
+    const StripView strip(ray.hit.strip);
+    if constexpr (Probe::kRecords) probe->read(strip.record_address(ray.hit.triangle), 4);
+    const std::uint32_t corners = strip.corners(ray.hit.triangle);
+    hits.set_hit(i, ray.hit.t, strip.triangle(ray.hit.triangle), ray.hit.weights[corners / 3],
+                 ray.hit.weights[corners % 3]);
+  }
+
+  template <bool kAnyHit, typename Probe>
+  void traverse(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
+    struct StackEntry {
+      std::uint32_t node;
+      float distance;
+    };
+    StackEntry stack[kMaxTreeDepth];
+    const BvhNode* nodes = nodes_.data();
+    const glm::vec3* positions = positions_.data();
+    for (std::uint32_t i = range.begin; i < range.end; ++i) {
+      if (!(rays.flags[i] & ray_flags::alive)) {
+        write_miss(hits, i);
+        continue;
+      }
+      StripRay ray({rays.origin_x[i], rays.origin_y[i], rays.origin_z[i]},
+                   {rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]}, rays.tmin[i], rays.tmax[i]);
+      std::uint32_t top = 0;
+      std::uint32_t node = 0;
+      probe.read(nodes, sizeof(BvhNode));
+      if (intersect_box(ray.box, nodes[0].lower, nodes[0].upper, ray.tmin, ray.tmax) == kInfinity) {
+        write_miss(hits, i);
+        continue;
+      }
+      while (true) {
+        const BvhNode& current = nodes[node];
+        if (current.leaf()) {
+          float near, far;
+          if (clip_to_box(ray.box, current.lower, current.upper, ray.tmin, ray.tmax, near, far)) {
+            const std::byte* strip_data = strip_bytes_.data() + std::size_t(current.first) * 4;
+            for (std::uint32_t s = 0; s < current.triangle_count(); ++s) {
+              probe.read(strip_data, ray_strip::kHeaderBytes);
+              const StripView strip(strip_data);
+              ray.traverse<kAnyHit>(strip, positions, near, far, options_.run_triangles, probe);
+              if (kAnyHit && ray.found()) break;
+              strip_data += strip.size();
+            }
+          }
+          if (kAnyHit && ray.found()) break;
+        } else {
+          std::uint32_t near = current.left(), far = current.right();
+          probe.read(nodes + near, sizeof(BvhNode));
+          probe.read(nodes + far, sizeof(BvhNode));
+          float near_distance = intersect_box(ray.box, nodes[near].lower, nodes[near].upper, ray.tmin, ray.tmax);
+          float far_distance = intersect_box(ray.box, nodes[far].lower, nodes[far].upper, ray.tmin, ray.tmax);
+          if (far_distance < near_distance) {
+            std::swap(near, far);
+            std::swap(near_distance, far_distance);
+          }
+          if (near_distance != kInfinity) {
+            if (far_distance != kInfinity) stack[top++] = {far, far_distance};
+            node = near;
+            continue;
+          }
+        }
+        while (top > 0 && stack[top - 1].distance > ray.tmax) --top;
+        if (top == 0) break;
+        node = stack[--top].node;
+      }
+      write_hit(ray, hits, i, &probe);
+    }
+  }
+
+  static constexpr float kInfinity = std::numeric_limits<float>::infinity();
+
+  RayStripsOptions options_;
+  LargeArray<BvhNode> nodes_;
+  LargeArray<std::byte> strip_bytes_;
+  LargeArray<glm::vec3> positions_;
+  RayStripStats stats_;
+  BuildReport build_;
+};
+
+}  // namespace
+
+std::unique_ptr<Accelerator> make_raystrips_accelerator(const TriangleMesh& mesh, const RayStripsOptions& options) {
+  return std::make_unique<RayStripsAccelerator>(mesh, options);
+}
+
+}  // namespace wavetrace

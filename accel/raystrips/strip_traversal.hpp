@@ -1,0 +1,212 @@
+// One ray through one Ray-Strip (§5.1, Algorithm 1): the implicit kd-tree walked near
+// child first with the ray's [dmin, dmax] interval and the strip interval tracked on a
+// small stack, and the shared-edge intersection of a run of strip triangles (§5.2).
+//
+// Edge tests. Each vertex of the run is moved into the watertight test's ray space (origin
+// at the ray origin, sheared so the ray runs along +z; Woop et al. 2013), where the Plücker
+// side of the ray against an edge (p, q) is the 2D edge function f(p, q) = q.x p.y - q.y p.x.
+// A run of m triangles has m + 2 vertices and 2m + 1 edges: the strip edges (s[j], s[j+1])
+// and the diagonals (s[j], s[j+2]); triangle j uses f(s[j+1], s[j+2]), -f(s[j], s[j+2]) and
+// f(s[j], s[j+1]) as the weights of its corners, and is hit when the three signs agree. The
+// arithmetic is the watertight test's (an exact zero is redone in double), and f(q, p) is
+// exactly -f(p, q), so two triangles sharing an edge — in a strip or across strips — see
+// the same edge value and no ray slips between them. Runs are processed 6 triangles
+// (8 vertices, 7 + 6 edges) at a time in fixed-width loops the compiler maps to AVX2.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include <glm/vec3.hpp>
+
+#include "accel/raystrips/ray_strip_format.hpp"
+#include "kernels/ray_box.hpp"
+#include "kernels/triangle_intersect.hpp"
+
+namespace wavetrace {
+
+// Slack on the kd-tree's plane distances: the float error of (plane - origin) * inverse.
+inline constexpr float kPlaneDistanceSlack = 2.0f * float_error_gamma(2);
+
+// A plane distance moved outward by that error bound: later (exit) or earlier (entry).
+inline float widen_exit(float t) { return t * (t > 0.0f ? 1.0f + kPlaneDistanceSlack : 1.0f - kPlaneDistanceSlack); }
+inline float widen_entry(float t) { return t * (t > 0.0f ? 1.0f - kPlaneDistanceSlack : 1.0f + kPlaneDistanceSlack); }
+
+inline constexpr std::uint32_t kRunVertices = 8;
+inline constexpr std::uint32_t kRunTriangles = kRunVertices - 2;
+
+// The nearest hit so far of one ray, in strip terms until it is written out.
+struct StripHit {
+  float t = std::numeric_limits<float>::infinity();
+  float weights[3] = {0.0f, 0.0f, 0.0f};  // of the strip corners, normalized
+  const std::byte* strip = nullptr;       // null: no hit
+  std::uint32_t triangle = 0;             // strip triangle
+};
+
+class StripRay {
+ public:
+  StripRay(const glm::vec3& origin, const glm::vec3& direction, float tmin, float tmax)
+      : tmin(tmin), tmax(tmax), box(make_box_ray(origin, direction)), sheared_(make_watertight_ray(origin, direction)) {}
+
+  float tmin;
+  float tmax;  // shrinks to the nearest hit found
+  BoxRay box;
+  StripHit hit;
+
+  bool found() const { return hit.strip != nullptr; }
+
+  // Walks the strip's kd-tree inside [dmin, dmax] (the part of the ray in the strip's box),
+  // testing runs of at most `run_triangles` triangles. With kAnyHit stops at the first hit.
+  template <bool kAnyHit, typename Probe>
+  void traverse(const ray_strip::StripView& strip, const glm::vec3* positions, float dmin, float dmax,
+                std::uint32_t run_triangles, Probe& probe) {
+    traverse_subtree<kAnyHit>(strip, positions, 0, 0, ray_strip::leaf_count(strip.triangles()), dmin, dmax,
+                              run_triangles, probe);
+  }
+
+  // The same from kd-node `node` spanning leaves [first, first + leaves).
+  template <bool kAnyHit, typename Probe>
+  void traverse_subtree(const ray_strip::StripView& strip, const glm::vec3* positions, std::uint32_t node,
+                        std::uint32_t first, std::uint32_t leaves, float dmin, float dmax, std::uint32_t run_triangles,
+                        Probe& probe) {
+    using namespace ray_strip;
+    struct Pending {
+      std::uint32_t node, first, leaves;
+      float dmin, dmax;
+    };
+    Pending stack[18];  // 65535 triangles: 16 levels of nodes
+    std::uint32_t top = 0;
+    const std::uint32_t triangles = strip.triangles();
+    dmax = std::min(dmax, tmax);
+    while (true) {
+      // Descend while the span holds more triangles than one run tests.
+      while (leaves >= 2 && std::min(2 * (first + leaves), triangles) - 2 * first > run_triangles) {
+        probe.read(strip.splits(node), 8);
+        probe.read(strip.data() + strip.layout().node_bits + node, 1);
+        const float* split = strip.splits(node);
+        const std::uint8_t bits = strip.node_bits(node);
+        const int axis = bits & kAxisMask;
+        const bool reverse = (bits & kReverse) != 0;
+        const std::uint32_t first_leaves = (leaves + 1) / 2;
+        const Pending strip_first{node + 1, first, first_leaves, 0, 0};
+        const Pending strip_second{node + first_leaves, first + first_leaves, leaves - first_leaves, 0, 0};
+        const Pending& lower = reverse ? strip_second : strip_first;
+        const Pending& upper = reverse ? strip_first : strip_second;
+        const float inverse = box.inverse_direction[axis];
+        const bool positive = !std::signbit(inverse);
+        const Pending& near = positive ? lower : upper;
+        const Pending& far = positive ? upper : lower;
+        const float near_exit = widen_exit(((positive ? split[0] : split[1]) - box.origin[axis]) * inverse);
+        const float far_entry = widen_entry(((positive ? split[1] : split[0]) - box.origin[axis]) * inverse);
+        // NaN (a ray in the plane) compares false both ways: both children stay in.
+        const bool near_hit = !(near_exit < dmin);
+        const bool far_hit = !(far_entry > dmax);
+        if (near_hit) {
+          if (far_hit) stack[top++] = {far.node, far.first, far.leaves, far_entry > dmin ? far_entry : dmin, dmax};
+          node = near.node, first = near.first, leaves = near.leaves;
+          dmax = near_exit < dmax ? near_exit : dmax;
+        } else if (far_hit) {
+          node = far.node, first = far.first, leaves = far.leaves;
+          dmin = far_entry > dmin ? far_entry : dmin;
+        } else {
+          goto pop;
+        }
+      }
+      test_run<kAnyHit>(strip, positions, 2 * first, std::min(2 * (first + leaves), triangles), probe);
+      if (kAnyHit && found()) return;
+    pop:
+      while (top > 0 && stack[top - 1].dmin > tmax) --top;
+      if (top == 0) return;
+      --top;
+      node = stack[top].node, first = stack[top].first, leaves = stack[top].leaves;
+      dmin = stack[top].dmin;
+      dmax = std::min(stack[top].dmax, tmax);
+    }
+  }
+
+  // Tests strip triangles [begin, end) by shared edges, 6 at a time.
+  template <bool kAnyHit, typename Probe>
+  void test_run(const ray_strip::StripView& strip, const glm::vec3* positions, std::uint32_t begin, std::uint32_t end,
+                Probe& probe) {
+    for (std::uint32_t chunk = begin; chunk < end; chunk += kRunTriangles) {
+      test_chunk<kAnyHit>(strip, positions, chunk, std::min(end - chunk, kRunTriangles), probe);
+      if (kAnyHit && found()) return;
+    }
+  }
+
+ private:
+  static float edge(float px, float py, float qx, float qy) { return qx * py - qy * px; }
+  static float edge_in_double(float px, float py, float qx, float qy) {
+    return static_cast<float>(double(qx) * double(py) - double(qy) * double(px));
+  }
+
+  // Triangles [first, first + count), count <= 6.
+  template <bool kAnyHit, typename Probe>
+  void test_chunk(const ray_strip::StripView& strip, const glm::vec3* positions, std::uint32_t first,
+                  std::uint32_t count, Probe& probe) {
+    const std::uint32_t vertices = count + 2;
+    float x[kRunVertices], y[kRunVertices], z[kRunVertices];
+    float px[kRunVertices], py[kRunVertices], pz[kRunVertices];
+    probe.read(strip.vertex_address(first), vertices * ((strip.widths() & ray_strip::kShortIndices) ? 2 : 4));
+    for (std::uint32_t i = 0; i < kRunVertices; ++i) {
+      const glm::vec3& p = positions[strip.vertex(first + std::min(i, vertices - 1))];
+      if constexpr (Probe::kRecords) {
+        if (i < vertices) probe.read(&p, sizeof p);
+      }
+      px[i] = p[sheared_.kx] - sheared_.origin[sheared_.kx];
+      py[i] = p[sheared_.ky] - sheared_.origin[sheared_.ky];
+      pz[i] = p[sheared_.kz] - sheared_.origin[sheared_.kz];
+    }
+    for (std::uint32_t i = 0; i < kRunVertices; ++i) {
+      x[i] = px[i] - sheared_.shear_x * pz[i];
+      y[i] = py[i] - sheared_.shear_y * pz[i];
+      z[i] = sheared_.shear_z * pz[i];
+    }
+    // strip_edge[j] = f(s[j], s[j+1]), diagonal[j] = f(s[j], s[j+2]).
+    float strip_edge[kRunVertices], diagonal[kRunVertices];
+    for (std::uint32_t j = 0; j < kRunVertices; ++j) {
+      const std::uint32_t j1 = std::min(j + 1, kRunVertices - 1), j2 = std::min(j + 2, kRunVertices - 1);
+      strip_edge[j] = edge(x[j], y[j], x[j1], y[j1]);
+      diagonal[j] = edge(x[j], y[j], x[j2], y[j2]);
+    }
+    for (std::uint32_t j = 0; j < count + 1; ++j) {
+      if (strip_edge[j] == 0.0f) strip_edge[j] = edge_in_double(x[j], y[j], x[j + 1], y[j + 1]);
+      if (j < count && diagonal[j] == 0.0f) diagonal[j] = edge_in_double(x[j], y[j], x[j + 2], y[j + 2]);
+    }
+    float t[kRunTriangles];
+    bool accepted[kRunTriangles];
+    float w0[kRunTriangles], w1[kRunTriangles], w2[kRunTriangles], inverse_det[kRunTriangles];
+    for (std::uint32_t j = 0; j < kRunTriangles; ++j) {
+      w0[j] = strip_edge[j + 1];
+      w1[j] = -diagonal[j];
+      w2[j] = strip_edge[j];
+      const bool mixed = (w0[j] < 0.0f || w1[j] < 0.0f || w2[j] < 0.0f) && (w0[j] > 0.0f || w1[j] > 0.0f || w2[j] > 0.0f);
+      const float determinant = w0[j] + w1[j] + w2[j];
+      const float scaled_t = w0[j] * z[j] + w1[j] * z[j + 1] + w2[j] * z[j + 2];
+      const float sign = std::copysign(1.0f, determinant);
+      const float abs_determinant = std::fabs(determinant);
+      const float signed_t = scaled_t * sign;
+      accepted[j] = !mixed && determinant != 0.0f && !(signed_t < tmin * abs_determinant) &&
+               !(signed_t > tmax * abs_determinant) && j < count;
+      inverse_det[j] = 1.0f / determinant;
+      t[j] = scaled_t * inverse_det[j];
+    }
+    for (std::uint32_t j = 0; j < count; ++j) {
+      if (!accepted[j] || t[j] > tmax) continue;
+      tmax = t[j];
+      hit.strip = strip.data();
+      hit.triangle = first + j;
+      hit.t = t[j];
+      hit.weights[0] = w0[j] * inverse_det[j];
+      hit.weights[1] = w1[j] * inverse_det[j];
+      hit.weights[2] = w2[j] * inverse_det[j];
+      if constexpr (kAnyHit) return;
+    }
+  }
+
+  WatertightRay sheared_;
+};
+
+}  // namespace wavetrace

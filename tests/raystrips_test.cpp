@@ -1,0 +1,281 @@
+// Ray-Strips: the byte layout and its size formula, both stripifiers' coverage, agreement
+// with robust Embree (hits, t, barycentrics in the mesh's corner order) for single rays
+// and packets, no leaks, the soup case's memory, and option errors.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <set>
+
+#include "accel/raystrips/ray_strip_format.hpp"
+#include "accel/raystrips/raystrips_accelerator.hpp"
+#include "accel/raystrips/strip_encode.hpp"
+#include "accel/raystrips/stripify.hpp"
+#include "accel/registry.hpp"
+#include "bench/accel_bench.hpp"
+#include "bench/leak_bench.hpp"
+#include "bench/ray_sets.hpp"
+#include "scene/builtin_scenes.hpp"
+#include "scene/scene.hpp"
+#include "stages/config.hpp"
+
+namespace wavetrace {
+namespace {
+
+using namespace ray_strip;
+
+TEST(RayStripFormat, SizeOfAStripOfNTrianglesFollowsTheFormula) {
+  // 12-byte header, 9 bytes per node (ceil(n/2) - 1 of them), indices and records, each
+  // aligned to its width, the whole to 4 bytes.
+  EXPECT_EQ(strip_layout(1, kShortIndices | kShortRecords).size, 12u + 3 * 2 + 1 * 2 + 0);  // 20
+  EXPECT_EQ(strip_layout(2, kShortIndices | kShortRecords).size, 24u);  // 12 + 8 + 4
+  EXPECT_EQ(strip_layout(5, kShortIndices | kShortRecords).size, 56u);  // 12 + 18 = 30, +14 = 44, +10 = 54 -> 56
+  EXPECT_EQ(strip_layout(5, 0).size, 80u);                              // 30 -> 32, +28 = 60, +20 = 80
+  EXPECT_EQ(strip_layout(100, kShortIndices).size, 1060u);  // 12 + 441 = 453 -> 454, +204 = 658 -> 660, +400
+  for (std::uint32_t n = 1; n <= 2000; ++n) {
+    for (std::uint8_t widths = 0; widths < 4; ++widths) {
+      const std::size_t w = (widths & kShortIndices) ? 2 : 4, v = (widths & kShortRecords) ? 2 : 4;
+      const std::size_t nodes = (n + 1) / 2 - 1;
+      std::size_t size = 12 + 9 * nodes;
+      size = (size + w - 1) / w * w + w * (n + 2);
+      size = (size + v - 1) / v * v + v * n;
+      size = (size + 3) / 4 * 4;
+      ASSERT_EQ(strip_layout(n, widths).size, size) << n << " triangles, widths " << int(widths);
+      ASSERT_LE(strip_layout(n, widths).size, 12 + 4.5 * n + w * (n + 2) + v * n + 6);
+    }
+  }
+}
+
+TEST(RayStripFormat, EncodedStripDecodesToItsVerticesTrianglesAndCorners) {
+  // A fan-free strip over a 2 x 4 quad grid: vertices 0..9, triangles of both windings.
+  TriangleMesh mesh;
+  for (int row = 0; row < 2; ++row) {
+    for (int column = 0; column < 5; ++column) mesh.positions.emplace_back(float(column), float(row), 0.1f * column);
+  }
+  const std::vector<std::uint32_t> order = {0, 5, 1, 6, 2, 7, 3, 8, 4, 9};  // the strip's vertices
+  for (std::uint32_t k = 0; k < 8; ++k) {
+    // Mesh triangles in a rotated corner order, so the corner codes are not trivial.
+    mesh.triangles.emplace_back(order[k + 1], order[k + 2], order[k]);
+  }
+  std::vector<std::uint32_t> all(8);
+  for (std::uint32_t t = 0; t < 8; ++t) all[t] = 7 - t;  // any order in
+  const std::vector<TriangleStrip> strips = stripify(mesh, all, StripifierKind::dual_path, kMaxTriangles);
+  std::vector<std::uint32_t> identity(mesh.vertex_count());
+  for (std::uint32_t v = 0; v < identity.size(); ++v) identity[v] = v;
+  std::size_t covered = 0;
+  for (const TriangleStrip& strip : strips) {
+    const StripEncoding encoding = choose_encoding(strip, identity);
+    const auto n = static_cast<std::uint32_t>(strip.triangles.size());
+    std::vector<std::byte> buffer(encoding.size(n) + 64, std::byte{0xAB});
+    encode_strip(strip, encoding, identity, mesh.positions, mesh, buffer.data());
+    for (std::size_t i = encoding.size(n); i < buffer.size(); ++i) ASSERT_EQ(buffer[i], std::byte{0xAB}) << "wrote past the formula";
+    const StripView view(buffer.data());
+    ASSERT_EQ(view.triangles(), n);
+    ASSERT_EQ(view.size(), encoding.size(n));
+    for (std::uint32_t i = 0; i < n + 2; ++i) EXPECT_EQ(view.vertex(i), strip.vertices[i]);
+    for (std::uint32_t k = 0; k < n; ++k) {
+      ASSERT_EQ(view.triangle(k), strip.triangles[k]);
+      const glm::uvec3& corners = mesh.triangles[strip.triangles[k]];
+      EXPECT_EQ(view.vertex(k + view.corners(k) / 3), corners.y);
+      EXPECT_EQ(view.vertex(k + view.corners(k) % 3), corners.z);
+    }
+    // The root's planes bound its children: the lower child ends at lower_child_max, the
+    // upper one starts at upper_child_min.
+    if (node_count(n) > 0) {
+      const int axis = view.node_bits(0) & kAxisMask;
+      ASSERT_LT(axis, 3);
+      const std::uint32_t split_vertex = 2 * ((leaf_count(n) + 1) / 2);  // first child: vertices [0, split + 2)
+      const bool reverse = (view.node_bits(0) & kReverse) != 0;
+      for (std::uint32_t i = 0; i < n + 2; ++i) {
+        const float coordinate = mesh.positions[view.vertex(i)][axis];
+        const bool in_first = i < split_vertex + 2, in_second = i >= split_vertex;
+        if ((in_first && !reverse) || (in_second && reverse)) {
+          EXPECT_LE(coordinate, view.splits(0)[0]) << i;
+        }
+        if ((in_second && !reverse) || (in_first && reverse)) {
+          EXPECT_GE(coordinate, view.splits(0)[1]) << i;
+        }
+      }
+    }
+    covered += n;
+  }
+  EXPECT_GE(covered, 8u);
+  EXPECT_EQ(strips.size(), 1u) << "a 2 x 4 quad strip is one strip";
+}
+
+class Stripifiers : public ::testing::TestWithParam<StripifierKind> {};
+
+TEST_P(Stripifiers, CoverEveryTriangleWithItsOwnCornersAndRespectTheLengthLimit) {
+  for (const char* source : {"builtin:sphere:20k", "builtin:soup:2000", "builtin:room:20k"}) {
+    const Scene scene = make_builtin_scene(source);
+    std::vector<std::uint32_t> triangles(scene.mesh.triangle_count());
+    for (std::uint32_t t = 0; t < triangles.size(); ++t) triangles[t] = t;
+    const std::uint32_t limit = 40;
+    const std::vector<TriangleStrip> strips = stripify(scene.mesh, triangles, GetParam(), limit);
+    std::vector<int> seen(triangles.size(), 0);
+    for (const TriangleStrip& strip : strips) {
+      ASSERT_LE(strip.triangles.size(), limit);
+      ASSERT_EQ(strip.vertices.size(), strip.triangles.size() + 2);
+      for (std::size_t k = 0; k < strip.triangles.size(); ++k) {
+        const std::uint32_t t = strip.triangles[k];
+        if (t == kNoTriangle) continue;
+        ++seen[t];
+        std::multiset<std::uint32_t> strip_corners(strip.vertices.begin() + k, strip.vertices.begin() + k + 3);
+        const glm::uvec3& c = scene.mesh.triangles[t];
+        ASSERT_EQ(strip_corners, (std::multiset<std::uint32_t>{c.x, c.y, c.z})) << source << " strip triangle " << k;
+      }
+    }
+    for (std::uint32_t t = 0; t < triangles.size(); ++t) ASSERT_GE(seen[t], 1) << source << " triangle " << t;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Both, Stripifiers, ::testing::Values(StripifierKind::dual_path, StripifierKind::openmesh),
+                         [](const auto& info) { return to_string(info.param); });
+
+struct Agreement {
+  std::size_t rays = 0, hit_differs = 0, far_t = 0, far_uv = 0, same_primitive = 0;
+};
+
+Agreement compare(const Scene& scene, const Accelerator& reference, const Accelerator& tested, RaySetKind kind,
+                  std::size_t count, bool packets) {
+  const RaySet rays = make_ray_set(kind, scene, reference, count);
+  const auto expected = trace_ray_set(reference, rays);
+  const auto actual = trace_ray_set(tested, rays, packets);
+  const float diagonal = scene.mesh.bounds().diagonal();
+  Agreement result;
+  for (std::size_t b = 0; b < rays.batches.size(); ++b) {
+    for (std::size_t i = 0; i < rays.batches[b]->count; ++i) {
+      ++result.rays;
+      const HitBatch& e = *expected[b];
+      const HitBatch& a = *actual[b];
+      result.hit_differs += e.is_hit(i) != a.is_hit(i);
+      if (rays.any_hit() || !e.is_hit(i) || !a.is_hit(i)) continue;
+      result.far_t += std::fabs(e.t[i] - a.t[i]) > 1e-4f * diagonal;
+      if (e.primitive[i] == a.primitive[i]) {
+        ++result.same_primitive;
+        result.far_uv += std::fabs(e.u[i] - a.u[i]) > 1e-3f || std::fabs(e.v[i] - a.v[i]) > 1e-3f;
+      }
+    }
+  }
+  return result;
+}
+
+class RayStripsAgreesWithEmbree : public ::testing::TestWithParam<std::string> {};
+
+std::string scene_label(const ::testing::TestParamInfo<std::string>& info) {
+  static const std::vector<std::string> names = {"sphere", "soup", "terrain", "stadium", "bunny"};
+  return names[info.index];
+}
+
+TEST_P(RayStripsAgreesWithEmbree, OnAtLeast9999PerMyriadOfRaysWithTheMeshsBarycentrics) {
+  const Scene scene = load_scene({GetParam(), 0});
+  AcceleratorOptions robust;
+  robust.embree.mode = EmbreeMode::robust;
+  const auto reference = make_accelerator(scene.mesh, robust);
+  for (const StripifierKind stripifier : {StripifierKind::openmesh, StripifierKind::dual_path}) {
+    for (const std::uint32_t run : {2u, 6u, 16u}) {
+      RayStripsOptions options;
+      options.stripifier = stripifier;
+      options.run_triangles = run;
+      options.strips_per_leaf = run == 16 ? 4 : 1;
+      options.submesh_triangles = run == 16 ? 1000 : 256;
+      const auto strips = make_raystrips_accelerator(scene.mesh, options);
+      for (const RaySetKind kind : {RaySetKind::primary, RaySetKind::random, RaySetKind::diffuse, RaySetKind::shadow}) {
+        for (const bool packets : {false, true}) {
+          if (packets && kind != RaySetKind::primary) continue;
+          const Agreement result = compare(scene, *reference, *strips, kind, 8000, packets);
+          const std::string label = to_string(stripifier) + " run " + std::to_string(run) + " " + to_string(kind) +
+                                    (packets ? " packets" : "");
+          EXPECT_LE(double(result.hit_differs), 1e-4 * double(result.rays)) << label;
+          EXPECT_LE(double(result.far_t), 1e-4 * double(result.rays)) << label;
+          EXPECT_EQ(result.far_uv, 0u) << label;
+          if (kind == RaySetKind::primary) {
+            EXPECT_GT(result.same_primitive, result.rays / 50) << label;  // enough hits to judge u, v
+          }
+        }
+      }
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, RayStripsAgreesWithEmbree,
+                         ::testing::Values("builtin:sphere:100k", "builtin:soup:20k", "builtin:terrain:50k",
+                                           "builtin:stadium:2000", std::string(WAVETRACE_DATA_DIR) + "/bunny00.off"),
+                         scene_label);
+
+TEST(RayStrips, PacketsAnswerExactlyAsSingleRays) {
+  const Scene scene = make_builtin_scene("builtin:sphere:30k");
+  RayStripsOptions options;
+  for (const std::uint32_t min_active : {1u, 2u, 4u}) {
+    options.packet_min_active = min_active;
+    const auto strips = make_raystrips_accelerator(scene.mesh, options);
+    const RaySet rays = make_ray_set(RaySetKind::primary, scene, *strips, 20000);
+    const auto single = trace_ray_set(*strips, rays, false);
+    const auto packets = trace_ray_set(*strips, rays, true);
+    for (std::size_t b = 0; b < rays.batches.size(); ++b) {
+      for (std::size_t i = 0; i < rays.batches[b]->count; ++i) {
+        ASSERT_EQ(single[b]->primitive[i], packets[b]->primitive[i]) << "min_active " << min_active;
+        ASSERT_EQ(single[b]->t[i], packets[b]->t[i]);
+        ASSERT_EQ(single[b]->u[i], packets[b]->u[i]);
+      }
+    }
+  }
+}
+
+TEST(RayStrips, NoRayEscapesClosedMeshes) {
+  for (const char* source : {"builtin:sphere:200k", "builtin:room:50k"}) {
+    const Scene scene = make_builtin_scene(source);
+    const LeakReport report =
+        run_leak_bench(scene,
+                       {parse_accelerator_spec("raystrips", Config{}),
+                        parse_accelerator_spec("raystrips:stripifier=dual_path:run_triangles=2", Config{})},
+                       200000, 0);
+    ASSERT_EQ(report.results.size(), 2u);
+    for (const LeakResult& result : report.results) EXPECT_EQ(result.escaped, 0u) << source << " " << result.label;
+  }
+}
+
+TEST(RayStrips, MemoryIsItsPartsAndTheSoupStaysNearAnIndexedTriangleList) {
+  const Scene sphere = make_builtin_scene("builtin:sphere:50k");
+  const auto strips = make_raystrips_accelerator(sphere.mesh, RayStripsOptions{});
+  const MemoryReport memory = strips->memory();
+  std::size_t span_bytes = 0;
+  for (const auto& span : strips->memory_spans()) span_bytes += span.size();
+  EXPECT_EQ(memory.total(), span_bytes);
+  BvhOptions baseline;
+  const auto bvh = make_bvh_accelerator(sphere.mesh, baseline);
+  EXPECT_LT(memory.total() * 2, bvh->memory().total()) << "connected meshes: well under half the baseline";
+
+  // A soup has no connectivity: every strip is one triangle (§6.2).
+  const Scene soup = make_builtin_scene("builtin:soup:20k");
+  const auto soup_strips = make_raystrips_accelerator(soup.mesh, RayStripsOptions{});
+  EXPECT_NE(soup_strips->build_notes().find("100.00% of triangles in strips of one"), std::string::npos)
+      << soup_strips->build_notes();
+  const auto soup_bvh = make_bvh_accelerator(soup.mesh, baseline);
+  EXPECT_LT(soup_strips->memory().total(), soup_bvh->memory().total() * 14 / 10);
+  RayStripsOptions grouped;
+  grouped.strips_per_leaf = 4;
+  EXPECT_LT(make_raystrips_accelerator(soup.mesh, grouped)->memory().total(), soup_bvh->memory().total() * 11 / 10);
+}
+
+TEST(RayStrips, BadOptionsAreClearErrors) {
+  const Scene scene = make_builtin_scene("builtin:sphere:2000");
+  RayStripsOptions options;
+  options.submesh_triangles = 1;
+  EXPECT_THROW(make_raystrips_accelerator(scene.mesh, options), std::invalid_argument);
+  options = {};
+  options.run_triangles = 1;
+  EXPECT_THROW(make_raystrips_accelerator(scene.mesh, options), std::invalid_argument);
+  options = {};
+  options.packet_min_active = 5;
+  EXPECT_THROW(make_raystrips_accelerator(scene.mesh, options), std::invalid_argument);
+  EXPECT_THROW(parse_accelerator_spec("raystrips:stripifier=stripe", Config{}), ConfigError);
+  EXPECT_THROW(parse_accelerator_spec("raystrips:submesh_triangles=70000", Config{}), ConfigError);
+  EXPECT_THROW(parse_stripifier("stripe"), std::invalid_argument);
+  EXPECT_THROW(make_raystrips_accelerator(TriangleMesh{}, RayStripsOptions{}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace wavetrace
