@@ -1,9 +1,11 @@
-// 2x2 ray packets through the top BVH and the strips (§5.3): a node or a strip's kd-node
-// is entered when any ray of the packet needs it, so its fetch and decode are shared; each
+// 2x2 ray packets through the top BVH and the strips (§5.3): a top node or a strip's
+// kd-node is entered when any ray of the packet needs it, and its box or planes are tested
+// for the four rays at once (4-lane vectors), so fetch, decode and test are shared; each
 // ray keeps its own [dmin, dmax] and nearest hit. Where fewer than `min_active` rays are
 // left in a strip's subtree — the incoherent case at the bottom of a detailed mesh — the
 // packet falls back to single-ray traversal of that subtree, whose edge tests are SIMD
-// across edges instead of across rays (the paper's switch).
+// across edges instead of across rays (the paper's switch). Runs of triangles are always
+// tested ray by ray, across edges.
 #pragma once
 
 #include <bit>
@@ -20,6 +22,9 @@ namespace wavetrace {
 inline constexpr std::uint32_t kPacketRays = 4;
 
 struct PacketTraversal {
+  using Lanes = float __attribute__((vector_size(16)));
+  using LaneMask = std::int32_t __attribute__((vector_size(16)));
+
   const BvhNode* nodes;
   const std::byte* strips;
   const glm::vec3* positions;
@@ -30,13 +35,20 @@ struct PacketTraversal {
   template <typename WriteHit>
   void trace(const RayBatch& rays, HitBatch& hits, RayRange range, WriteHit&& write) const {
     std::optional<StripRay> packet[kPacketRays];
+    Packet lanes{};
     std::uint32_t alive = 0;
     for (std::uint32_t r = 0; r < range.size(); ++r) {
       const std::uint32_t i = range.begin + r;
       if (!(rays.flags[i] & ray_flags::alive)) continue;
-      packet[r].emplace(glm::vec3(rays.origin_x[i], rays.origin_y[i], rays.origin_z[i]),
-                        glm::vec3(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]), rays.tmin[i],
-                        rays.tmax[i]);
+      const StripRay& ray = packet[r].emplace(glm::vec3(rays.origin_x[i], rays.origin_y[i], rays.origin_z[i]),
+                                              glm::vec3(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]),
+                                              rays.tmin[i], rays.tmax[i]);
+      for (int axis = 0; axis < 3; ++axis) {
+        lanes.origin[axis][r] = ray.box.origin[axis];
+        lanes.inverse[axis][r] = ray.box.inverse_direction[axis];
+      }
+      lanes.tmin[r] = ray.tmin;
+      lanes.tmax[r] = ray.tmax;
       alive |= 1u << r;
     }
     struct Pending {
@@ -46,35 +58,32 @@ struct PacketTraversal {
     std::uint32_t top = 0;
     std::uint32_t node = 0, mask = alive;
     while (mask != 0) {
-      // The node's box, for the rays still with it; leaves keep each ray's [near, far].
       const BvhNode& current = nodes[node];
-      float near[kPacketRays], far[kPacketRays];
-      std::uint32_t inside = 0;
-      for (std::uint32_t bits = mask; bits != 0; bits &= bits - 1) {
-        const int r = std::countr_zero(bits);
-        const StripRay& ray = *packet[r];
-        if (clip_to_box(ray.box, current.lower, current.upper, ray.tmin, ray.tmax, near[r], far[r])) inside |= 1u << r;
-      }
+      Lanes near, far;
+      const std::uint32_t inside = mask & clip_to_box(lanes, current.lower, current.upper, near, far);
       if (inside != 0) {
-        if (current.leaf()) {
-          const std::byte* strip_data = strips + std::size_t(current.first) * 4;
-          for (std::uint32_t s = 0; s < current.triangle_count(); ++s) {
-            const ray_strip::StripView strip(strip_data);
-            traverse_strip(strip, packet, inside, near, far);
-            strip_data += strip.size();
-          }
-        } else {
-          // Near child first, as the first ray of the packet sees it.
-          const StripRay& lead = *packet[std::countr_zero(inside)];
+        if (!current.leaf()) {
+          // Near child first, as the first ray of the packet sees it (by the children's centres).
+          const int lead = std::countr_zero(inside);
           const BvhNode& left = nodes[current.left()];
           const BvhNode& right = nodes[current.right()];
-          const float left_distance = intersect_box(lead.box, left.lower, left.upper, lead.tmin, lead.tmax);
-          const float right_distance = intersect_box(lead.box, right.lower, right.upper, lead.tmin, lead.tmax);
-          const bool left_first = left_distance <= right_distance;
+          float left_along = 0.0f, right_along = 0.0f;
+          for (int axis = 0; axis < 3; ++axis) {
+            const float direction = 1.0f / lanes.inverse[axis][lead];
+            left_along += (left.lower[axis] + left.upper[axis]) * direction;
+            right_along += (right.lower[axis] + right.upper[axis]) * direction;
+          }
+          const bool left_first = !(right_along < left_along);
           stack[top++] = {left_first ? current.right() : current.left(), inside};
           node = left_first ? current.left() : current.right();
           mask = inside;
           continue;
+        }
+        const std::byte* strip_data = strips + std::size_t(current.first) * 4;
+        for (std::uint32_t s = 0; s < current.triangle_count(); ++s) {
+          const ray_strip::StripView strip(strip_data);
+          traverse_strip(strip, packet, lanes, inside, near, far);
+          strip_data += strip.size();
         }
       }
       if (top == 0) break;
@@ -86,31 +95,57 @@ struct PacketTraversal {
       if (packet[r]) {
         write(*packet[r], range.begin + r);
       } else {
-        write_miss(hits, range.begin + r);
+        hits.set_miss(range.begin + r);
       }
     }
   }
 
  private:
-  static void write_miss(HitBatch& hits, std::uint32_t i) { hits.set_miss(i); }
+  // The packet's rays, one lane each (dead lanes: zeros, never in a mask).
+  struct Packet {
+    Lanes origin[3], inverse[3];
+    Lanes tmin, tmax;  // tmax follows each ray's nearest hit
+  };
+
+  static std::uint32_t bits_of(LaneMask mask) {
+    std::uint32_t bits = 0;
+    for (std::uint32_t r = 0; r < kPacketRays; ++r) bits |= std::uint32_t(mask[r] != 0) << r;
+    return bits;
+  }
+
+  // clip_to_box (kernels/ray_box.hpp) for four rays: same arithmetic, same NaN rules.
+  static std::uint32_t clip_to_box(const Packet& packet, const glm::vec3& lower, const glm::vec3& upper, Lanes& near,
+                                   Lanes& far) {
+    near = packet.tmin;
+    far = packet.tmax;
+    for (int axis = 0; axis < 3; ++axis) {
+      const Lanes t0 = (lower[axis] - packet.origin[axis]) * packet.inverse[axis];
+      const Lanes t1 = (upper[axis] - packet.origin[axis]) * packet.inverse[axis];
+      const LaneMask swap = t0 > t1;
+      const Lanes entry = swap ? t1 : t0;
+      const Lanes exit = (swap ? t0 : t1) * kSlabFarScale;
+      near = entry > near ? entry : near;
+      far = exit < far ? exit : far;
+    }
+    return bits_of(near <= far);
+  }
+
+  static Lanes widen_exit(Lanes t) { return t * (t > 0.0f ? Lanes{} + (1.0f + kPlaneDistanceSlack) : Lanes{} + (1.0f - kPlaneDistanceSlack)); }
+  static Lanes widen_entry(Lanes t) { return t * (t > 0.0f ? Lanes{} + (1.0f - kPlaneDistanceSlack) : Lanes{} + (1.0f + kPlaneDistanceSlack)); }
 
   // The packet's rays in `mask` through one strip, each within its own [dmin, dmax].
-  void traverse_strip(const ray_strip::StripView& strip, std::optional<StripRay>* packet, std::uint32_t mask,
-                      const float* entry, const float* exit) const {
+  void traverse_strip(const ray_strip::StripView& strip, std::optional<StripRay>* packet, Packet& lanes,
+                      std::uint32_t mask, Lanes entry, Lanes exit) const {
     using namespace ray_strip;
     NullProbe probe;
     struct Pending {
       std::uint32_t node, first, leaves, mask;
-      float dmin[kPacketRays], dmax[kPacketRays];
+      Lanes dmin, dmax;
     };
     Pending stack[18];
     std::uint32_t top = 0;
     const std::uint32_t triangles = strip.triangles();
-    Pending current{0, 0, leaf_count(triangles), mask, {}, {}};
-    for (std::uint32_t r = 0; r < kPacketRays; ++r) {
-      current.dmin[r] = entry[r];
-      current.dmax[r] = exit[r];
-    }
+    Pending current{0, 0, leaf_count(triangles), mask, entry, exit};
     while (true) {
       if (static_cast<std::uint32_t>(std::popcount(current.mask)) < min_active) {
         // Too few rays left here for the packet to pay: each goes on alone.
@@ -119,6 +154,7 @@ struct PacketTraversal {
           StripRay& ray = *packet[r];
           ray.traverse_subtree<false>(strip, positions, current.node, current.first, current.leaves, current.dmin[r],
                                       current.dmax[r], run_triangles, probe);
+          lanes.tmax[r] = ray.tmax;
         }
       } else if (current.leaves >= 2 &&
                  std::min(2 * (current.first + current.leaves), triangles) - 2 * current.first > run_triangles) {
@@ -127,35 +163,30 @@ struct PacketTraversal {
         const int axis = bits & kAxisMask;
         const bool reverse = (bits & kReverse) != 0;
         const std::uint32_t first_leaves = (current.leaves + 1) / 2;
-        Pending strip_first{current.node + 1, current.first, first_leaves, 0, {}, {}};
-        Pending strip_second{current.node + first_leaves, current.first + first_leaves, current.leaves - first_leaves,
-                             0, {}, {}};
-        Pending& lower = reverse ? strip_second : strip_first;
-        Pending& upper = reverse ? strip_first : strip_second;
-        for (std::uint32_t ray_bits = current.mask; ray_bits != 0; ray_bits &= ray_bits - 1) {
-          const int r = std::countr_zero(ray_bits);
-          const StripRay& ray = *packet[r];
-          const float inverse = ray.box.inverse_direction[axis];
-          const float dmin = current.dmin[r], dmax = std::min(current.dmax[r], ray.tmax);
-          const float lower_plane = (split[0] - ray.box.origin[axis]) * inverse;
-          const float upper_plane = (split[1] - ray.box.origin[axis]) * inverse;
-          float lower_min = dmin, lower_max = dmax, upper_min = dmin, upper_max = dmax;
-          if (!std::signbit(inverse)) {  // the lower child comes first along the ray
-            const float exit_plane = widen_exit(lower_plane), entry_plane = widen_entry(upper_plane);
-            lower_max = exit_plane < lower_max ? exit_plane : lower_max;
-            upper_min = entry_plane > upper_min ? entry_plane : upper_min;
-          } else {
-            const float exit_plane = widen_exit(upper_plane), entry_plane = widen_entry(lower_plane);
-            upper_max = exit_plane < upper_max ? exit_plane : upper_max;
-            lower_min = entry_plane > lower_min ? entry_plane : lower_min;
-          }
-          lower.dmin[r] = lower_min, lower.dmax[r] = lower_max;
-          upper.dmin[r] = upper_min, upper.dmax[r] = upper_max;
-          lower.mask |= std::uint32_t(lower_min <= lower_max) << r;
-          upper.mask |= std::uint32_t(upper_min <= upper_max) << r;
-        }
-        const StripRay& lead = *packet[std::countr_zero(current.mask)];
-        const bool lower_first = !std::signbit(lead.box.inverse_direction[axis]);
+        const Lanes dmin = current.dmin;
+        const Lanes dmax = current.dmax < lanes.tmax ? current.dmax : lanes.tmax;
+        const Lanes inverse = lanes.inverse[axis];
+        const Lanes lower_plane = (split[0] - lanes.origin[axis]) * inverse;
+        const Lanes upper_plane = (split[1] - lanes.origin[axis]) * inverse;
+        // Along a ray with a positive direction the lower child comes first: it ends at its
+        // plane and the upper child starts at its own; a negative direction swaps the roles.
+        const LaneMask positive = !(inverse < 0.0f);
+        const Lanes lower_exit = widen_exit(lower_plane), lower_entry = widen_entry(lower_plane);
+        const Lanes upper_exit = widen_exit(upper_plane), upper_entry = widen_entry(upper_plane);
+        const Lanes lower_min = positive ? dmin : (lower_entry > dmin ? lower_entry : dmin);
+        const Lanes lower_max = positive ? (lower_exit < dmax ? lower_exit : dmax) : dmax;
+        const Lanes upper_min = positive ? (upper_entry > dmin ? upper_entry : dmin) : dmin;
+        const Lanes upper_max = positive ? dmax : (upper_exit < dmax ? upper_exit : dmax);
+        const std::uint32_t lower_mask = current.mask & bits_of(lower_min <= lower_max);
+        const std::uint32_t upper_mask = current.mask & bits_of(upper_min <= upper_max);
+        const Pending strip_first{current.node + 1, current.first, first_leaves, 0, {}, {}};
+        const Pending strip_second{current.node + first_leaves, current.first + first_leaves,
+                                   current.leaves - first_leaves, 0, {}, {}};
+        Pending lower = reverse ? strip_second : strip_first;
+        Pending upper = reverse ? strip_first : strip_second;
+        lower.mask = lower_mask, lower.dmin = lower_min, lower.dmax = lower_max;
+        upper.mask = upper_mask, upper.dmin = upper_min, upper.dmax = upper_max;
+        const bool lower_first = positive[std::countr_zero(current.mask)] != 0;
         Pending& near = lower_first ? lower : upper;
         Pending& far = lower_first ? upper : lower;
         if (near.mask != 0) {
@@ -171,20 +202,17 @@ struct PacketTraversal {
         const std::uint32_t begin = 2 * current.first;
         const std::uint32_t end = std::min(2 * (current.first + current.leaves), triangles);
         for (std::uint32_t ray_bits = current.mask; ray_bits != 0; ray_bits &= ray_bits - 1) {
-          packet[std::countr_zero(ray_bits)]->test_run<false>(strip, positions, begin, end, probe);
+          const int r = std::countr_zero(ray_bits);
+          packet[r]->test_run<false>(strip, positions, begin, end, probe);
+          lanes.tmax[r] = packet[r]->tmax;
         }
       }
       // Pop the next subtree that some ray can still improve on.
       while (true) {
         if (top == 0) return;
         current = stack[--top];
-        std::uint32_t still = 0;
-        for (std::uint32_t bits = current.mask; bits != 0; bits &= bits - 1) {
-          const int r = std::countr_zero(bits);
-          still |= std::uint32_t(current.dmin[r] <= packet[r]->tmax) << r;
-        }
-        current.mask = still;
-        if (still != 0) break;
+        current.mask &= bits_of(current.dmin <= lanes.tmax);
+        if (current.mask != 0) break;
       }
     }
   }

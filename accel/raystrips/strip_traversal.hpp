@@ -11,7 +11,7 @@
 // arithmetic is the watertight test's (an exact zero is redone in double), and f(q, p) is
 // exactly -f(p, q), so two triangles sharing an edge — in a strip or across strips — see
 // the same edge value and no ray slips between them. Runs are processed 6 triangles
-// (8 vertices, 7 + 6 edges) at a time in fixed-width loops the compiler maps to AVX2.
+// (8 vertices, 7 + 6 edges) at a time in 8-lane vectors (AVX2).
 #pragma once
 
 #include <algorithm>
@@ -137,19 +137,27 @@ class StripRay {
   }
 
  private:
-  static float edge(float px, float py, float qx, float qy) { return qx * py - qy * px; }
+  // Eight float lanes (GCC/Clang vector extensions: AVX2 here, plain scalar code elsewhere).
+  using Lanes = float __attribute__((vector_size(32)));
+  using LaneMask = std::int32_t __attribute__((vector_size(32)));
+
+  // Lane j takes lane j + 1 (j + 2); the last lanes repeat lane 7.
+  static Lanes next(Lanes v) { return __builtin_shuffle(v, LaneMask{1, 2, 3, 4, 5, 6, 7, 7}); }
+  static Lanes after_next(Lanes v) { return __builtin_shuffle(v, LaneMask{2, 3, 4, 5, 6, 7, 7, 7}); }
+
   static float edge_in_double(float px, float py, float qx, float qy) {
     return static_cast<float>(double(qx) * double(py) - double(qy) * double(px));
   }
 
-  // Triangles [first, first + count), count <= 6.
+  // Triangles [first, first + count), count <= 6: lane j of every vector is vertex s[first + j]
+  // (vertices past the run repeat the last one), edge (s[j], s[j+1]) or (s[j], s[j+2]), or
+  // triangle j.
   template <bool kAnyHit, typename Probe>
   void test_chunk(const ray_strip::StripView& strip, const glm::vec3* positions, std::uint32_t first,
                   std::uint32_t count, Probe& probe) {
     const std::uint32_t vertices = count + 2;
-    float x[kRunVertices], y[kRunVertices], z[kRunVertices];
-    float px[kRunVertices], py[kRunVertices], pz[kRunVertices];
     probe.read(strip.vertex_address(first), vertices * ((strip.widths() & ray_strip::kShortIndices) ? 2 : 4));
+    Lanes px, py, pz;
     for (std::uint32_t i = 0; i < kRunVertices; ++i) {
       const glm::vec3& p = positions[strip.vertex(first + std::min(i, vertices - 1))];
       if constexpr (Probe::kRecords) {
@@ -159,49 +167,45 @@ class StripRay {
       py[i] = p[sheared_.ky] - sheared_.origin[sheared_.ky];
       pz[i] = p[sheared_.kz] - sheared_.origin[sheared_.kz];
     }
-    for (std::uint32_t i = 0; i < kRunVertices; ++i) {
-      x[i] = px[i] - sheared_.shear_x * pz[i];
-      y[i] = py[i] - sheared_.shear_y * pz[i];
-      z[i] = sheared_.shear_z * pz[i];
+    const Lanes x = px - sheared_.shear_x * pz;
+    const Lanes y = py - sheared_.shear_y * pz;
+    const Lanes z = sheared_.shear_z * pz;
+    // f(p, q) = q.x p.y - q.y p.x for the strip edges and the diagonals.
+    const Lanes x1 = next(x), y1 = next(y), x2 = after_next(x), y2 = after_next(y);
+    Lanes strip_edge = x1 * y - y1 * x;
+    Lanes diagonal = x2 * y - y2 * x;
+    const LaneMask zero = (strip_edge == 0.0f) | (diagonal == 0.0f);
+    bool any_zero = false;
+    for (std::uint32_t j = 0; j < kRunVertices; ++j) any_zero |= zero[j] != 0;
+    if (any_zero) {  // an exact zero is decided in double, per edge, as the watertight test does
+      for (std::uint32_t j = 0; j < count + 1; ++j) {
+        if (strip_edge[j] == 0.0f) strip_edge[j] = edge_in_double(x[j], y[j], x[j + 1], y[j + 1]);
+        if (j < count && diagonal[j] == 0.0f) diagonal[j] = edge_in_double(x[j], y[j], x[j + 2], y[j + 2]);
+      }
     }
-    // strip_edge[j] = f(s[j], s[j+1]), diagonal[j] = f(s[j], s[j+2]).
-    float strip_edge[kRunVertices], diagonal[kRunVertices];
-    for (std::uint32_t j = 0; j < kRunVertices; ++j) {
-      const std::uint32_t j1 = std::min(j + 1, kRunVertices - 1), j2 = std::min(j + 2, kRunVertices - 1);
-      strip_edge[j] = edge(x[j], y[j], x[j1], y[j1]);
-      diagonal[j] = edge(x[j], y[j], x[j2], y[j2]);
-    }
-    for (std::uint32_t j = 0; j < count + 1; ++j) {
-      if (strip_edge[j] == 0.0f) strip_edge[j] = edge_in_double(x[j], y[j], x[j + 1], y[j + 1]);
-      if (j < count && diagonal[j] == 0.0f) diagonal[j] = edge_in_double(x[j], y[j], x[j + 2], y[j + 2]);
-    }
-    float t[kRunTriangles];
-    bool accepted[kRunTriangles];
-    float w0[kRunTriangles], w1[kRunTriangles], w2[kRunTriangles], inverse_det[kRunTriangles];
-    for (std::uint32_t j = 0; j < kRunTriangles; ++j) {
-      w0[j] = strip_edge[j + 1];
-      w1[j] = -diagonal[j];
-      w2[j] = strip_edge[j];
-      const bool mixed = (w0[j] < 0.0f || w1[j] < 0.0f || w2[j] < 0.0f) && (w0[j] > 0.0f || w1[j] > 0.0f || w2[j] > 0.0f);
-      const float determinant = w0[j] + w1[j] + w2[j];
-      const float scaled_t = w0[j] * z[j] + w1[j] * z[j + 1] + w2[j] * z[j + 2];
-      const float sign = std::copysign(1.0f, determinant);
-      const float abs_determinant = std::fabs(determinant);
-      const float signed_t = scaled_t * sign;
-      accepted[j] = !mixed && determinant != 0.0f && !(signed_t < tmin * abs_determinant) &&
-               !(signed_t > tmax * abs_determinant) && j < count;
-      inverse_det[j] = 1.0f / determinant;
-      t[j] = scaled_t * inverse_det[j];
-    }
+    const Lanes w0 = next(strip_edge), w1 = -diagonal, w2 = strip_edge;
+    const LaneMask negative = (w0 < 0.0f) | (w1 < 0.0f) | (w2 < 0.0f);
+    const LaneMask positive = (w0 > 0.0f) | (w1 > 0.0f) | (w2 > 0.0f);
+    const Lanes determinant = w0 + w1 + w2;
+    const Lanes scaled_t = w0 * z + w1 * next(z) + w2 * after_next(z);
+    // t * det against [tmin, tmax] * |det| without dividing; the sign of det flips t * det.
+    const LaneMask flip = determinant < 0.0f;
+    const Lanes abs_determinant = flip ? -determinant : determinant;
+    const Lanes signed_t = flip ? -scaled_t : scaled_t;
+    const LaneMask accepted = ~(negative & positive) & (determinant != 0.0f) & (signed_t >= tmin * abs_determinant) &
+                              (signed_t <= tmax * abs_determinant);
     for (std::uint32_t j = 0; j < count; ++j) {
-      if (!accepted[j] || t[j] > tmax) continue;
-      tmax = t[j];
+      if (!accepted[j]) continue;
+      const float inverse = 1.0f / determinant[j];
+      const float t = scaled_t[j] * inverse;
+      if (t > tmax) continue;
+      tmax = t;
       hit.strip = strip.data();
       hit.triangle = first + j;
-      hit.t = t[j];
-      hit.weights[0] = w0[j] * inverse_det[j];
-      hit.weights[1] = w1[j] * inverse_det[j];
-      hit.weights[2] = w2[j] * inverse_det[j];
+      hit.t = t;
+      hit.weights[0] = w0[j] * inverse;
+      hit.weights[1] = w1[j] * inverse;
+      hit.weights[2] = w2[j] * inverse;
       if constexpr (kAnyHit) return;
     }
   }
