@@ -4,12 +4,14 @@
 
 #include <cstddef>
 #include <map>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
 #include "memory/memory_probe.hpp"
 #include "memory/ray_batch.hpp"
+#include "scene/triangle_mesh.hpp"
 
 namespace wavetrace {
 
@@ -61,6 +63,11 @@ class Accelerator {
   virtual BuildReport build() const = 0;
   // What the build chose that a user should know (resolution, guards that fired); may be empty.
   virtual std::string build_notes() const { return {}; }
+
+  // The surface the accelerator answers for, when it is not `source` itself: a lossy
+  // representation (hmq snaps vertices to a grid) returns `source` with its vertices moved
+  // as it decodes them, so that tests and the leak bench can ask exact questions of it.
+  virtual std::optional<TriangleMesh> represented_mesh(const TriangleMesh& source) const { return std::nullopt; }
 
   // The byte ranges traversal reads, for the pager; empty where memory cannot be observed.
   virtual std::vector<std::span<const std::byte>> memory_spans() const { return {}; }

@@ -1,4 +1,4 @@
-// Name-to-builder table of the accelerators that exist today (hmq is not written yet).
+// Name-to-builder table of the accelerators.
 #include "accel/registry.hpp"
 
 #include <stdexcept>
@@ -7,12 +7,13 @@
 
 namespace wavetrace {
 
-std::vector<std::string> accelerator_names() { return {"embree", "bvh", "raystrips", "grid", "mlgrid", "arraygrid"}; }
+std::vector<std::string> accelerator_names() { return {"embree", "bvh", "raystrips", "hmq", "grid", "mlgrid", "arraygrid"}; }
 
 std::unique_ptr<Accelerator> make_accelerator(const TriangleMesh& mesh, const AcceleratorOptions& options) {
   if (options.type == "embree") return make_embree_accelerator(mesh, options.embree);
   if (options.type == "bvh") return make_bvh_accelerator(mesh, options.bvh);
   if (options.type == "raystrips") return make_raystrips_accelerator(mesh, options.raystrips);
+  if (options.type == "hmq") return make_hmq_accelerator(mesh, options.hmq);
   if (options.type == "grid") return make_hashed_grid_accelerator(mesh, options.grid);
   if (options.type == "arraygrid") return make_array_grid_accelerator(mesh, options.arraygrid);
   if (options.type == "mlgrid") {

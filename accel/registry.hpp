@@ -10,6 +10,7 @@
 #include "accel/embree/embree_accelerator.hpp"
 #include "accel/grid/array_grid.hpp"
 #include "accel/grid/hashed_grid.hpp"
+#include "accel/hmq/hmq_accelerator.hpp"
 #include "accel/raystrips/raystrips_accelerator.hpp"
 #include "scene/triangle_mesh.hpp"
 
@@ -23,6 +24,7 @@ struct AcceleratorOptions {
   HashedGridOptions mlgrid{32.0, std::size_t{1} << 30, 6};
   ArrayGridOptions arraygrid;
   RayStripsOptions raystrips;
+  HmqOptions hmq;
 };
 
 std::vector<std::string> accelerator_names();

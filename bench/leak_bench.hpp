@@ -17,6 +17,9 @@ struct LeakResult {
   std::string label;
   std::size_t rays = 0;
   std::size_t escaped = 0;
+  // A lossy accelerator (Accelerator::represented_mesh) is shot at from points inside the
+  // surface it represents, which may differ from the mesh's near its walls.
+  bool own_surface = false;
 };
 
 struct LeakReport {

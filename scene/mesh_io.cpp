@@ -123,7 +123,8 @@ class TriangleListImporter final : public OpenMesh::IO::BaseImporter {
   std::size_t face_count_ = 0;
 };
 
-// OpenMesh reports parse problems on its own log streams; ours are exceptions.
+}  // namespace
+
 void silence_openmesh_logs() {
   static const bool silenced = [] {
     omlog().disable();
@@ -133,8 +134,6 @@ void silence_openmesh_logs() {
   }();
   (void)silenced;
 }
-
-}  // namespace
 
 LoadedMesh load_mesh_file(const std::string& path) {
   silence_openmesh_logs();

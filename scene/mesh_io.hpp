@@ -18,4 +18,8 @@ struct LoadedMesh {
 // Throws SceneError naming the file on a missing, unreadable or malformed file.
 LoadedMesh load_mesh_file(const std::string& path);
 
+// OpenMesh reports problems on its own log streams (parse errors, faces its kernel refuses);
+// ours are exceptions or counts, so every OpenMesh user calls this first.
+void silence_openmesh_logs();
+
 }  // namespace wavetrace

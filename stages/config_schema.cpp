@@ -36,7 +36,7 @@ const std::vector<ConfigKey>& config_schema() {
       {"render.pixel_order", T::text, std::string("scanline"), 0, 0, {"scanline", "zcurve"},
        "order in which camera rays are generated"},
 
-      {"accel.type", T::text, std::string("embree"), 0, 0, {"embree", "bvh", "raystrips", "grid", "mlgrid", "arraygrid"}, "main accelerator"},
+      {"accel.type", T::text, std::string("embree"), 0, 0, {"embree", "bvh", "raystrips", "hmq", "grid", "mlgrid", "arraygrid"}, "main accelerator"},
       {"accel.embree.mode", T::text, std::string("default"), 0, 0, {"default", "compact", "robust"},
        "Embree scene flags"},
       {"accel.bvh.leaf_size", T::integer, std::int64_t{4}, 1, 16, {}, "most triangles per BVH leaf"},
@@ -72,6 +72,11 @@ const std::vector<ConfigKey>& config_schema() {
       {"accel.raystrips.packets", T::boolean, true, 0, 0, {}, "camera rays as 2x2 packets"},
       {"accel.raystrips.packet_min_active", T::integer, std::int64_t{2}, 1, 4, {},
        "below this many active rays a packet continues as single rays"},
+      {"accel.hmq.bits", T::integer, std::int64_t{16}, 1, 24, {}, "global grid bits per axis (the paper: 16)"},
+      {"accel.hmq.epsilon", T::real, 0.0, 0.0, 1e30, {},
+       "error bound in scene units instead of bits (0: unset); the grid is the coarsest that keeps every vertex within it"},
+      {"accel.hmq.leaf_size", T::integer, std::int64_t{8}, 1, 14, {}, "most triangles per leaf (the paper: 4, 8, 12)"},
+      {"accel.hmq.top_fraction", T::real, 0.05, 0.0, 1.0, {}, "share of the BVH's nodes kept uncompressed at the top"},
       {"accel.bvh.width", T::integer, std::int64_t{2}, 2, 8, {}, "2: binary 32-byte nodes; 8: AVX2 8-wide nodes"},
 
       {"memory.budget", T::text, std::string("none"), 0, 0, {},

@@ -77,6 +77,15 @@ AcceleratorOptions accelerator_options(const Config& config) {
   options.raystrips.packets = config.boolean("accel.raystrips.packets");
   options.raystrips.packet_min_active = static_cast<std::uint32_t>(config.integer("accel.raystrips.packet_min_active"));
   options.raystrips.bins = options.bvh.bins;
+  options.hmq.bits = static_cast<std::uint32_t>(config.integer("accel.hmq.bits"));
+  options.hmq.epsilon = config.real("accel.hmq.epsilon");
+  options.hmq.leaf_size = static_cast<std::uint32_t>(config.integer("accel.hmq.leaf_size"));
+  options.hmq.top_fraction = config.real("accel.hmq.top_fraction");
+  options.hmq.bins = options.bvh.bins;
+  if (options.hmq.epsilon > 0.0 && options.hmq.bits != 16) {
+    throw ConfigError(fmt::format("accel.hmq.bits = {} and accel.hmq.epsilon = {}: set one of them",
+                                  options.hmq.bits, options.hmq.epsilon));
+  }
   options.mlgrid.density = config.real("accel.mlgrid.density");
   options.mlgrid.max_cells = static_cast<std::size_t>(config.integer("accel.mlgrid.max_cells"));
   options.mlgrid.macrocell_factor = static_cast<std::uint32_t>(config.integer("accel.mlgrid.macrocell_factor"));

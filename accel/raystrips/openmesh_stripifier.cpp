@@ -9,6 +9,7 @@
 #include <OpenMesh/Tools/Utils/StripifierT.hh>
 
 #include "accel/raystrips/stripify.hpp"
+#include "scene/mesh_io.hpp"
 
 namespace wavetrace {
 namespace {
@@ -32,6 +33,7 @@ TriangleStrip single_triangle_strip(const TriangleMesh& mesh, std::uint32_t tria
 std::vector<TriangleStrip> stripify_openmesh(const TriangleMesh& mesh, std::span<const std::uint32_t> triangles,
                                              std::uint32_t max_triangles) {
   if (max_triangles < 1) throw std::invalid_argument("a strip needs room for one triangle");
+  silence_openmesh_logs();  // refused (non-manifold) faces become strips of one, counted in the notes
   // Local vertex numbering: the sub-mesh is small, the mesh may not be.
   std::vector<std::uint32_t> local_to_mesh;
   std::unordered_map<std::uint32_t, std::uint32_t> mesh_to_local;

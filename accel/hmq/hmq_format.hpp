@@ -1,0 +1,104 @@
+// The byte layout of HMQ's compressed part (Segovia and Ernst 2010, §4–6, Figure 4): blocks
+// of 4-byte quantized nodes, forward slots to other blocks, and leaf records interleaved
+// after each block. All little-endian; a block starts 4-byte aligned.
+//
+// Block (at a word offset from the start of the block array):
+//   offset     size   field
+//        0        1   node_slots n      (1 .. 64)
+//        1        1   forward_slots f   (n + f <= 64)
+//        2        1   leaves l
+//        3        1   zero
+//        4       4n   node slots 0 .. n-1 (below)
+//   4 + 4n       4f   forward slots: uint32 word offset of another block from the block
+//                     array's start; forward slot j is addressed as slot n + j
+//   4 + 4(n+f)   2l   leaf offsets: uint16 byte offset of leaf record i from the block start
+//   ...               leaf records, byte-aligned, one after another; the block ends 4-aligned
+//
+// Node slot, a uint32:
+//   bits  0-11   lower[x], lower[y], lower[z]: 4 bits each, child.lower = parent.lower + q * step
+//   bits 12-23   upper[x], upper[y], upper[z]: 4 bits each, child.upper = parent.upper - q * step
+//                (step = (parent.upper - parent.lower) / 16 per axis, float arithmetic exactly
+//                as decode_child_box below; the encoder rounds outward)
+//   bits 24-29   index: inner node: its children are slots index and index + 1 of this block,
+//                or, when index >= n, the first two node slots of the block forward slot
+//                index - n points to; leaf: the leaf's number in this block's leaf offsets
+//   bit  30      1: inner node, 0: leaf
+//   bit  31      zero
+// A block's first one or two slots are the roots of its treelet: the two children of the
+// node that forwarded to it, or, for the block under a top-BVH leaf, that leaf's one or two
+// roots (the top leaf's `count` says which) with the top leaf's float box as their parent.
+//
+// Leaf record (its box is its node's decoded box, re-snapped outward to the global grid:
+// lines g_lower = floor, g_upper = ceil; never stored):
+//   bytes 0-4   a 40-bit little-endian header:
+//                 bits  0-8   strip table entry (strip_table.hpp): the triangles and their slots
+//                 bit   9     1: indexed strips (vertices stored once, slots index them);
+//                             0: strips (slot i is vertex i)
+//                 bits 10-15  vertex count v (strips: the entry's slot count)
+//                 bits 16-30  bits per axis of the vertex offsets, 5 bits each: bx, by, bz
+//                 bits 31-33  index bits bi (indexed strips; else 0)
+//                 bits 34-38  triangle id delta bits bt (0 .. 31)
+//                 bit  39     zero
+//   bytes 5-8   uint32 triangle id base
+//   then packed streams (packed_stream.hpp), each starting at the next byte:
+//     x offsets   v values of 1 + bx bits: offset << 1 | from_upper; grid line = from_upper ?
+//                 g_upper.x - offset : g_lower.x + offset (the min-max trick, §4.1)
+//     y, z        the same with by, bz
+//     indices     (indexed strips) slot count values of bi bits: the vertex of each slot
+//     ids         t values of bt bits: triangle k is mesh triangle base + id[k]
+//     corners     t values of 3 bits: 3 c1 + c2, the corners (0, 1, 2 of the strip triangle)
+//                 of the mesh triangle's second and third vertex, for barycentrics
+//   A vertex is the global grid point of its three lines, in floats: origin + line * cell.
+#pragma once
+
+#include <cstdint>
+#include <cstring>
+
+#include <glm/vec3.hpp>
+
+namespace wavetrace::hmq {
+
+inline constexpr std::uint32_t kMaxBlockSlots = 64;
+inline constexpr std::uint32_t kInnerBit = 1u << 30;
+inline constexpr std::uint32_t kBlockHeaderBytes = 4;
+inline constexpr std::uint32_t kLeafHeaderBytes = 9;
+
+struct Box {
+  glm::vec3 lower, upper;
+};
+
+inline bool is_inner(std::uint32_t node) { return (node & kInnerBit) != 0; }
+inline std::uint32_t node_index(std::uint32_t node) { return (node >> 24) & 63u; }
+
+// The child's box from its parent's and its 24 bits; the encoder uses this very function.
+inline Box decode_child_box(const Box& parent, std::uint32_t node) {
+  Box child;
+  for (int axis = 0; axis < 3; ++axis) {
+    const float step = (parent.upper[axis] - parent.lower[axis]) * 0.0625f;
+    child.lower[axis] = parent.lower[axis] + float((node >> (4 * axis)) & 15u) * step;
+    child.upper[axis] = parent.upper[axis] - float((node >> (12 + 4 * axis)) & 15u) * step;
+  }
+  return child;
+}
+
+struct LeafHeader {
+  std::uint32_t entry, vertex_count, index_bits, id_bits, id_base;
+  bool indexed;
+  std::uint32_t axis_bits[3];
+};
+
+inline LeafHeader read_leaf_header(const std::byte* record) {
+  std::uint64_t bits = 0;
+  std::memcpy(&bits, record, 5);
+  LeafHeader header;
+  header.entry = bits & 511u;
+  header.indexed = (bits >> 9) & 1u;
+  header.vertex_count = (bits >> 10) & 63u;
+  for (int axis = 0; axis < 3; ++axis) header.axis_bits[axis] = (bits >> (16 + 5 * axis)) & 31u;
+  header.index_bits = (bits >> 31) & 7u;
+  header.id_bits = (bits >> 34) & 31u;
+  std::memcpy(&header.id_base, record + 5, 4);
+  return header;
+}
+
+}  // namespace wavetrace::hmq

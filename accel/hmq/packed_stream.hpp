@@ -1,0 +1,62 @@
+// Bit strings laid out for fast decoding (HMQ Appendix A): values of `bits` bits are packed
+// p = floor(64 / bits) to a 64-bit little-endian quad-word, and the next group starts at the
+// next *byte* after them, so every group is read with one unaligned 8-byte load and shifts,
+// never a value straddling two words. A stream of `count` values takes
+// (count / p) * ceil(p * bits / 8) + ceil((count % p) * bits / 8) bytes; decoding may read up
+// to 8 bytes from a group's start, so the buffer holding streams keeps 8 bytes of slack.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <span>
+#include <vector>
+
+namespace wavetrace::hmq {
+
+struct StreamShape {
+  std::uint32_t per_group;    // values per quad-word
+  std::uint32_t group_bytes;  // bytes from one group's start to the next
+};
+
+constexpr StreamShape stream_shape(std::uint32_t bits) {
+  const std::uint32_t per_group = bits == 0 ? 64 : 64 / bits;
+  return {per_group, (per_group * bits + 7) / 8};
+}
+
+constexpr std::size_t stream_bytes(std::uint32_t bits, std::uint32_t count) {
+  if (bits == 0) return 0;
+  const StreamShape shape = stream_shape(bits);
+  return std::size_t(count / shape.per_group) * shape.group_bytes + ((count % shape.per_group) * bits + 7) / 8;
+}
+
+// Appends the stream to `out`; every value must fit in `bits` (0 .. 32) bits.
+inline void append_stream(std::vector<std::byte>& out, std::span<const std::uint32_t> values, std::uint32_t bits) {
+  if (bits == 0) return;
+  const StreamShape shape = stream_shape(bits);
+  for (std::size_t first = 0; first < values.size(); first += shape.per_group) {
+    std::uint64_t word = 0;
+    const std::size_t count = std::min<std::size_t>(shape.per_group, values.size() - first);
+    for (std::size_t j = 0; j < count; ++j) word |= std::uint64_t(values[first + j]) << (j * bits);
+    const std::size_t bytes = (count * bits + 7) / 8;
+    for (std::size_t b = 0; b < bytes; ++b) out.push_back(static_cast<std::byte>(word >> (8 * b)));
+  }
+}
+
+// Decodes `count` values of `bits` bits from `data` into `out`.
+inline void read_stream(const std::byte* data, std::uint32_t bits, std::uint32_t count, std::uint32_t* out) {
+  if (bits == 0) {
+    for (std::uint32_t i = 0; i < count; ++i) out[i] = 0;
+    return;
+  }
+  const StreamShape shape = stream_shape(bits);
+  const std::uint64_t mask = (std::uint64_t{1} << bits) - 1;
+  for (std::uint32_t first = 0; first < count; first += shape.per_group, data += shape.group_bytes) {
+    std::uint64_t word;
+    std::memcpy(&word, data, 8);  // unaligned
+    const std::uint32_t end = std::min(count - first, shape.per_group);
+    for (std::uint32_t j = 0; j < end; ++j) out[first + j] = static_cast<std::uint32_t>((word >> (j * bits)) & mask);
+  }
+}
+
+}  // namespace wavetrace::hmq
