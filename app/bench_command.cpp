@@ -1,4 +1,4 @@
-// `wavetrace bench accel` and `wavetrace bench leak`.
+// `wavetrace bench accel`, `bench leak`, `bench reorder` and `bench image`.
 #include <fstream>
 #include <memory>
 #include <sstream>
@@ -7,6 +7,7 @@
 
 #include "app/commands.hpp"
 #include "bench/accel_bench.hpp"
+#include "bench/image_bench.hpp"
 #include "bench/leak_bench.hpp"
 #include "bench/reorder_bench.hpp"
 #include "stages/render_setup.hpp"
@@ -142,6 +143,34 @@ int run_reorder(const ReorderArguments& args) {
   return 0;
 }
 
+struct ImageArguments {
+  std::string scene = "builtin:room:1M";
+  std::string accel = "embree:mode=robust,hmq:bits=8,hmq:bits=12,hmq:bits=16";
+  std::string size = "320x240";
+  int spp = 4;
+  int threads = 0;
+  std::string json;
+  std::vector<std::string> assignments;
+};
+
+int run_image(const ImageArguments& args) {
+  Config config;
+  for (const std::string& assignment : args.assignments) config.set(assignment);
+  config.set_value("scene.source", args.scene);
+  config.set("render.spp=" + std::to_string(args.spp));
+  config.set("render.threads=" + std::to_string(args.threads));
+  const std::size_t by = args.size.find('x');
+  if (by == std::string::npos) throw ConfigError(fmt::format("--size '{}': expected WIDTHxHEIGHT", args.size));
+  config.set("render.width=" + args.size.substr(0, by));
+  config.set("render.height=" + args.size.substr(by + 1));
+  std::vector<AcceleratorSpec> accelerators;
+  for (const std::string& text : split_commas(args.accel)) accelerators.push_back(parse_accelerator_spec(text, config));
+  const ImageBenchReport report = run_image_bench(config, accelerators);
+  fmt::print("{}", to_table(report));
+  if (!args.json.empty()) write_text(args.json, to_json(report).dump(2) + "\n");
+  return 0;
+}
+
 void add_common_options(CLI::App* command, BenchArguments& args) {
   command->add_option("--scene", args.scene, "mesh file, scene file (.toml) or builtin:NAME[:TRIANGLES]");
   command->add_option("--accel", args.accel,
@@ -195,6 +224,20 @@ void add_bench_command(CLI::App& app, int& exit_code) {
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   reorder->callback([reorder_args, &exit_code] { exit_code = run_reorder(*reorder_args); });
+
+  auto image_args = std::make_shared<ImageArguments>();
+  CLI::App* image = bench->add_subcommand("image", "render the same image with each accelerator, RMSE against the first");
+  image->add_option("--scene", image_args->scene, "mesh file, scene file (.toml) or builtin:NAME[:TRIANGLES]");
+  image->add_option("--accel", image_args->accel,
+                    "comma-separated accelerators, TYPE[:key=value]...; the first renders the reference image");
+  image->add_option("--spp", image_args->spp, "samples per pixel");
+  image->add_option("--size", image_args->size, "image size as WIDTHxHEIGHT");
+  image->add_option("--threads", image_args->threads, "worker threads (0: all cores)");
+  image->add_option("--json", image_args->json, "write results as JSON");
+  image->add_option("--set", image_args->assignments, "config override section.key=value (e.g. render.max_depth=2)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  image->callback([image_args, &exit_code] { exit_code = run_image(*image_args); });
 }
 
 }  // namespace wavetrace

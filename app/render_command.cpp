@@ -49,9 +49,10 @@ int run_render(const RenderArguments& args) {
   const Config config = build_config(args);
   const RenderPlan plan = plan_render(config);
 
-  const Scene scene = load_scene(plan.scene);
+  Scene scene = load_scene(plan.scene);
   const Camera camera = resolve_camera(plan.camera, scene);
   const std::unique_ptr<Accelerator> accelerator = make_accelerator(scene.mesh, plan.accelerator);
+  adopt_represented_surface(scene, *accelerator);
   const LightSampler lights(scene);
   const std::unique_ptr<Proxy> proxy = build_proxy(plan, scene, *accelerator);
   const World world{scene, *accelerator, lights, proxy.get()};

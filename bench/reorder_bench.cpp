@@ -26,9 +26,10 @@ ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<Reo
     throw ConfigError(fmt::format("render.max_depth = {}: the reorder benchmark path traces to depth 3 or more",
                                   base.rules.max_depth));
   }
-  const Scene scene = load_scene(base.scene);
+  Scene scene = load_scene(base.scene);
   const Camera camera = resolve_camera(base.camera, scene);
   const auto accelerator = make_accelerator(scene.mesh, base.accelerator);
+  adopt_represented_surface(scene, *accelerator);
   const LightSampler lights(scene);
   std::unique_ptr<Proxy> proxy;
   for (ReorderHeuristic heuristic : heuristics) {

@@ -195,6 +195,13 @@ std::vector<const Stage*> StageChain::stages() const {
   return stages;
 }
 
+bool adopt_represented_surface(Scene& scene, const Accelerator& accelerator) {
+  std::optional<TriangleMesh> represented = accelerator.represented_mesh(scene.mesh);
+  if (!represented) return false;
+  scene.mesh.positions = std::move(represented->positions);
+  return true;
+}
+
 RenderOutput render_image(const RenderPlan& plan, const World& world, const Camera& camera,
                           const std::function<void(const Progress&)>& on_progress) {
   Film film(plan.image.width, plan.image.height);

@@ -91,6 +91,11 @@ struct RenderOutput {
   std::uint64_t rejected_contributions = 0;
 };
 
+// Shading and spawning read the scene's mesh (normals, hit points from barycentrics); with
+// a lossy accelerator (hmq) they must read the surface it answers for, or secondary rays
+// start off that surface. Replaces the mesh's positions with it; returns whether it did.
+bool adopt_represented_surface(Scene& scene, const Accelerator& accelerator);
+
 RenderOutput render_image(const RenderPlan& plan, const World& world, const Camera& camera,
                           const std::function<void(const Progress&)>& on_progress = {});
 
