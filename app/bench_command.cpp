@@ -116,19 +116,27 @@ struct ReorderArguments {
   std::vector<std::string> assignments;
 };
 
-int run_reorder(const ReorderArguments& args) {
+// A rendering benchmark's config: `defaults`, then the --set assignments, then its own flags.
+Config render_bench_config(const std::vector<std::string>& defaults, const std::vector<std::string>& assignments,
+                           const std::string& scene, int spp, int threads, const std::string& size) {
   Config config;
-  config.set("render.max_depth=5");
-  for (const std::string& assignment : args.assignments) config.set(assignment);
-  config.set_value("scene.source", args.scene);
+  for (const std::string& assignment : defaults) config.set(assignment);
+  for (const std::string& assignment : assignments) config.set(assignment);
+  config.set_value("scene.source", scene);
+  config.set("render.spp=" + std::to_string(spp));
+  config.set("render.threads=" + std::to_string(threads));
+  const std::size_t by = size.find('x');
+  if (by == std::string::npos) throw ConfigError(fmt::format("--size '{}': expected WIDTHxHEIGHT", size));
+  config.set("render.width=" + size.substr(0, by));
+  config.set("render.height=" + size.substr(by + 1));
+  return config;
+}
+
+int run_reorder(const ReorderArguments& args) {
+  Config config =
+      render_bench_config({"render.max_depth=5"}, args.assignments, args.scene, args.spp, args.threads, args.size);
   config.set("accel.type=" + args.accel);
   config.set("reorder.curve=" + args.curve);
-  config.set("render.spp=" + std::to_string(args.spp));
-  config.set("render.threads=" + std::to_string(args.threads));
-  const std::size_t by = args.size.find('x');
-  if (by == std::string::npos) throw ConfigError(fmt::format("--size '{}': expected WIDTHxHEIGHT", args.size));
-  config.set("render.width=" + args.size.substr(0, by));
-  config.set("render.height=" + args.size.substr(by + 1));
   std::vector<ReorderHeuristic> heuristics;
   for (const std::string& name : split_commas(args.heuristics)) {
     try {
@@ -154,15 +162,7 @@ struct ImageArguments {
 };
 
 int run_image(const ImageArguments& args) {
-  Config config;
-  for (const std::string& assignment : args.assignments) config.set(assignment);
-  config.set_value("scene.source", args.scene);
-  config.set("render.spp=" + std::to_string(args.spp));
-  config.set("render.threads=" + std::to_string(args.threads));
-  const std::size_t by = args.size.find('x');
-  if (by == std::string::npos) throw ConfigError(fmt::format("--size '{}': expected WIDTHxHEIGHT", args.size));
-  config.set("render.width=" + args.size.substr(0, by));
-  config.set("render.height=" + args.size.substr(by + 1));
+  const Config config = render_bench_config({}, args.assignments, args.scene, args.spp, args.threads, args.size);
   std::vector<AcceleratorSpec> accelerators;
   for (const std::string& text : split_commas(args.accel)) accelerators.push_back(parse_accelerator_spec(text, config));
   const ImageBenchReport report = run_image_bench(config, accelerators);

@@ -17,11 +17,14 @@
 #include "accel/hmq/strip_table.hpp"
 #include "accel/registry.hpp"
 #include "bench/accel_bench.hpp"
+#include "bench/image_bench.hpp"
 #include "bench/leak_bench.hpp"
 #include "bench/ray_sets.hpp"
 #include "scene/builtin_scenes.hpp"
 #include "scene/scene.hpp"
 #include "stages/config.hpp"
+#include "accel_agreement.hpp"
+#include "stages/render_setup.hpp"
 
 namespace wavetrace {
 namespace {
@@ -162,33 +165,6 @@ TEST(HmqLeaf, RecordDecodesToTheSnappedVerticesIdsAndCorners) {
   }
 }
 
-struct Agreement {
-  std::size_t rays = 0, hit_differs = 0, far_t = 0, far_uv = 0, same_primitive = 0;
-  double max_t_error = 0.0;
-};
-
-Agreement compare(const Scene& scene, const Accelerator& reference, const Accelerator& tested, RaySetKind kind,
-                  std::size_t count, float t_tolerance) {
-  const RaySet rays = make_ray_set(kind, scene, reference, count);
-  const auto expected = trace_ray_set(reference, rays);
-  const auto actual = trace_ray_set(tested, rays);
-  Agreement result;
-  for (std::size_t b = 0; b < rays.batches.size(); ++b) {
-    for (std::size_t i = 0; i < rays.batches[b]->count; ++i) {
-      ++result.rays;
-      const HitBatch& e = *expected[b];
-      const HitBatch& a = *actual[b];
-      result.hit_differs += e.is_hit(i) != a.is_hit(i);
-      if (rays.any_hit() || !e.is_hit(i) || !a.is_hit(i)) continue;
-      result.far_t += std::fabs(e.t[i] - a.t[i]) > t_tolerance;
-      if (e.primitive[i] == a.primitive[i]) {
-        ++result.same_primitive;
-        result.far_uv += std::fabs(e.u[i] - a.u[i]) > 0.05f || std::fabs(e.v[i] - a.v[i]) > 0.05f;
-      }
-    }
-  }
-  return result;
-}
 
 class HmqAgreesWithEmbree : public ::testing::TestWithParam<std::string> {};
 
@@ -209,7 +185,8 @@ TEST_P(HmqAgreesWithEmbree, ExactlyOnTheSurfaceItRepresentsAndWithinItsErrorOnTh
     Scene snapped_scene = scene;
     snapped_scene.mesh = snapped;
     for (const RaySetKind kind : {RaySetKind::primary, RaySetKind::random, RaySetKind::diffuse, RaySetKind::shadow}) {
-      const Agreement result = compare(snapped_scene, *snapped_reference, *hmq, kind, 8000, 1e-4f * diagonal);
+      const testing::Agreement result =
+          testing::compare_on_rays(snapped_scene, *snapped_reference, *hmq, kind, 8000, 1e-4f * diagonal, 0.05f);
       const std::string label = "leaf " + std::to_string(leaf_size) + " " + to_string(kind);
       EXPECT_LE(double(result.hit_differs), 1e-4 * double(result.rays)) << label;
       EXPECT_LE(double(result.far_t), 1e-4 * double(result.rays)) << label;
@@ -221,7 +198,8 @@ TEST_P(HmqAgreesWithEmbree, ExactlyOnTheSurfaceItRepresentsAndWithinItsErrorOnTh
     // Against the mesh itself, from the camera: vertices moved by ~1e-5 of the scene at q = 16
     // change an answer only on silhouettes (a grazing ray that now hits or misses a triangle
     // finds its hit far away).
-    const Agreement original = compare(scene, *reference, *hmq, RaySetKind::primary, 8000, 1e-3f * diagonal);
+    const testing::Agreement original =
+        testing::compare_on_rays(scene, *reference, *hmq, RaySetKind::primary, 8000, 1e-3f * diagonal, 0.05f);
     EXPECT_LE(double(original.hit_differs), 1e-3 * double(original.rays)) << "leaf " << leaf_size;
     EXPECT_LE(double(original.far_t), 3e-3 * double(original.rays)) << "leaf " << leaf_size;
   }
@@ -263,6 +241,41 @@ TEST(Hmq, MemoryIsItsPartsAndFarBelowTheBaseline) {
   coarse.bits = 10;
   EXPECT_LT(make_hmq_accelerator(scene.mesh, coarse)->memory().total(), hmq->memory().total());
   EXPECT_NE(hmq->build_notes().find("grid 16x16x16 bits"), std::string::npos) << hmq->build_notes();
+}
+
+TEST(Hmq, RendersShadeTheSurfaceItRepresents) {
+  Scene scene = make_builtin_scene("builtin:sphere:5000");
+  const TriangleMesh original = scene.mesh;
+  const auto bvh = make_bvh_accelerator(scene.mesh, BvhOptions{});
+  EXPECT_FALSE(adopt_represented_surface(scene, *bvh));
+  EXPECT_EQ(scene.mesh.positions, original.positions);
+  HmqOptions coarse;
+  coarse.bits = 8;
+  const auto hmq = make_hmq_accelerator(scene.mesh, coarse);
+  ASSERT_TRUE(adopt_represented_surface(scene, *hmq));
+  EXPECT_NE(scene.mesh.positions, original.positions);
+  EXPECT_EQ(scene.mesh.positions, hmq->represented_mesh(original)->positions);
+  EXPECT_EQ(scene.mesh.triangles, original.triangles);
+}
+
+TEST(Hmq, ImagesApproachTheReferenceAsTheGridRefines) {
+  Config config;
+  config.set_value("scene.source", std::string("builtin:sphere:20k"));
+  config.set("render.width=64");
+  config.set("render.height=48");
+  config.set("render.spp=2");
+  std::vector<AcceleratorSpec> accelerators;
+  for (const char* text : {"embree:mode=robust", "bvh", "hmq:bits=6", "hmq:bits=16"}) {
+    accelerators.push_back(parse_accelerator_spec(text, config));
+  }
+  const ImageBenchReport report = run_image_bench(config, accelerators);
+  ASSERT_EQ(report.results.size(), 4u);
+  EXPECT_EQ(report.results[0].rmse, 0.0);
+  EXPECT_LT(report.results[1].relative_rmse, 1e-3) << "the same surface, watertight both";
+  EXPECT_GT(report.results[2].rmse, report.results[3].rmse);
+  EXPECT_GT(report.results[2].relative_rmse, 1e-3) << "64 lines per axis visibly move the sphere";
+  EXPECT_LT(report.results[3].relative_rmse, 1e-2);
+  EXPECT_LT(report.results[3].bytes_per_triangle, report.results[1].bytes_per_triangle / 3);
 }
 
 TEST(Hmq, BadOptionsAreClearErrors) {

@@ -20,6 +20,7 @@
 #include "scene/builtin_scenes.hpp"
 #include "scene/scene.hpp"
 #include "stages/config.hpp"
+#include "accel_agreement.hpp"
 
 namespace wavetrace {
 namespace {
@@ -134,33 +135,6 @@ TEST_P(Stripifiers, CoverEveryTriangleWithItsOwnCornersAndRespectTheLengthLimit)
 INSTANTIATE_TEST_SUITE_P(Both, Stripifiers, ::testing::Values(StripifierKind::dual_path, StripifierKind::openmesh),
                          [](const auto& info) { return to_string(info.param); });
 
-struct Agreement {
-  std::size_t rays = 0, hit_differs = 0, far_t = 0, far_uv = 0, same_primitive = 0;
-};
-
-Agreement compare(const Scene& scene, const Accelerator& reference, const Accelerator& tested, RaySetKind kind,
-                  std::size_t count, bool packets) {
-  const RaySet rays = make_ray_set(kind, scene, reference, count);
-  const auto expected = trace_ray_set(reference, rays);
-  const auto actual = trace_ray_set(tested, rays, packets);
-  const float diagonal = scene.mesh.bounds().diagonal();
-  Agreement result;
-  for (std::size_t b = 0; b < rays.batches.size(); ++b) {
-    for (std::size_t i = 0; i < rays.batches[b]->count; ++i) {
-      ++result.rays;
-      const HitBatch& e = *expected[b];
-      const HitBatch& a = *actual[b];
-      result.hit_differs += e.is_hit(i) != a.is_hit(i);
-      if (rays.any_hit() || !e.is_hit(i) || !a.is_hit(i)) continue;
-      result.far_t += std::fabs(e.t[i] - a.t[i]) > 1e-4f * diagonal;
-      if (e.primitive[i] == a.primitive[i]) {
-        ++result.same_primitive;
-        result.far_uv += std::fabs(e.u[i] - a.u[i]) > 1e-3f || std::fabs(e.v[i] - a.v[i]) > 1e-3f;
-      }
-    }
-  }
-  return result;
-}
 
 class RayStripsAgreesWithEmbree : public ::testing::TestWithParam<std::string> {};
 
@@ -185,7 +159,8 @@ TEST_P(RayStripsAgreesWithEmbree, OnAtLeast9999PerMyriadOfRaysWithTheMeshsBaryce
       for (const RaySetKind kind : {RaySetKind::primary, RaySetKind::random, RaySetKind::diffuse, RaySetKind::shadow}) {
         for (const bool packets : {false, true}) {
           if (packets && kind != RaySetKind::primary) continue;
-          const Agreement result = compare(scene, *reference, *strips, kind, 8000, packets);
+          const testing::Agreement result = testing::compare_on_rays(scene, *reference, *strips, kind, 8000,
+                                                   1e-4f * scene.mesh.bounds().diagonal(), 1e-3f, packets);
           const std::string label = to_string(stripifier) + " run " + std::to_string(run) + " " + to_string(kind) +
                                     (packets ? " packets" : "");
           EXPECT_LE(double(result.hit_differs), 1e-4 * double(result.rays)) << label;

@@ -12,11 +12,13 @@
 #include <tbb/parallel_for.h>
 
 #include "accel/bvh/bvh_node.hpp"
+#include "accel/bvh/bvh_walk.hpp"
 #include "accel/bvh/leaf_query.hpp"
 #include "accel/bvh/sah_builder.hpp"
 #include "accel/hmq/global_grid.hpp"
 #include "accel/hmq/hmq_format.hpp"
 #include "accel/hmq/leaf_codec.hpp"
+#include "accel/probed_accelerator.hpp"
 #include "kernels/ray_box.hpp"
 #include "kernels/triangle_intersect.hpp"
 #include "memory/cache_aligned_allocator.hpp"
@@ -184,7 +186,9 @@ struct HmqHit {
   bool found = false;
 };
 
-class HmqAccelerator final : public Accelerator {
+class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
+  friend class ProbedAccelerator<HmqAccelerator>;
+
  public:
   HmqAccelerator(const TriangleMesh& mesh, const HmqOptions& options) : options_(options) {
     check_options(options);
@@ -277,24 +281,6 @@ class HmqAccelerator final : public Accelerator {
 
   std::string name() const override { return "hmq"; }
 
-  void intersect_closest(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
-    NullProbe probe;
-    traverse<false>(rays, hits, range, probe);
-  }
-  void intersect_any(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
-    NullProbe probe;
-    traverse<true>(rays, hits, range, probe);
-  }
-  bool probed() const override { return true; }
-  void intersect_closest_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
-                                RecordingProbe& probe) const override {
-    traverse<false>(rays, hits, range, probe);
-  }
-  void intersect_any_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
-                            RecordingProbe& probe) const override {
-    traverse<true>(rays, hits, range, probe);
-  }
-
   MemoryReport memory() const override {
     MemoryReport report;
     report.hierarchy = top_.size() * sizeof(BvhNode) + parts_.hierarchy;
@@ -329,12 +315,6 @@ class HmqAccelerator final : public Accelerator {
 
   template <bool kAnyHit, typename Probe>
   void traverse(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
-    struct StackEntry {
-      std::uint32_t node;
-      float distance;
-    };
-    StackEntry stack[kMaxTreeDepth];
-    const BvhNode* nodes = top_.data();
     for (std::uint32_t i = range.begin; i < range.end; ++i) {
       if (!(rays.flags[i] & ray_flags::alive)) {
         write_miss(hits, i);
@@ -347,37 +327,10 @@ class HmqAccelerator final : public Accelerator {
       const float tmin = rays.tmin[i];
       float tmax = rays.tmax[i];
       HmqHit best;
-      std::uint32_t top = 0, node = 0;
-      probe.read(nodes, sizeof(BvhNode));
-      if (intersect_box(box_ray, nodes[0].lower, nodes[0].upper, tmin, tmax) == kInfinity) {
-        write_miss(hits, i);
-        continue;
-      }
-      while (true) {
-        const BvhNode& current = nodes[node];
-        if (current.leaf()) {
-          traverse_blocks<kAnyHit>(current, box_ray, sheared, tmin, tmax, best, probe);
-          if (kAnyHit && best.found) break;
-        } else {
-          std::uint32_t near = current.left(), far = current.right();
-          probe.read(nodes + near, sizeof(BvhNode));
-          probe.read(nodes + far, sizeof(BvhNode));
-          float near_distance = intersect_box(box_ray, nodes[near].lower, nodes[near].upper, tmin, tmax);
-          float far_distance = intersect_box(box_ray, nodes[far].lower, nodes[far].upper, tmin, tmax);
-          if (far_distance < near_distance) {
-            std::swap(near, far);
-            std::swap(near_distance, far_distance);
-          }
-          if (near_distance != kInfinity) {
-            if (far_distance != kInfinity) stack[top++] = {far, far_distance};
-            node = near;
-            continue;
-          }
-        }
-        while (top > 0 && stack[top - 1].distance > tmax) --top;
-        if (top == 0) break;
-        node = stack[--top].node;
-      }
+      walk_bvh(top_.data(), box_ray, tmin, tmax, probe, [&](const BvhNode& leaf) {
+        traverse_blocks<kAnyHit>(leaf, box_ray, sheared, tmin, tmax, best, probe);
+        return kAnyHit && best.found;
+      });
       write_hit(best, hits, i, probe);
     }
   }

@@ -12,9 +12,11 @@
 #include <tbb/parallel_for.h>
 
 #include "accel/bvh/bvh_node.hpp"
+#include "accel/bvh/bvh_walk.hpp"
 #include "accel/bvh/leaf_query.hpp"
 #include "accel/bvh/node_layout.hpp"
 #include "accel/bvh/sah_builder.hpp"
+#include "accel/probed_accelerator.hpp"
 #include "accel/raystrips/strip_encode.hpp"
 #include "accel/raystrips/strip_packet.hpp"
 #include "accel/raystrips/strip_traversal.hpp"
@@ -85,7 +87,9 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> cut_submeshes(const BuildTr
   return submeshes;
 }
 
-class RayStripsAccelerator final : public Accelerator {
+class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator> {
+  friend class ProbedAccelerator<RayStripsAccelerator>;
+
  public:
   RayStripsAccelerator(const TriangleMesh& mesh, const RayStripsOptions& options) : options_(options) {
     check_options(options);
@@ -201,14 +205,6 @@ class RayStripsAccelerator final : public Accelerator {
 
   std::string name() const override { return "raystrips"; }
 
-  void intersect_closest(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
-    NullProbe probe;
-    traverse<false>(rays, hits, range, probe);
-  }
-  void intersect_any(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
-    NullProbe probe;
-    traverse<true>(rays, hits, range, probe);
-  }
   void intersect_coherent(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
     if (!options_.packets) return intersect_closest(rays, hits, range);
     PacketTraversal packets{nodes_.data(), strip_bytes_.data(), positions_.data(), options_.run_triangles,
@@ -218,16 +214,6 @@ class RayStripsAccelerator final : public Accelerator {
       packets.trace(rays, hits, {begin, end}, [&](const StripRay& ray, std::uint32_t i) { write_hit(ray, hits, i); });
     }
   }
-  bool probed() const override { return true; }
-  void intersect_closest_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
-                                RecordingProbe& probe) const override {
-    traverse<false>(rays, hits, range, probe);
-  }
-  void intersect_any_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
-                            RecordingProbe& probe) const override {
-    traverse<true>(rays, hits, range, probe);
-  }
-
   MemoryReport memory() const override {
     MemoryReport report;
     report.hierarchy = nodes_.size() * sizeof(BvhNode) + stats_.header_and_tree_bytes;
@@ -310,12 +296,6 @@ class RayStripsAccelerator final : public Accelerator {
 
   template <bool kAnyHit, typename Probe>
   void traverse(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
-    struct StackEntry {
-      std::uint32_t node;
-      float distance;
-    };
-    StackEntry stack[kMaxTreeDepth];
-    const BvhNode* nodes = nodes_.data();
     const glm::vec3* positions = positions_.data();
     for (std::uint32_t i = range.begin; i < range.end; ++i) {
       if (!(rays.flags[i] & ray_flags::alive)) {
@@ -324,53 +304,22 @@ class RayStripsAccelerator final : public Accelerator {
       }
       StripRay ray({rays.origin_x[i], rays.origin_y[i], rays.origin_z[i]},
                    {rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]}, rays.tmin[i], rays.tmax[i]);
-      std::uint32_t top = 0;
-      std::uint32_t node = 0;
-      probe.read(nodes, sizeof(BvhNode));
-      if (intersect_box(ray.box, nodes[0].lower, nodes[0].upper, ray.tmin, ray.tmax) == kInfinity) {
-        write_miss(hits, i);
-        continue;
-      }
-      while (true) {
-        const BvhNode& current = nodes[node];
-        if (current.leaf()) {
-          float near, far;
-          if (clip_to_box(ray.box, current.lower, current.upper, ray.tmin, ray.tmax, near, far)) {
-            const std::byte* strip_data = strip_bytes_.data() + std::size_t(current.first) * 4;
-            for (std::uint32_t s = 0; s < current.triangle_count(); ++s) {
-              probe.read(strip_data, ray_strip::kHeaderBytes);
-              const StripView strip(strip_data);
-              ray.traverse<kAnyHit>(strip, positions, near, far, options_.run_triangles, probe);
-              if (kAnyHit && ray.found()) break;
-              strip_data += strip.size();
-            }
-          }
-          if (kAnyHit && ray.found()) break;
-        } else {
-          std::uint32_t near = current.left(), far = current.right();
-          probe.read(nodes + near, sizeof(BvhNode));
-          probe.read(nodes + far, sizeof(BvhNode));
-          float near_distance = intersect_box(ray.box, nodes[near].lower, nodes[near].upper, ray.tmin, ray.tmax);
-          float far_distance = intersect_box(ray.box, nodes[far].lower, nodes[far].upper, ray.tmin, ray.tmax);
-          if (far_distance < near_distance) {
-            std::swap(near, far);
-            std::swap(near_distance, far_distance);
-          }
-          if (near_distance != kInfinity) {
-            if (far_distance != kInfinity) stack[top++] = {far, far_distance};
-            node = near;
-            continue;
-          }
+      walk_bvh(nodes_.data(), ray.box, ray.tmin, ray.tmax, probe, [&](const BvhNode& leaf) {
+        float near, far;
+        if (!clip_to_box(ray.box, leaf.lower, leaf.upper, ray.tmin, ray.tmax, near, far)) return false;
+        const std::byte* strip_data = strip_bytes_.data() + std::size_t(leaf.first) * 4;
+        for (std::uint32_t s = 0; s < leaf.triangle_count(); ++s) {
+          probe.read(strip_data, ray_strip::kHeaderBytes);
+          const StripView strip(strip_data);
+          ray.traverse<kAnyHit>(strip, positions, near, far, options_.run_triangles, probe);
+          if (kAnyHit && ray.found()) return true;
+          strip_data += strip.size();
         }
-        while (top > 0 && stack[top - 1].distance > ray.tmax) --top;
-        if (top == 0) break;
-        node = stack[--top].node;
-      }
+        return false;
+      });
       write_hit(ray, hits, i, &probe);
     }
   }
-
-  static constexpr float kInfinity = std::numeric_limits<float>::infinity();
 
   RayStripsOptions options_;
   LargeArray<BvhNode> nodes_;
