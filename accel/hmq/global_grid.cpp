@@ -27,6 +27,7 @@ GlobalGrid grid_from_bits(const Bounds3& bounds, std::uint32_t bits) {
     // A flat axis still needs a positive cell; any will do, every vertex sits at line 0.
     grid.cell[axis] = extent > 0.0f ? extent / float((1u << bits) - 1) : 1.0f;
   }
+  grid.inverse_cell = 1.0f / grid.cell;
   grid.max_vertex_error = error_of(grid.cell);
   return grid;
 }
@@ -51,6 +52,7 @@ GlobalGrid grid_from_epsilon(const Bounds3& bounds, double epsilon) {
     grid.bits[axis] = bits;
     grid.cell[axis] = static_cast<float>(cell);
   }
+  grid.inverse_cell = 1.0f / grid.cell;
   grid.max_vertex_error = error_of(grid.cell);
   return grid;
 }

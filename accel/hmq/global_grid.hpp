@@ -16,6 +16,7 @@ namespace wavetrace {
 struct GlobalGrid {
   glm::vec3 origin{0.0f};
   glm::vec3 cell{1.0f};
+  glm::vec3 inverse_cell{1.0f};  // 1 / cell, for re-snapping leaf boxes without dividing
   glm::uvec3 bits{16};
   // What snapping promises: no vertex moves more than this (half a cell diagonal).
   double max_vertex_error = 0.0;
@@ -33,11 +34,12 @@ struct GlobalGrid {
     return {origin.x + float(g.x) * cell.x, origin.y + float(g.y) * cell.y, origin.z + float(g.z) * cell.z};
   }
   // The grid lines at or below / at or above a coordinate (for re-snapping leaf boxes).
+  // The encoder and the decoder both re-snap through these, so their rounding is shared.
   int floor_line(float value, int axis) const {
-    return static_cast<int>(std::floor((value - origin[axis]) / cell[axis]));
+    return static_cast<int>(std::floor((value - origin[axis]) * inverse_cell[axis]));
   }
   int ceil_line(float value, int axis) const {
-    return static_cast<int>(std::ceil((value - origin[axis]) / cell[axis]));
+    return static_cast<int>(std::ceil((value - origin[axis]) * inverse_cell[axis]));
   }
 };
 

@@ -335,54 +335,65 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
     }
   }
 
-  // The compressed treelets under one top leaf: nodes decoded from their parents' boxes.
+  // The compressed treelets under one top leaf: nodes decoded from their parents' boxes,
+  // the nearer child visited next and the farther one stacked, as in walk_bvh.
   template <bool kAnyHit, typename Probe>
   void traverse_blocks(const BvhNode& top_leaf, const BoxRay& box_ray, const WatertightRay& sheared, float tmin,
                        float& tmax, HmqHit& best, Probe& probe) const {
-    struct Entry {
+    struct Node {
       const std::byte* block;
-      std::uint32_t slot;
-      float distance;
-      Box box;
+      std::uint32_t word;  // its slot
+      float distance;      // where the ray enters its box
+      Box box;             // decoded
     };
-    Entry stack[2 * kMaxTreeDepth];
+    Node stack[kMaxTreeDepth + 2];
     std::uint32_t top = 0;
-    const std::byte* root_block = blocks_.data() + std::size_t(top_leaf.first) * 4;
-    const Box top_box{top_leaf.lower, top_leaf.upper};
-    for (std::uint32_t r = top_leaf.triangle_count(); r-- > 0;) {
-      const std::uint32_t word = slot_word(root_block, r, probe);
-      const Box box = decode_child_box(top_box, word);
-      const float distance = intersect_box(box_ray, box.lower, box.upper, tmin, tmax);
-      if (distance != kInfinity) stack[top++] = {root_block, r, distance, box};
-    }
-    if (top == 2 && stack[1].distance > stack[0].distance) std::swap(stack[0], stack[1]);
-    while (top > 0) {
-      const Entry entry = stack[--top];
-      if (entry.distance > tmax) continue;
-      const std::uint32_t word = slot_word(entry.block, entry.slot, probe);
-      if (!is_inner(word)) {
-        test_leaf<kAnyHit>(entry.block, node_index(word), entry.box, sheared, tmin, tmax, best, probe);
-        if (kAnyHit && best.found) return;
-        continue;
+    // The node pair at `slot` of `block` (one node when `count` is 1), children of `parent`:
+    // the nearer hit one becomes `next`, the other is stacked; false when neither is hit.
+    auto visit_pair = [&](const std::byte* block, std::uint32_t slot, std::uint32_t count, const Box& parent,
+                          Node& next) {
+      Node pair[2];
+      std::uint32_t hit = 0;
+      for (std::uint32_t k = 0; k < count; ++k) {
+        const std::uint32_t word = slot_word(block, slot + k, probe);
+        const Box box = decode_child_box(parent, word);
+        const float distance = intersect_box(box_ray, box.lower, box.upper, tmin, tmax);
+        if (distance != kInfinity) pair[hit++] = {block, word, distance, box};
       }
-      const std::byte* child_block = entry.block;
-      std::uint32_t child_slot = node_index(word);
-      const std::uint32_t node_slots = static_cast<std::uint8_t>(entry.block[0]);
-      if (child_slot >= node_slots) {
-        std::uint32_t forward;
-        probe.read(entry.block + kBlockHeaderBytes + 4 * child_slot, 4);
-        std::memcpy(&forward, entry.block + kBlockHeaderBytes + 4 * child_slot, 4);
-        child_block = blocks_.data() + std::size_t(forward) * 4;
-        child_slot = 0;
+      if (hit == 0) return false;
+      if (hit == 2 && pair[1].distance < pair[0].distance) std::swap(pair[0], pair[1]);
+      if (hit == 2) stack[top++] = pair[1];
+      next = pair[0];
+      return true;
+    };
+    Node current{};
+    bool have = visit_pair(blocks_.data() + std::size_t(top_leaf.first) * 4, 0, top_leaf.triangle_count(),
+                           Box{top_leaf.lower, top_leaf.upper}, current);
+    while (true) {
+      if (have) {
+        if (!is_inner(current.word)) {
+          test_leaf<kAnyHit>(current.block, node_index(current.word), current.box, sheared, tmin, tmax, best, probe);
+          if (kAnyHit && best.found) return;
+          have = false;
+        } else {
+          const std::byte* child_block = current.block;
+          std::uint32_t child_slot = node_index(current.word);
+          if (child_slot >= static_cast<std::uint8_t>(current.block[0])) {  // a forward slot
+            std::uint32_t forward;
+            probe.read(current.block + kBlockHeaderBytes + 4 * child_slot, 4);
+            std::memcpy(&forward, current.block + kBlockHeaderBytes + 4 * child_slot, 4);
+            child_block = blocks_.data() + std::size_t(forward) * 4;
+            child_slot = 0;
+          }
+          const Box box = current.box;
+          have = visit_pair(child_block, child_slot, 2, box, current);
+        }
+        if (have) continue;
       }
-      const Box first_box = decode_child_box(entry.box, slot_word(child_block, child_slot, probe));
-      const Box second_box = decode_child_box(entry.box, slot_word(child_block, child_slot + 1, probe));
-      float first = intersect_box(box_ray, first_box.lower, first_box.upper, tmin, tmax);
-      float second = intersect_box(box_ray, second_box.lower, second_box.upper, tmin, tmax);
-      Entry near{child_block, child_slot, first, first_box}, far{child_block, child_slot + 1, second, second_box};
-      if (second < first) std::swap(near, far);
-      if (far.distance != kInfinity) stack[top++] = far;
-      if (near.distance != kInfinity) stack[top++] = near;
+      while (top > 0 && stack[top - 1].distance > tmax) --top;
+      if (top == 0) return;
+      current = stack[--top];
+      have = true;
     }
   }
 

@@ -80,15 +80,6 @@ std::vector<LeafStrip> strips_of_leaf(const TriangleMesh& mesh, std::span<const 
 
 }  // namespace
 
-GridBox snap_outward(const GlobalGrid& grid, const Box& box) {
-  GridBox snapped;
-  for (int axis = 0; axis < 3; ++axis) {
-    snapped.lower[axis] = grid.floor_line(box.lower[axis], axis);
-    snapped.upper[axis] = grid.ceil_line(box.upper[axis], axis);
-  }
-  return snapped;
-}
-
 void encode_leaf(const QuantizedMesh& quantized, std::span<const std::uint32_t> triangles, const GridBox& box,
                  std::vector<std::byte>& out) {
   if (triangles.empty() || triangles.size() > kMaxLeafTriangles) {

@@ -24,7 +24,14 @@ struct QuantizedMesh {
 struct GridBox {
   glm::ivec3 lower, upper;
 };
-GridBox snap_outward(const GlobalGrid& grid, const Box& box);
+inline GridBox snap_outward(const GlobalGrid& grid, const Box& box) {
+  GridBox snapped;
+  for (int axis = 0; axis < 3; ++axis) {
+    snapped.lower[axis] = grid.floor_line(box.lower[axis], axis);
+    snapped.upper[axis] = grid.ceil_line(box.upper[axis], axis);
+  }
+  return snapped;
+}
 
 // Appends the record of `triangles` (1 .. 14 mesh triangle ids) to `out`.
 void encode_leaf(const QuantizedMesh& quantized, std::span<const std::uint32_t> triangles, const GridBox& box,

@@ -6,6 +6,7 @@
 // to 8 bytes from a group's start, so the buffer holding streams keeps 8 bytes of slack.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -19,10 +20,19 @@ struct StreamShape {
   std::uint32_t group_bytes;  // bytes from one group's start to the next
 };
 
-constexpr StreamShape stream_shape(std::uint32_t bits) {
+constexpr StreamShape compute_stream_shape(std::uint32_t bits) {
   const std::uint32_t per_group = bits == 0 ? 64 : 64 / bits;
   return {per_group, (per_group * bits + 7) / 8};
 }
+
+// Appendix A's look-up table: the shape for every width 0 .. 64, so decoding divides nothing.
+inline constexpr auto kStreamShapes = [] {
+  std::array<StreamShape, 65> shapes{};
+  for (std::uint32_t bits = 0; bits <= 64; ++bits) shapes[bits] = compute_stream_shape(bits);
+  return shapes;
+}();
+
+constexpr StreamShape stream_shape(std::uint32_t bits) { return kStreamShapes[bits]; }
 
 constexpr std::size_t stream_bytes(std::uint32_t bits, std::uint32_t count) {
   if (bits == 0) return 0;
