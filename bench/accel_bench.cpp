@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include <fmt/format.h>
+#include <glm/geometric.hpp>
 
 #include "stages/render_setup.hpp"
 #include "stages/tracing_arena.hpp"
@@ -61,6 +62,35 @@ AcceleratorSpec parse_accelerator_spec(const std::string& text, const Config& ba
     colon = next;
   }
   return {text, accelerator_options(config)};
+}
+
+// For a lossy accelerator: the distance of each hit point (origin + t direction) from the
+// point with the same barycentrics on the mesh's triangle, against the largest vertex move.
+void measure_surface_error(const TriangleMesh& mesh, const Accelerator& accelerator, const RaySet& rays,
+                           const std::vector<std::unique_ptr<HitBatch>>& hits, AccelBenchResult& result) {
+  const std::optional<TriangleMesh> represented = accelerator.represented_mesh(mesh);
+  if (!represented) return;
+  double moved = 0.0;
+  for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
+    moved = std::max(moved, double(glm::length(represented->positions[v] - mesh.positions[v])));
+  }
+  double worst = 0.0;
+  for (std::size_t b = 0; b < rays.batches.size(); ++b) {
+    const RayBatch& batch = *rays.batches[b];
+    const HitBatch& hit = *hits[b];
+    for (std::size_t i = 0; i < batch.count; ++i) {
+      if (!hit.is_hit(i)) continue;
+      const glm::dvec3 origin(batch.origin_x[i], batch.origin_y[i], batch.origin_z[i]);
+      const glm::dvec3 direction(batch.direction_x[i], batch.direction_y[i], batch.direction_z[i]);
+      const glm::uvec3& corners = mesh.triangles[hit.primitive[i]];
+      const double u = hit.u[i], v = hit.v[i];
+      const glm::dvec3 on_mesh = (1.0 - u - v) * glm::dvec3(mesh.positions[corners.x]) +
+                                 u * glm::dvec3(mesh.positions[corners.y]) + v * glm::dvec3(mesh.positions[corners.z]);
+      worst = std::max(worst, glm::length(origin + double(hit.t[i]) * direction - on_mesh));
+    }
+  }
+  result.surface_error_max = worst;
+  result.vertex_error_max = moved;
 }
 
 // A probed pass per budget (or one cache-only pass), each with a fresh pool and caches.
@@ -131,6 +161,7 @@ AccelBenchReport run_accel_bench(const Scene& scene, const AccelBenchRequest& re
       }
       result.mrays_per_s = median(result.mrays_per_s_runs);
       compare(rays, hits, reference_hits, diagonal, result);
+      if (!rays.any_hit()) measure_surface_error(scene.mesh, *accelerator, rays, hits, result);
       result.probed = accelerator->probed();
       if (report.memory_observed && result.probed) {
         result.memory_runs = memory_runs(*accelerator, rays, request, report.threads);
@@ -183,6 +214,8 @@ nlohmann::json to_json(const AccelBenchReport& report) {
                        {"mrays_per_s_runs", r.mrays_per_s_runs},
                        {"hit_agreement", r.hit_agreement},
                        {"prim_agreement", optional(r.prim_agreement)},
+                       {"surface_error_max", optional(r.surface_error_max)},
+                       {"vertex_error_max", optional(r.vertex_error_max)},
                        {"t_error_max", optional(r.t_error_max)},
                        {"t_error_mean", optional(r.t_error_mean)},
                        {"memory_runs", memory_runs_json(report, r)}});
@@ -260,6 +293,11 @@ std::string to_table(const AccelBenchReport& report) {
   }
   for (const AccelBenchResult& r : report.results) {
     if (!r.build_notes.empty()) table += fmt::format("{}: {}\n", r.label, r.build_notes);
+  }
+  for (const AccelBenchResult& r : report.results) {
+    if (!r.surface_error_max) continue;
+    table += fmt::format("{}: hit points lie at most {:.3g} from the mesh's triangles (vertices moved at most {:.3g})\n",
+                         r.label, *r.surface_error_max, *r.vertex_error_max);
   }
   if (report.memory_observed) table += memory_table(report);
   return table;

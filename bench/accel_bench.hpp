@@ -46,6 +46,11 @@ struct AccelBenchResult {
   std::optional<double> prim_agreement;  // same primitive where both hit (closest-hit sets only)
   std::optional<double> t_error_max;     // |t - t_ref| / scene diagonal where both hit
   std::optional<double> t_error_mean;
+  // Lossy accelerators (Accelerator::represented_mesh): how far its hit points lie from the
+  // mesh's own triangle at the same barycentrics, and the bound it promises (the largest
+  // distance any vertex moved). Closest-hit sets only.
+  std::optional<double> surface_error_max;
+  std::optional<double> vertex_error_max;
   bool probed = false;                 // false: the accelerator's reads cannot be observed (Embree)
   std::vector<MemoryRun> memory_runs;  // one per budget, when memory observation was asked for
 };

@@ -243,6 +243,26 @@ TEST(Hmq, MemoryIsItsPartsAndFarBelowTheBaseline) {
   EXPECT_NE(hmq->build_notes().find("grid 16x16x16 bits"), std::string::npos) << hmq->build_notes();
 }
 
+TEST(Hmq, HitPointsStayWithinThePromisedErrorOfTheMesh) {
+  const Scene scene = make_builtin_scene("builtin:sphere:20k");
+  AccelBenchRequest request;
+  request.accelerators = {parse_accelerator_spec("hmq:bits=8", Config{}), parse_accelerator_spec("hmq:bits=16", Config{}),
+                          parse_accelerator_spec("bvh", Config{})};
+  request.count = 20000;
+  request.repeats = 1;
+  const AccelBenchReport report = run_accel_bench(scene, request);
+  ASSERT_EQ(report.results.size(), 3u);
+  for (const std::uint32_t index : {0u, 1u}) {
+    const AccelBenchResult& result = report.results[index];
+    const double promised = grid_from_bits(scene.mesh.bounds(), index == 0 ? 8 : 16).max_vertex_error;
+    ASSERT_TRUE(result.surface_error_max && result.vertex_error_max) << result.label;
+    EXPECT_LE(*result.vertex_error_max, promised) << result.label;
+    EXPECT_LE(*result.surface_error_max, promised * 1.05) << result.label;  // plus origin + t d in float
+    EXPECT_GT(*result.surface_error_max, promised * 0.1) << result.label;   // it does move the surface
+  }
+  EXPECT_FALSE(report.results[2].surface_error_max) << "bvh is exact: nothing to report";
+}
+
 TEST(Hmq, RendersShadeTheSurfaceItRepresents) {
   Scene scene = make_builtin_scene("builtin:sphere:5000");
   const TriangleMesh original = scene.mesh;

@@ -11,8 +11,21 @@ namespace {
 
 inline constexpr std::uint32_t kMaxBits = 24;  // grid coordinates stay exact in a float
 
-double error_of(const glm::vec3& cell) {
-  return 0.5 * std::sqrt(double(cell.x) * cell.x + double(cell.y) * cell.y + double(cell.z) * cell.z);
+// A decoded coordinate origin + g * cell is rounded twice in float: at most one ulp of the
+// largest coordinate of the scene, per axis.
+double rounding_of(const Bounds3& bounds, int axis) {
+  const double largest = std::max(std::fabs(double(bounds.lower[axis])), std::fabs(double(bounds.upper[axis])));
+  return largest * std::ldexp(1.0, -23);
+}
+
+// Half a cell per axis, plus the rounding, over the three axes.
+double error_of(const glm::vec3& cell, const Bounds3& bounds) {
+  double sum = 0.0;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double error = 0.5 * double(cell[axis]) + rounding_of(bounds, axis);
+    sum += error * error;
+  }
+  return std::sqrt(sum);
 }
 
 }  // namespace
@@ -28,7 +41,7 @@ GlobalGrid grid_from_bits(const Bounds3& bounds, std::uint32_t bits) {
     grid.cell[axis] = extent > 0.0f ? extent / float((1u << bits) - 1) : 1.0f;
   }
   grid.inverse_cell = 1.0f / grid.cell;
-  grid.max_vertex_error = error_of(grid.cell);
+  grid.max_vertex_error = error_of(grid.cell, bounds);
   return grid;
 }
 
@@ -36,8 +49,14 @@ GlobalGrid grid_from_epsilon(const Bounds3& bounds, double epsilon) {
   if (!(epsilon > 0.0) || !std::isfinite(epsilon)) {
     throw std::invalid_argument(fmt::format("hmq: epsilon = {}: must be a positive distance", epsilon));
   }
-  // Half a cube cell's diagonal is at most epsilon: cell = 2 epsilon / sqrt(3).
-  const double cell = 2.0 * epsilon / std::sqrt(3.0);
+  // Half a cube cell's diagonal plus the float rounding of decoding is at most epsilon.
+  double rounding = 0.0;
+  for (int axis = 0; axis < 3; ++axis) rounding = std::max(rounding, rounding_of(bounds, axis));
+  const double cell = 2.0 * (epsilon / std::sqrt(3.0) - rounding) * 0.999;
+  if (!(cell > 0.0)) {
+    throw std::invalid_argument(fmt::format(
+        "hmq: epsilon = {} is below the float precision of the scene's coordinates ({:.3g})", epsilon, rounding));
+  }
   GlobalGrid grid;
   grid.origin = bounds.lower;
   for (int axis = 0; axis < 3; ++axis) {
@@ -53,7 +72,7 @@ GlobalGrid grid_from_epsilon(const Bounds3& bounds, double epsilon) {
     grid.cell[axis] = static_cast<float>(cell);
   }
   grid.inverse_cell = 1.0f / grid.cell;
-  grid.max_vertex_error = error_of(grid.cell);
+  grid.max_vertex_error = error_of(grid.cell, bounds);
   return grid;
 }
 

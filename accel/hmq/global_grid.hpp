@@ -18,7 +18,8 @@ struct GlobalGrid {
   glm::vec3 cell{1.0f};
   glm::vec3 inverse_cell{1.0f};  // 1 / cell, for re-snapping leaf boxes without dividing
   glm::uvec3 bits{16};
-  // What snapping promises: no vertex moves more than this (half a cell diagonal).
+  // What snapping promises: no vertex moves more than this (half a cell diagonal, plus the
+  // float rounding of decoding).
   double max_vertex_error = 0.0;
 
   glm::ivec3 snap(const glm::vec3& p) const {
