@@ -3,24 +3,23 @@
 #include "accel/bvh/bvh_accelerator.hpp"
 
 #include <chrono>
-#include <limits>
-#include <numeric>
 #include <stdexcept>
-
 
 #include "accel/bvh/bvh_build.hpp"
 #include "accel/bvh/bvh_node.hpp"
-#include "accel/bvh/wide_bvh_accelerator.hpp"
-#include "kernels/ray_box.hpp"
+#include "accel/bvh/bvh_walk.hpp"
 #include "accel/bvh/leaf_query.hpp"
+#include "accel/bvh/wide_bvh_accelerator.hpp"
+#include "accel/probed_accelerator.hpp"
+#include "kernels/ray_box.hpp"
 #include "memory/cache_aligned_allocator.hpp"
 
 namespace wavetrace {
 namespace {
 
-constexpr float kInfinity = std::numeric_limits<float>::infinity();
+class BvhAccelerator final : public ProbedAccelerator<BvhAccelerator> {
+  friend class ProbedAccelerator<BvhAccelerator>;
 
-class BvhAccelerator final : public Accelerator {
  public:
   BvhAccelerator(const TriangleMesh& mesh, const BvhOptions& options)
       : geometry_(mesh, options.triangle_order) {
@@ -58,24 +57,6 @@ class BvhAccelerator final : public Accelerator {
 
   std::string name() const override { return "bvh"; }
 
-  void intersect_closest(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
-    NullProbe probe;
-    traverse<false>(rays, hits, range, probe);
-  }
-  void intersect_any(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
-    NullProbe probe;
-    traverse<true>(rays, hits, range, probe);
-  }
-  bool probed() const override { return true; }
-  void intersect_closest_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
-                                RecordingProbe& probe) const override {
-    traverse<false>(rays, hits, range, probe);
-  }
-  void intersect_any_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
-                            RecordingProbe& probe) const override {
-    traverse<true>(rays, hits, range, probe);
-  }
-
   MemoryReport memory() const override {
     MemoryReport report;
     report.hierarchy = nodes_.size() * sizeof(BvhNode) + leaf_triangles_.size() * sizeof(std::uint32_t);
@@ -93,12 +74,6 @@ class BvhAccelerator final : public Accelerator {
  private:
   template <bool kAnyHit, typename Probe>
   void traverse(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
-    struct StackEntry {
-      std::uint32_t node;
-      float distance;
-    };
-    StackEntry stack[kMaxTreeDepth];
-    const BvhNode* nodes = nodes_.data();
     for (std::uint32_t i = range.begin; i < range.end; ++i) {
       if (!(rays.flags[i] & ray_flags::alive)) {
         write_miss(hits, i);
@@ -106,44 +81,12 @@ class BvhAccelerator final : public Accelerator {
       }
       const glm::vec3 origin(rays.origin_x[i], rays.origin_y[i], rays.origin_z[i]);
       const glm::vec3 direction(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]);
-      const BoxRay box_ray = make_box_ray(origin, direction);
       LeafQuery query(geometry_, leaf_triangles_, origin, direction, rays.tmin[i], rays.tmax[i]);
-      const float tmin = query.tmin;
-      float& tmax = query.tmax;
-
-      std::uint32_t top = 0;
-      std::uint32_t node = 0;
-      probe.read(nodes, sizeof(BvhNode));
-      if (intersect_box(box_ray, nodes[0].lower, nodes[0].upper, tmin, tmax) == kInfinity) {
-        write_miss(hits, i);
-        continue;
-      }
-      while (true) {
-        const BvhNode& current = nodes[node];
-        if (current.leaf()) {
-          query.test_leaf<kAnyHit>(current.first, current.triangle_count(), probe);
-          if (kAnyHit && query.found()) break;
-        } else {
-          std::uint32_t near = current.left(), far = current.right();
-          probe.read(nodes + near, sizeof(BvhNode));
-          probe.read(nodes + far, sizeof(BvhNode));
-          float near_distance = intersect_box(box_ray, nodes[near].lower, nodes[near].upper, tmin, tmax);
-          float far_distance = intersect_box(box_ray, nodes[far].lower, nodes[far].upper, tmin, tmax);
-          if (far_distance < near_distance) {
-            std::swap(near, far);
-            std::swap(near_distance, far_distance);
-          }
-          if (near_distance != kInfinity) {
-            if (far_distance != kInfinity) stack[top++] = {far, far_distance};
-            node = near;
-            continue;
-          }
-        }
-        // Pop the nearest pending subtree that can still hold a closer hit.
-        while (top > 0 && stack[top - 1].distance > tmax) --top;
-        if (top == 0) break;
-        node = stack[--top].node;
-      }
+      walk_bvh(nodes_.data(), make_box_ray(origin, direction), query.tmin, query.tmax, probe,
+               [&](const BvhNode& leaf) {
+                 query.test_leaf<kAnyHit>(leaf.first, leaf.triangle_count(), probe);
+                 return kAnyHit && query.found();
+               });
       query.write(hits, i, probe);
     }
   }

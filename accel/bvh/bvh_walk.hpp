@@ -1,6 +1,6 @@
 // One ray through a tree of 32-byte BvhNodes, near child first with a short stack of
-// (node, entry distance): the top level that Ray-Strips and HMQ put above their compact
-// leaves. (The `bvh` baseline keeps its own copy of this loop, tuned and measured as is.)
+// (node, entry distance): the `bvh` baseline's traversal, and the top level that Ray-Strips
+// and HMQ put above their compact leaves.
 #pragma once
 
 #include <cstdint>
@@ -14,9 +14,10 @@
 namespace wavetrace {
 
 // `visit_leaf(node)` handles a leaf and returns true to end the walk (an any-hit query
-// found one); it may shrink `tmax`, which prunes what is left on the stack.
+// found one); it may shrink `tmax`, which prunes what is left on the stack. Always inlined:
+// as a call, the leaf visit cannot be folded into the loop (7% slower on the bvh baseline).
 template <typename Probe, typename VisitLeaf>
-void walk_bvh(const BvhNode* nodes, const BoxRay& ray, float tmin, const float& tmax, Probe& probe,
+[[gnu::always_inline]] inline void walk_bvh(const BvhNode* nodes, const BoxRay& ray, float tmin, const float& tmax, Probe& probe,
               VisitLeaf&& visit_leaf) {
   constexpr float kInfinity = std::numeric_limits<float>::infinity();
   struct StackEntry {
