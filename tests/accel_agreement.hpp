@@ -4,6 +4,10 @@
 
 #include <cmath>
 #include <cstddef>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
 
 #include "accel/accelerator.hpp"
 #include "bench/ray_sets.hpp"
@@ -43,6 +47,18 @@ inline Agreement compare_on_rays(const Scene& scene, const Accelerator& referenc
     }
   }
   return result;
+}
+
+// The scenes each accelerator is checked on against Embree: a closed mesh, one without
+// connectivity, a height field, thin axis-aligned geometry and a scanned mesh.
+inline std::vector<std::string> agreement_scenes(const std::string& soup) {
+  return {"builtin:sphere:100k", soup, "builtin:terrain:50k", "builtin:stadium:2000",
+          std::string(WAVETRACE_DATA_DIR) + "/bunny00.off"};
+}
+
+inline std::string agreement_scene_label(const ::testing::TestParamInfo<std::string>& info) {
+  static const std::vector<std::string> names = {"sphere", "soup", "terrain", "stadium", "bunny"};
+  return names[info.index];
 }
 
 }  // namespace wavetrace::testing

@@ -11,6 +11,8 @@
 #include "bench/ray_sets.hpp"
 #include "scene/builtin_scenes.hpp"
 
+#include "accel_agreement.hpp"
+
 namespace wavetrace {
 namespace {
 
@@ -66,15 +68,9 @@ TEST_P(GridAgreesWithEmbree, OnAtLeast9999PerMyriadOfRays) {
   }
 }
 
-std::string scene_label(const ::testing::TestParamInfo<std::string>& info) {
-  static const std::vector<std::string> names = {"sphere", "soup", "terrain", "stadium", "bunny"};
-  return names[info.index];
-}
-
 INSTANTIATE_TEST_SUITE_P(Scenes, GridAgreesWithEmbree,
-                         ::testing::Values("builtin:sphere:100k", "builtin:soup:50k", "builtin:terrain:50k",
-                                           "builtin:stadium:2000", std::string(WAVETRACE_DATA_DIR) + "/bunny00.off"),
-                         scene_label);
+                         ::testing::ValuesIn(testing::agreement_scenes("builtin:soup:50k")),
+                         testing::agreement_scene_label);
 
 TEST(Grid, AxisParallelRaysAlongCellFacesFromInsideAndOutside) {
   // An axis-aligned box mesh on a grid whose cell faces it shares: rays along the axes,

@@ -205,15 +205,9 @@ TEST_P(HmqAgreesWithEmbree, ExactlyOnTheSurfaceItRepresentsAndWithinItsErrorOnTh
   }
 }
 
-std::string scene_label(const ::testing::TestParamInfo<std::string>& info) {
-  static const std::vector<std::string> names = {"sphere", "soup", "terrain", "stadium", "bunny"};
-  return names[info.index];
-}
-
 INSTANTIATE_TEST_SUITE_P(Scenes, HmqAgreesWithEmbree,
-                         ::testing::Values("builtin:sphere:100k", "builtin:soup:20k", "builtin:terrain:50k",
-                                           "builtin:stadium:2000", std::string(WAVETRACE_DATA_DIR) + "/bunny00.off"),
-                         scene_label);
+                         ::testing::ValuesIn(testing::agreement_scenes("builtin:soup:20k")),
+                         testing::agreement_scene_label);
 
 TEST(Hmq, NoRayEscapesClosedMeshesAtAnyGridResolution) {
   // From points inside the surface it represents (the leak bench asks represented_mesh).
