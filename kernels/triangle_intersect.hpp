@@ -44,8 +44,9 @@ inline WatertightRay make_watertight_ray(const glm::vec3& origin, const glm::vec
   return ray;
 }
 
-// A hit with t in [tmin, tmax] writes `hit` and returns true. Both faces hit.
-inline bool intersect_watertight(const WatertightRay& ray, const glm::vec3& v0, const glm::vec3& v1,
+// A hit with t in [tmin, tmax] writes `hit` and returns true. Both faces hit. Always inlined:
+// GCC kept it a call in loops over decoded leaves (hmq: 8% slower, bvh unchanged).
+[[gnu::always_inline]] inline bool intersect_watertight(const WatertightRay& ray, const glm::vec3& v0, const glm::vec3& v1,
                                  const glm::vec3& v2, float tmin, float tmax, TriangleHit& hit) {
   const glm::vec3 a = v0 - ray.origin, b = v1 - ray.origin, c = v2 - ray.origin;
   const float ax = a[ray.kx] - ray.shear_x * a[ray.kz], ay = a[ray.ky] - ray.shear_y * a[ray.kz];
