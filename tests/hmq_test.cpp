@@ -9,6 +9,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "accel/hmq/child_pair.hpp"
 #include "accel/hmq/global_grid.hpp"
 #include "accel/hmq/hmq_accelerator.hpp"
 #include "accel/hmq/hmq_format.hpp"
@@ -123,6 +124,43 @@ TEST(HmqNodes, QuantizedChildBoxesContainTheChildAndDecodeAsEncoded) {
       EXPECT_GE(decoded.upper[axis], child.upper[axis]);
       EXPECT_LE(decoded.upper[axis] - decoded.lower[axis],
                 child.upper[axis] - child.lower[axis] + 2.0f * (parent.upper[axis] - parent.lower[axis]) / 16.0f * 1.001f);
+    }
+  }
+}
+
+TEST(HmqNodes, PairedDecodeAndBoxTestAreBitIdenticalToTheScalarOnes) {
+  // Including rays along a box's faces (zero direction components: NaN slabs), rays through
+  // a box's edge and origins inside the parent.
+  std::mt19937 random(12);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  std::uniform_int_distribution<std::uint32_t> word(0, (1u << 24) - 1);
+  for (int i = 0; i < 20000; ++i) {
+    const glm::vec3 corner(unit(random), unit(random), unit(random));
+    const Box parent{corner, corner + glm::vec3(1.0f + unit(random), 0.5f + unit(random), 1.5f + unit(random))};
+    const std::uint32_t first = word(random), second = word(random);
+    glm::vec3 direction(unit(random), unit(random), unit(random));
+    glm::vec3 origin = parent.lower + (parent.upper - parent.lower) * glm::vec3(1.5f) * glm::vec3(unit(random), unit(random), unit(random));
+    if (i % 4 == 1) direction[i % 3] = 0.0f;
+    if (i % 4 == 2) {  // on a decoded face plane of the first child
+      direction[i % 3] = 0.0f;
+      origin[i % 3] = decode_child_box(parent, first).lower[i % 3];
+    }
+    if (i % 4 == 3) {  // at an edge of the first child, where entry and exit meet (the far scale)
+      const Box box = decode_child_box(parent, first);
+      const glm::vec3 edge(box.lower.x, box.upper.y, 0.5f * (box.lower.z + box.upper.z));
+      origin = edge - glm::vec3(2.0f, -1.0f - unit(random), 0.5f * unit(random));
+      direction = edge - origin;
+    }
+    const BoxRay ray = make_box_ray(origin, direction);
+    const float tmin = i % 3 == 0 ? 0.0f : 0.25f, tmax = i % 5 == 0 ? 0.5f : 1e30f;
+    const ChildPair pair = decode_and_intersect_children(parent, first, second, ray, tmin, tmax);
+    for (int k = 0; k < 2; ++k) {
+      const Box box = decode_child_box(parent, k == 0 ? first : second);
+      for (int axis = 0; axis < 3; ++axis) {
+        ASSERT_EQ(pair.box[k].lower[axis], box.lower[axis]);
+        ASSERT_EQ(pair.box[k].upper[axis], box.upper[axis]);
+      }
+      ASSERT_EQ(pair.distance[k], intersect_box(ray, box.lower, box.upper, tmin, tmax)) << i << " child " << k;
     }
   }
 }

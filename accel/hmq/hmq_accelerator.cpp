@@ -15,6 +15,7 @@
 #include "accel/bvh/bvh_walk.hpp"
 #include "accel/bvh/leaf_query.hpp"
 #include "accel/bvh/sah_builder.hpp"
+#include "accel/hmq/child_pair.hpp"
 #include "accel/hmq/global_grid.hpp"
 #include "accel/hmq/hmq_format.hpp"
 #include "accel/hmq/leaf_codec.hpp"
@@ -354,8 +355,14 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
                           Node& next) {
       Node pair[2];
       std::uint32_t hit = 0;
-      for (std::uint32_t k = 0; k < count; ++k) {
-        const std::uint32_t word = slot_word(block, slot + k, probe);
+      if (count == 2) {
+        const std::uint32_t words[2] = {slot_word(block, slot, probe), slot_word(block, slot + 1, probe)};
+        const ChildPair children = decode_and_intersect_children(parent, words[0], words[1], box_ray, tmin, tmax);
+        for (int k = 0; k < 2; ++k) {
+          if (children.distance[k] != kInfinity) pair[hit++] = {block, words[k], children.distance[k], children.box[k]};
+        }
+      } else {  // a top leaf with one root
+        const std::uint32_t word = slot_word(block, slot, probe);
         const Box box = decode_child_box(parent, word);
         const float distance = intersect_box(box_ray, box.lower, box.upper, tmin, tmax);
         if (distance != kInfinity) pair[hit++] = {block, word, distance, box};
