@@ -9,6 +9,7 @@
 #include "accel/bvh/bvh_node.hpp"
 #include "accel/bvh/bvh_walk.hpp"
 #include "accel/bvh/leaf_query.hpp"
+#include "accel/bvh/node_layout.hpp"
 #include "accel/bvh/wide_bvh_accelerator.hpp"
 #include "accel/probed_accelerator.hpp"
 #include "kernels/ray_box.hpp"
@@ -26,30 +27,14 @@ class BvhAccelerator final : public ProbedAccelerator<BvhAccelerator> {
     const auto start = std::chrono::steady_clock::now();
     const BuildTree tree = build_bvh_tree(geometry_, options);
 
-    // Flatten in the chosen order: node i of the array is build node order[i].
-    const std::vector<std::uint32_t> order = node_order(tree, options.layout);
-    std::vector<std::uint32_t> position_of(tree.nodes.size());
-    for (std::uint32_t i = 0; i < order.size(); ++i) position_of[order[i]] = i;
-    nodes_.resize(order.size());
+    // Leaf triangles are stored in node order too, so a leaf's slots follow its node's position.
     leaf_triangles_.resize(geometry_.triangle_count());
     std::uint32_t slot = 0;
-    for (std::uint32_t i = 0; i < order.size(); ++i) {
-      const BuildNode& built = tree.nodes[order[i]];
-      BvhNode& node = nodes_[i];
-      node.lower = built.bounds.lower;
-      node.upper = built.bounds.upper;
-      if (built.leaf()) {
-        // Leaf triangles are stored in node order too, so a leaf's slots follow its node's position.
-        node.first = slot;
-        node.count = BvhNode::kLeafFlag | built.count;
-        for (std::uint32_t k = 0; k < built.count; ++k) {
-          leaf_triangles_[slot++] = tree.primitive_order[built.first + k];
-        }
-      } else {
-        node.first = position_of[built.left];
-        node.count = position_of[built.right];
-      }
-    }
+    flatten_tree(tree, node_order(tree, options.layout), nodes_, [&](const BuildNode& leaf) {
+      const std::uint32_t first = slot;
+      for (std::uint32_t k = 0; k < leaf.count; ++k) leaf_triangles_[slot++] = tree.primitive_order[leaf.first + k];
+      return first;
+    });
     adopt_leaf_order(options, geometry_, leaf_triangles_);
     build_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     build_.peak_bytes = bvh_build_peak_bytes(tree, geometry_, memory().total());

@@ -7,7 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "accel/bvh/bvh_node.hpp"
 #include "accel/bvh/sah_builder.hpp"
+#include "memory/cache_aligned_allocator.hpp"
 
 namespace wavetrace {
 
@@ -18,5 +20,28 @@ std::string to_string(NodeLayout layout);
 
 // Build-node ids in the order they are to be stored.
 std::vector<std::uint32_t> node_order(const BuildTree& tree, NodeLayout layout);
+
+// The tree as 32-byte nodes in `order` (array node i is build node order[i]); a leaf's `first`
+// is what `leaf_first(build_node)` returns, called for the leaves in array order.
+template <typename LeafFirst>
+void flatten_tree(const BuildTree& tree, const std::vector<std::uint32_t>& order, LargeArray<BvhNode>& nodes,
+                  LeafFirst&& leaf_first) {
+  std::vector<std::uint32_t> position_of(tree.nodes.size());
+  for (std::uint32_t i = 0; i < order.size(); ++i) position_of[order[i]] = i;
+  nodes.resize(order.size());
+  for (std::uint32_t i = 0; i < order.size(); ++i) {
+    const BuildNode& built = tree.nodes[order[i]];
+    BvhNode& node = nodes[i];
+    node.lower = built.bounds.lower;
+    node.upper = built.bounds.upper;
+    if (built.leaf()) {
+      node.first = leaf_first(built);
+      node.count = BvhNode::kLeafFlag | built.count;
+    } else {
+      node.first = position_of[built.left];
+      node.count = position_of[built.right];
+    }
+  }
+}
 
 }  // namespace wavetrace

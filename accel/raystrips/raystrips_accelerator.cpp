@@ -178,24 +178,12 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
     });
 
     // Flatten the top BVH: a leaf's `first` is the word offset of its first strip.
-    std::vector<std::uint32_t> position_of(top.nodes.size());
-    for (std::uint32_t i = 0; i < node_order_list.size(); ++i) position_of[node_order_list[i]] = i;
-    nodes_.resize(node_order_list.size());
     std::size_t next_strip = 0;
-    for (std::uint32_t i = 0; i < node_order_list.size(); ++i) {
-      const BuildNode& built = top.nodes[node_order_list[i]];
-      BvhNode& node = nodes_[i];
-      node.lower = built.bounds.lower;
-      node.upper = built.bounds.upper;
-      if (built.leaf()) {
-        node.first = static_cast<std::uint32_t>(offset[next_strip] / 4);
-        node.count = BvhNode::kLeafFlag | built.count;
-        next_strip += built.count;
-      } else {
-        node.first = position_of[built.left];
-        node.count = position_of[built.right];
-      }
-    }
+    flatten_tree(top, node_order_list, nodes_, [&](const BuildNode& leaf) {
+      const auto first = static_cast<std::uint32_t>(offset[next_strip] / 4);
+      next_strip += leaf.count;
+      return first;
+    });
     stats_.encode_seconds = seconds_since(encode_start);
     collect_stats(strips, encodings, strip_order);
     build_.seconds = seconds_since(start);
