@@ -1,6 +1,8 @@
 // Name-to-builder table of the accelerators.
 #include "accel/registry.hpp"
 
+#include "accel/chunked/chunked_accelerator.hpp"
+
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -8,6 +10,34 @@
 namespace wavetrace {
 
 std::vector<std::string> accelerator_names() { return {"embree", "bvh", "raystrips", "hmq", "grid", "mlgrid", "arraygrid"}; }
+
+double estimated_bytes_per_triangle(const std::string& type) {
+  if (type == "embree") return 83.0;
+  if (type == "bvh") return 55.0;
+  if (type == "raystrips") return 22.0;
+  if (type == "hmq") return 10.0;
+  return 60.0;  // the grids: cells and lists vary with the scene; about the bvh's
+}
+
+bool builds_in_chunks(const std::string& type) { return type == "hmq" || type == "raystrips" || type == "bvh"; }
+bool holds_own_geometry(const std::string& type) { return type == "hmq" || type == "raystrips"; }
+
+std::unique_ptr<Accelerator> make_world_accelerator(const TriangleSource& source, const TriangleMesh* whole,
+                                                    const AcceleratorOptions& options) {
+  AcceleratorOptions chunk_options = options;
+  chunk_options.hmq.grid_bounds = source.bounds();  // one global grid, whether chunked or not
+  if (builds_in_chunks(options.type) && source.triangle_count() > options.chunk_triangles) {
+    return make_chunked_accelerator(
+        source, options.chunk_triangles,
+        [&](const TriangleMesh& chunk) { return make_accelerator(chunk, chunk_options); }, !holds_own_geometry(options.type));
+  }
+  if (whole != nullptr) return make_accelerator(*whole, chunk_options);
+  if (!holds_own_geometry(options.type)) {
+    throw std::logic_error(fmt::format("'{}' reads its mesh in place: the caller must keep the whole mesh", options.type));
+  }
+  const TriangleMesh mesh = source.extract(0, source.triangle_count());
+  return make_accelerator(mesh, chunk_options);
+}
 
 std::unique_ptr<Accelerator> make_accelerator(const TriangleMesh& mesh, const AcceleratorOptions& options) {
   if (options.type == "embree") return make_embree_accelerator(mesh, options.embree);

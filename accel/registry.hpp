@@ -13,6 +13,7 @@
 #include "accel/hmq/hmq_accelerator.hpp"
 #include "accel/raystrips/raystrips_accelerator.hpp"
 #include "scene/triangle_mesh.hpp"
+#include "scene/triangle_source.hpp"
 
 namespace wavetrace {
 
@@ -25,11 +26,32 @@ struct AcceleratorOptions {
   ArrayGridOptions arraygrid;
   RayStripsOptions raystrips;
   HmqOptions hmq;
+  // Scenes of more triangles are built in chunks of at most this many (hmq, raystrips, bvh).
+  std::size_t chunk_triangles = std::size_t{1} << 24;
 };
 
 std::vector<std::string> accelerator_names();
 
 // Throws std::invalid_argument naming an unknown type.
 std::unique_ptr<Accelerator> make_accelerator(const TriangleMesh& mesh, const AcceleratorOptions& options);
+
+// What a type's finished structure costs per triangle on builtin:room, measured (README,
+// "Memory at scale"), for refusing a scene that will not fit before building it; and what a
+// build holds per triangle of the mesh it builds at once, at most (the SAH build's arrays).
+double estimated_bytes_per_triangle(const std::string& type);
+inline constexpr double kBuildBytesPerTriangle = 200.0;
+
+// Types that can be built chunk by chunk under a top-level BVH.
+bool builds_in_chunks(const std::string& type);
+// Types whose structure holds the geometry it traces (no reference to the input mesh), so
+// the mesh can be released once they are built and need never exist whole.
+bool holds_own_geometry(const std::string& type);
+
+// The world's accelerator over a scene's triangles: chunked (make_chunked_accelerator) when
+// the type builds in chunks and the source has more than options.chunk_triangles, else one
+// build over `whole` (a mesh the caller keeps alive), or over the source extracted whole
+// when `whole` is null.
+std::unique_ptr<Accelerator> make_world_accelerator(const TriangleSource& source, const TriangleMesh* whole,
+                                                    const AcceleratorOptions& options);
 
 }  // namespace wavetrace

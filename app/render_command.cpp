@@ -10,6 +10,7 @@
 #include "app/image_output.hpp"
 #include "app/progress_line.hpp"
 #include "app/render_report.hpp"
+#include "memory/process_memory.hpp"
 #include "scene/lights.hpp"
 #include "stages/render_setup.hpp"
 
@@ -49,12 +50,20 @@ int run_render(const RenderArguments& args) {
   const Config config = build_config(args);
   const RenderPlan plan = plan_render(config);
 
-  Scene scene = load_scene(plan.scene);
+  ProcessMemory measured;
+  // An accelerator that holds its own geometry never needs the whole mesh: a builtin scene
+  // is then generated a chunk at a time as it is built. The proxy is simplified from the mesh.
+  RenderPlan load_plan = plan;
+  load_plan.scene.streamed = holds_own_geometry(plan.accelerator.type) && !plan.needs_proxy();
+  check_scene_fits(load_plan);
+  Scene scene = load_scene(load_plan.scene);
+  measured.after_load_bytes = read_resident_memory().current_bytes;
   const Camera camera = resolve_camera(plan.camera, scene);
-  const std::unique_ptr<Accelerator> accelerator = make_accelerator(scene.mesh, plan.accelerator);
-  adopt_represented_surface(scene, *accelerator);
+  const std::unique_ptr<Accelerator> accelerator = build_world_accelerator(scene, plan.accelerator);
   const LightSampler lights(scene);
   const std::unique_ptr<Proxy> proxy = build_proxy(plan, scene, *accelerator);
+  if (holds_own_geometry(plan.accelerator.type)) scene.release_mesh();
+  measured.after_build_bytes = read_resident_memory().current_bytes;
   const World world{scene, *accelerator, lights, proxy.get()};
 
   ProgressLine progress(stderr);
@@ -62,13 +71,15 @@ int run_render(const RenderArguments& args) {
       render_image(plan, world, camera, progress.enabled() ? [&](const Progress& p) { progress.update(p); }
                                                           : std::function<void(const Progress&)>());
   progress.finish();
+  measured.after_render_bytes = read_resident_memory().current_bytes;
+  measured.peak_rss_bytes = read_resident_memory().peak_bytes;
 
   write_exr(args.out, plan.image.width, plan.image.height, output.image);
   const std::string preview = preview_path_for(args.out);
   write_png_preview(preview, plan.image.width, plan.image.height, output.image);
 
-  const RenderFacts facts{scene, *accelerator, plan, output, args.out, proxy.get()};
-  fmt::print("{}: {} triangles, {} vertices{}\n", scene.name, scene.mesh.triangle_count(), scene.mesh.vertex_count(),
+  const RenderFacts facts{scene, *accelerator, plan, output, args.out, proxy.get(), measured};
+  fmt::print("{}: {} triangles, {} vertices{}\n", scene.name, scene.triangle_count, scene.vertex_count,
              scene.cleanup.degenerate_dropped ? fmt::format(", {} degenerate dropped", scene.cleanup.degenerate_dropped)
                                               : std::string());
   fmt::print("{}", render_table(facts));

@@ -73,7 +73,7 @@ nlohmann::json proxy_json(const Proxy& proxy) {
 nlohmann::json render_stats_json(const RenderFacts& facts) {
   const MemoryReport memory = facts.accelerator.memory();
   const BuildReport build = facts.accelerator.build();
-  const double triangles = double(facts.scene.mesh.triangle_count());
+  const double triangles = double(facts.scene.triangle_count);
   nlohmann::json stages = nlohmann::json::array();
   for (const StageStats& stage : facts.output.run.stages) {
     nlohmann::json entry = {{"name", stage.name},
@@ -98,9 +98,9 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
   nlohmann::json stats = {
       {"scene",
        {{"source", facts.scene.name},
-        {"triangles", facts.scene.mesh.triangle_count()},
-        {"vertices", facts.scene.mesh.vertex_count()},
-        {"bounds", bounds_json(facts.scene.mesh.bounds())},
+        {"triangles", facts.scene.triangle_count},
+        {"vertices", facts.scene.vertex_count},
+        {"bounds", bounds_json(facts.scene.bounds)},
         {"degenerate_dropped", facts.scene.cleanup.degenerate_dropped}}},
       {"accel",
        {{"type", facts.accelerator.name()},
@@ -108,7 +108,7 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
         {"bytes_per_triangle", double(memory.total()) / triangles},
         {"parts", {{"hierarchy", memory.hierarchy}, {"geometry", memory.geometry}, {"other", memory.other}}},
         {"build_seconds", build.seconds},
-        {"build_peak_bytes", build.peak_bytes},
+        {"build_peak_accounted_bytes", build.peak_bytes},
         {"build_notes", facts.accelerator.build_notes()}}},
       {"stages", stages},
       {"hit_rates", hit_rates},
@@ -120,6 +120,12 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
         {"path", facts.image_path}}},
   };
   if (facts.proxy != nullptr) stats["proxy"] = proxy_json(*facts.proxy);
+  const ProcessMemory& measured = facts.memory;
+  stats["memory"] = {{"peak_rss_bytes", measured.peak_rss_bytes},
+                     {"after_load_bytes", measured.after_load_bytes},
+                     {"after_build_bytes", measured.after_build_bytes},
+                     {"after_render_bytes", measured.after_render_bytes},
+                     {"peak_rss_bytes_per_triangle", double(measured.peak_rss_bytes) / triangles}};
   return stats;
 }
 
@@ -160,12 +166,19 @@ std::string render_table(const RenderFacts& facts) {
                        run.seconds, run.threads, thread_seconds, traced / run.seconds * 1e-6);
   table += fmt::format("accel {}: {:.1f} MB, {:.1f} bytes/triangle (hierarchy {:.1f}, geometry {:.1f}), built in {:.3f} s\n",
                        facts.accelerator.name(), double(memory.total()) * 1e-6,
-                       double(memory.total()) / double(facts.scene.mesh.triangle_count()),
-                       double(memory.hierarchy) / double(facts.scene.mesh.triangle_count()),
-                       double(memory.geometry) / double(facts.scene.mesh.triangle_count()), build.seconds);
+                       double(memory.total()) / double(facts.scene.triangle_count),
+                       double(memory.hierarchy) / double(facts.scene.triangle_count),
+                       double(memory.geometry) / double(facts.scene.triangle_count), build.seconds);
   if (const std::string notes = facts.accelerator.build_notes(); !notes.empty()) {
     table += fmt::format("accel {}: {}\n", facts.accelerator.name(), notes);
   }
+  const ProcessMemory& measured = facts.memory;
+  table += fmt::format(
+      "memory (resident, from the OS): peak {:.2f} GB ({:.1f} bytes/triangle); after load {:.2f} GB, after build {:.2f} GB, "
+      "after render {:.2f} GB\n",
+      double(measured.peak_rss_bytes) * 1e-9, double(measured.peak_rss_bytes) / double(facts.scene.triangle_count),
+      double(measured.after_load_bytes) * 1e-9, double(measured.after_build_bytes) * 1e-9,
+      double(measured.after_render_bytes) * 1e-9);
   table += memory_lines(run.stages);
   if (facts.output.memory_unobserved) table += "memory: " + *facts.output.memory_unobserved + "\n";
   if (facts.output.rejected_contributions > 0) {

@@ -11,6 +11,15 @@
 
 namespace wavetrace {
 
+// Resident memory read from the OS (VmRSS) at the end of each phase of a render, and the
+// process's peak (VmHWM).
+struct ProcessMemory {
+  std::size_t after_load_bytes = 0;
+  std::size_t after_build_bytes = 0;
+  std::size_t after_render_bytes = 0;
+  std::size_t peak_rss_bytes = 0;
+};
+
 struct RenderFacts {
   const Scene& scene;
   const Accelerator& accelerator;
@@ -18,6 +27,7 @@ struct RenderFacts {
   const RenderOutput& output;
   std::string image_path;
   const Proxy* proxy = nullptr;
+  ProcessMemory memory;
 };
 
 nlohmann::json proxy_json(const Proxy& proxy);

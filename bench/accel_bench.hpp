@@ -38,7 +38,10 @@ struct AccelBenchResult {
   std::string label;
   MemoryReport memory;
   double bytes_per_triangle = 0.0;
-  BuildReport build;
+  BuildReport build;  // its peak_bytes: the build's own accounting (Embree's: its allocation monitor)
+  // The build's peak resident memory read from the OS (VmHWM, reset before the build) above
+  // what the process held when it began; 0 where the peak cannot be reset.
+  std::size_t build_peak_rss_above_start_bytes = 0;
   std::string build_notes;
   std::vector<double> mrays_per_s_runs;
   double mrays_per_s = 0.0;      // median of the runs

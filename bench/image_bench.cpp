@@ -26,10 +26,9 @@ ImageBenchReport run_image_bench(const Config& config, const std::vector<Acceler
   std::vector<float> reference;
   double reference_mean = 0.0;
   for (const AcceleratorSpec& spec : accelerators) {
-    const auto accelerator = make_accelerator(scene.mesh, spec.options);
-    Scene represented = scene;  // shading must read the surface the accelerator answers for
-    const bool lossy = adopt_represented_surface(represented, *accelerator);
-    const World world{lossy ? represented : scene, *accelerator, lights, nullptr};
+    // Hits carry the surface the accelerator answers for: a lossy one's renders shade it.
+    const auto accelerator = build_world_accelerator(scene, spec.options);
+    const World world{scene, *accelerator, lights, nullptr};
     const RenderOutput output = render_image(plan, world, camera);
     report.threads = output.run.threads;
     ImageBenchResult result;

@@ -12,6 +12,7 @@
 #include "kernels/random.hpp"
 #include "kernels/sampling.hpp"
 #include "scene/mesh_report.hpp"
+#include "stages/render_setup.hpp"
 #include "stages/tracing_arena.hpp"
 
 namespace wavetrace {
@@ -107,7 +108,7 @@ LeakReport run_leak_bench(const Scene& scene, const std::vector<AcceleratorSpec>
     report.inside_points = points.size();
 
     for (const AcceleratorSpec& spec : accelerators) {
-      const auto accelerator = make_accelerator(scene.mesh, spec.options);
+      const auto accelerator = build_world_accelerator(scene, spec.options);
       // A lossy accelerator answers for a moved surface: a point is asked to be inside that.
       LeakResult result{spec.label, count, 0, false};
       std::vector<glm::vec3> own_points;

@@ -28,8 +28,7 @@ ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<Reo
   }
   Scene scene = load_scene(base.scene);
   const Camera camera = resolve_camera(base.camera, scene);
-  const auto accelerator = make_accelerator(scene.mesh, base.accelerator);
-  adopt_represented_surface(scene, *accelerator);
+  const auto accelerator = build_world_accelerator(scene, base.accelerator);
   const LightSampler lights(scene);
   std::unique_ptr<Proxy> proxy;
   for (ReorderHeuristic heuristic : heuristics) {

@@ -96,12 +96,32 @@ void RayBatch::copy_ray(std::size_t to, const RayBatch& source, std::size_t from
 }
 
 HitBatch::HitBatch(std::size_t capacity)
-    : capacity_(capacity), storage_(columns_bytes<float, std::uint32_t, float, float>(capacity)) {
+    : capacity_(capacity),
+      storage_(columns_bytes<float, std::uint32_t, float, float, float, float, float, float, float, float, std::uint32_t>(
+          capacity)) {
   ColumnCarver carve(storage_.data(), capacity);
   t = carve.next<float>();
   primitive = carve.next<std::uint32_t>();
   u = carve.next<float>();
   v = carve.next<float>();
+  point_x = carve.next<float>();
+  point_y = carve.next<float>();
+  point_z = carve.next<float>();
+  normal_x = carve.next<float>();
+  normal_y = carve.next<float>();
+  normal_z = carve.next<float>();
+  material = carve.next<std::uint32_t>();
+}
+
+void HitBatch::copy_hit(std::size_t to, const HitBatch& source, std::size_t from) {
+  set_hit(to, source.t[from], source.primitive[from], source.u[from], source.v[from]);
+  point_x[to] = source.point_x[from];
+  point_y[to] = source.point_y[from];
+  point_z[to] = source.point_z[from];
+  normal_x[to] = source.normal_x[from];
+  normal_y[to] = source.normal_y[from];
+  normal_z[to] = source.normal_z[from];
+  material[to] = source.material[from];
 }
 
 }  // namespace wavetrace

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <limits>
 
+#include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
 #include "memory/aligned_buffer.hpp"
@@ -91,6 +92,9 @@ class RayBatch {
 };
 
 // Closest-hit results per ray; any-hit queries set primitive to a valid id when occluded.
+// Closest-hit queries also write what shading needs, so that shade and spawn never read the
+// mesh: the hit point (from the barycentrics on the triangle as the accelerator stores it),
+// its geometric normal, and (written by the trace stage) its material.
 class HitBatch {
  public:
   explicit HitBatch(std::size_t capacity = kDefaultBatchCapacity);
@@ -100,6 +104,16 @@ class HitBatch {
   std::uint32_t* primitive;  // kInvalidPrimitive on a miss
   float* u;
   float* v;
+  // Closest hits only: a + (b - a) u + (c - a) v and cross(b - a, c - a) of the hit
+  // triangle's corners a, b, c in the mesh's winding (unnormalized: its direction gives the
+  // front face); the material index of the triangle.
+  float* point_x;
+  float* point_y;
+  float* point_z;
+  float* normal_x;
+  float* normal_y;
+  float* normal_z;
+  std::uint32_t* material;
 
   bool is_hit(std::size_t ray) const { return primitive[ray] != kInvalidPrimitive; }
   void set_hit(std::size_t ray, float hit_t, std::uint32_t hit_primitive, float hit_u, float hit_v) {
@@ -109,6 +123,23 @@ class HitBatch {
     v[ray] = hit_v;
   }
   void set_miss(std::size_t ray) { set_hit(ray, std::numeric_limits<float>::infinity(), kInvalidPrimitive, 0.0f, 0.0f); }
+  // The point and normal of a closest hit whose u, v are set, from the triangle's corners.
+  // Spawn once computed exactly this from the mesh; the same arithmetic keeps images equal.
+  void set_surface(std::size_t ray, const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
+    const glm::vec3 ab = b - a, ac = c - a;
+    const glm::vec3 point = a + ab * u[ray] + ac * v[ray];
+    point_x[ray] = point.x;
+    point_y[ray] = point.y;
+    point_z[ray] = point.z;
+    const glm::vec3 normal = glm::cross(ab, ac);
+    normal_x[ray] = normal.x;
+    normal_y[ray] = normal.y;
+    normal_z[ray] = normal.z;
+  }
+  glm::vec3 point(std::size_t ray) const { return {point_x[ray], point_y[ray], point_z[ray]}; }
+  glm::vec3 normal(std::size_t ray) const { return {normal_x[ray], normal_y[ray], normal_z[ray]}; }
+  // Copies every column of hit `from` of `source` into slot `to`.
+  void copy_hit(std::size_t to, const HitBatch& source, std::size_t from);
 
  private:
   std::size_t capacity_;

@@ -22,8 +22,9 @@ bool is_builtin_scene(std::string_view source);
 std::vector<std::string> builtin_scene_names();
 
 // Parses "builtin:NAME[:COUNT]" (COUNT with an optional k, M or G suffix) and builds it.
-// The triangle count is met as closely as the generator's structure allows.
-Scene make_builtin_scene(std::string_view source);
+// The triangle count is met as closely as the generator's structure allows. Streamed, the
+// scene keeps its generators (Scene::procedural) and no mesh.
+Scene make_builtin_scene(std::string_view source, bool streamed = false);
 
 // Parses a count such as "8M", "250k" or "1000"; throws SceneError naming `what`.
 std::size_t parse_triangle_count(std::string_view text, std::string_view what);

@@ -2,6 +2,7 @@
 #include "scene/lights.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 
 #include <glm/geometric.hpp>
 
@@ -10,7 +11,16 @@
 namespace wavetrace {
 
 LightSampler::LightSampler(const Scene& scene) {
-  const TriangleMesh& mesh = scene.mesh;
+  // A streamed scene generates just its emissive objects here.
+  TriangleMesh generated;
+  if (scene.streamed()) {
+    std::vector<bool> emissive(scene.materials.size());
+    for (std::size_t m = 0; m < emissive.size(); ++m) emissive[m] = scene.materials[m].emissive();
+    generated = scene.procedural->objects_with_materials(emissive);
+  } else if (scene.mesh.triangles.empty() && scene.triangle_count > 0) {
+    throw std::logic_error("LightSampler needs the scene's mesh: build it before the mesh is released");
+  }
+  const TriangleMesh& mesh = scene.streamed() ? generated : scene.mesh;
   std::vector<double> power;
   double total = 0.0;
   for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {

@@ -17,7 +17,7 @@ Scene load_scene(const SceneRequest& request) {
   }
   Scene scene;
   if (is_builtin_scene(request.source)) {
-    scene = make_builtin_scene(request.source);
+    scene = make_builtin_scene(request.source, request.streamed && request.subdivide == 0);
   } else if (is_scene_file(request.source)) {
     scene = load_scene_file(request.source);
   } else {
@@ -37,7 +37,17 @@ Scene load_scene(const SceneRequest& request) {
     scene.subdivision_levels = static_cast<std::size_t>(request.subdivide);
     scene.enclosure.reset();  // Loop subdivision pulls the walls inward
   }
+  if (!scene.streamed()) scene.describe_mesh();
   return scene;
 }
+
+void Scene::describe_mesh() {
+  triangle_count = mesh.triangle_count();
+  vertex_count = mesh.vertex_count();
+  bounds = mesh.bounds();
+  material_runs = MaterialRuns::from_triangles(mesh.material_of_triangle, mesh.triangle_count());
+}
+
+void Scene::release_mesh() { mesh = TriangleMesh{}; }
 
 }  // namespace wavetrace

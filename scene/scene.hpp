@@ -2,6 +2,7 @@
 // gives, and the camera its author suggests.
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -9,6 +10,8 @@
 #include <glm/vec3.hpp>
 
 #include "scene/camera.hpp"
+#include "scene/material_runs.hpp"
+#include "scene/procedural_scene.hpp"
 #include "scene/triangle_mesh.hpp"
 
 namespace wavetrace {
@@ -22,7 +25,15 @@ struct Material {
 
 struct Scene {
   std::string name;
+  // The flattened mesh; empty when the scene is streamed (procedural holds its triangles)
+  // or was released once an accelerator that keeps its own geometry was built.
   TriangleMesh mesh;
+  std::shared_ptr<const ProceduralScene> procedural;  // set when streamed
+  // What stays known without the mesh: counts, bounds, each triangle's material.
+  std::size_t triangle_count = 0;
+  std::size_t vertex_count = 0;
+  Bounds3 bounds;
+  MaterialRuns material_runs;
   std::vector<Material> materials;
   glm::vec3 background{0.0f};    // radiance of every ray that leaves the scene
   std::optional<Camera> camera;  // the scene author's view, if any
@@ -32,11 +43,21 @@ struct Scene {
   MeshCleanup cleanup;
   std::size_t subdivision_levels = 0;
   std::size_t non_manifold_faces_dropped = 0;
+
+  bool streamed() const { return procedural != nullptr; }
+  // Frees the mesh (and its per-triangle materials); counts, bounds and runs stay.
+  void release_mesh();
+  // Sets counts, bounds and material runs from the mesh.
+  void describe_mesh();
 };
 
 struct SceneRequest {
   std::string source = "builtin:default";  // a mesh file, a scene file (.toml) or builtin:NAME[:TRIANGLES]
   int subdivide = 0;                       // Loop subdivision levels applied after loading
+  // A builtin is left as its generators (Scene::procedural) rather than assembled into one
+  // mesh, for a chunked build that makes it a range at a time. Ignored for files and when
+  // subdividing.
+  bool streamed = false;
 };
 
 // Loads a mesh or scene file or generates a builtin, subdivides, validates; throws

@@ -1,11 +1,11 @@
-// Procedural shapes the builtin scenes are composed of. The sphere is an icosahedron whose
-// faces are split into n x n triangle lattices with globally shared vertices, so it is closed.
+// Procedural shapes the builtin scenes are composed of, as generators of any triangle range.
+// The sphere is an icosahedron whose faces are split into n x n triangle lattices with
+// globally shared vertices, so it is closed.
 #include "scene/shapes.hpp"
 
 #include <array>
 #include <cmath>
 #include <map>
-#include <unordered_map>
 
 #include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
@@ -14,6 +14,7 @@
 #include "kernels/random.hpp"
 #include "kernels/sampling.hpp"
 #include "scene/noise.hpp"
+#include "scene/shape_generator.hpp"
 
 namespace wavetrace {
 namespace {
@@ -118,10 +119,271 @@ std::uint32_t icosphere_frequency(std::size_t triangles) {
   return static_cast<std::uint32_t>(std::max(1.0, n));
 }
 
-}  // namespace
 
-// An axis-aligned quad from corner with edges u and v; front face along cross(u, v).
-TriangleMesh make_quad(const glm::vec3& corner, const glm::vec3& u, const glm::vec3& v) {
+class SphereShape final : public ShapeGenerator {
+ public:
+  SphereShape(std::size_t triangles, const glm::vec3& center, float radius, std::uint32_t seed)
+      : n_(icosphere_frequency(triangles)), lattice_(n_), center_(center), radius_(radius), seed_(seed) {}
+  std::size_t triangle_count() const override { return lattice_.triangle_count(); }
+  std::size_t vertex_count() const override { return lattice_.vertex_count(); }
+  glm::vec3 position(std::uint64_t id) const override {
+    const glm::vec3 direction = lattice_.direction(id);
+    const float displacement =
+        kDisplacementAmplitude * fractal_noise(direction * kDisplacementFrequency, kDisplacementOctaves, seed_);
+    return center_ + direction * (radius_ * (1.0f + displacement));
+  }
+  // Face f holds n^2 triangles in rows; row i has n-i "up" and n-i-1 "down" triangles,
+  // interleaved up, down, up, ..., and starts at i (2n - i) within the face.
+  void corners(std::size_t first, std::size_t count, std::uint64_t* out) const override {
+    const std::size_t per_face = std::size_t(n_) * n_;
+    std::uint32_t face = static_cast<std::uint32_t>(first / per_face);
+    std::size_t in_face = first % per_face;
+    std::uint32_t i = 0;
+    while (std::size_t(i + 1) * (2 * n_ - i - 1) <= in_face) ++i;
+    std::size_t p = in_face - std::size_t(i) * (2 * n_ - i);
+    for (std::size_t done = 0; done < count; ++done) {
+      const auto j = static_cast<std::uint32_t>(p / 2);
+      std::uint64_t* corner = out + 3 * done;
+      if (p % 2 == 0) {
+        corner[0] = lattice_.vertex(face, i, j);
+        corner[1] = lattice_.vertex(face, i + 1, j);
+        corner[2] = lattice_.vertex(face, i, j + 1);
+      } else {
+        corner[0] = lattice_.vertex(face, i + 1, j);
+        corner[1] = lattice_.vertex(face, i + 1, j + 1);
+        corner[2] = lattice_.vertex(face, i, j + 1);
+      }
+      if (++p == 2 * std::size_t(n_ - i) - 1) {  // the row is done
+        p = 0;
+        if (++i == n_) {
+          i = 0;
+          ++face;
+        }
+      }
+    }
+  }
+
+ private:
+  std::uint32_t n_;
+  IcosphereLattice lattice_;
+  glm::vec3 center_;
+  float radius_;
+  std::uint32_t seed_;
+};
+
+// The sphere's triangles, each with three vertices of its own.
+class SoupShape final : public ShapeGenerator {
+ public:
+  explicit SoupShape(std::size_t triangles, std::uint32_t seed) : sphere_(triangles, glm::vec3(0.0f), 1.0f, seed) {}
+  std::size_t triangle_count() const override { return sphere_.triangle_count(); }
+  std::size_t vertex_count() const override { return 3 * sphere_.triangle_count(); }
+  glm::vec3 position(std::uint64_t key) const override {
+    std::uint64_t corners[3];
+    sphere_.corners(key / 3, 1, corners);
+    return sphere_.position(corners[key % 3]);
+  }
+  void corners(std::size_t first, std::size_t count, std::uint64_t* out) const override {
+    for (std::size_t k = 0; k < 3 * count; ++k) out[k] = 3 * first + k;
+  }
+
+ private:
+  SphereShape sphere_;
+};
+
+class TerrainShape final : public ShapeGenerator {
+ public:
+  TerrainShape(std::size_t triangles, float size, float height, std::uint32_t seed)
+      : cells_(static_cast<std::uint32_t>(std::max(1.0, std::round(std::sqrt(double(triangles) / 2.0))))),
+        size_(size),
+        height_(height),
+        seed_(seed) {}
+  std::size_t triangle_count() const override { return std::size_t(cells_) * cells_ * 2; }
+  std::size_t vertex_count() const override { return std::size_t(cells_ + 1) * (cells_ + 1); }
+  glm::vec3 position(std::uint64_t id) const override {
+    const std::uint64_t row = cells_ + 1;
+    const float fx = float(id % row) / cells_, fz = float(id / row) / cells_;
+    const glm::vec3 ground((fx - 0.5f) * size_, 0.0f, (fz - 0.5f) * size_);
+    const float y = height_ * fractal_noise(glm::vec3(fx * 4.0f, 0.37f, fz * 4.0f), 8, seed_);
+    return ground + glm::vec3(0.0f, y, 0.0f);
+  }
+  void corners(std::size_t first, std::size_t count, std::uint64_t* out) const override {
+    const std::uint64_t row = cells_ + 1;
+    for (std::size_t t = first; t < first + count; ++t) {
+      const std::uint64_t cell = t / 2, z = cell / cells_, x = cell % cells_;
+      const std::uint64_t v00 = z * row + x, v10 = v00 + 1, v01 = v00 + row, v11 = v01 + 1;
+      std::uint64_t* corner = out + 3 * (t - first);
+      corner[0] = v00;  // counter-clockwise seen from +y
+      corner[1] = t % 2 == 0 ? v01 : v11;
+      corner[2] = t % 2 == 0 ? v11 : v10;
+    }
+  }
+
+ private:
+  std::uint32_t cells_;
+  float size_, height_;
+  std::uint32_t seed_;
+};
+
+// Thin open tubes of triangular cross-section growing from a sphere. Roots are spread over
+// the icosahedron's faces in rows, so consecutive strands grow side by side and a run of
+// strands (a chunk) covers a patch of the sphere, not all of it.
+class StrandsShape final : public ShapeGenerator {
+ public:
+  static constexpr std::uint32_t kSegments = 4, kSides = 3, kRings = kSegments + 1;
+  static constexpr std::uint32_t kTrianglesPerStrand = kSegments * kSides * 2;
+  static constexpr std::uint32_t kVerticesPerStrand = kRings * kSides;
+
+  StrandsShape(std::size_t triangles, float radius, float length, float width, std::uint32_t seed)
+      : strands_(std::max<std::size_t>(1, triangles / kTrianglesPerStrand)),
+        per_face_((strands_ + 19) / 20),
+        columns_(static_cast<std::size_t>(std::ceil(std::sqrt(double(per_face_))))),
+        radius_(radius),
+        length_(length),
+        width_(width),
+        seed_(seed) {}
+  std::size_t triangle_count() const override { return strands_ * kTrianglesPerStrand; }
+  std::size_t vertex_count() const override { return strands_ * kVerticesPerStrand; }
+  glm::vec3 position(std::uint64_t id) const override {
+    const std::size_t s = id / kVerticesPerStrand;
+    const std::uint32_t ring = static_cast<std::uint32_t>(id % kVerticesPerStrand) / kSides;
+    const std::uint32_t side = static_cast<std::uint32_t>(id % kSides);
+    const UnitPair jitter = unit_pair(random_bits(std::uint32_t(s), seed_, 0, RandomPurpose::scene_generation));
+    const UnitPair bend = unit_pair(random_bits(std::uint32_t(s), seed_, 1, RandomPurpose::scene_generation));
+    // Row r of the face's columns x columns cells maps to a band parallel to the face's
+    // edge BC (the square-root parametrization keeps the spread uniform).
+    const std::size_t k = s % per_face_;
+    const float x = (float(k / columns_) + jitter.first) / float(columns_);
+    const float y = (float(k % columns_) + jitter.second) / float(columns_);
+    const Icosahedron& ico = icosahedron();
+    const glm::uvec3& face = ico.faces[s / per_face_];
+    const float root = std::sqrt(std::min(x, 1.0f));
+    const glm::vec3 normal = glm::normalize(ico.corners[face.x] * (1.0f - root) + ico.corners[face.y] * (root * (1.0f - y)) +
+                                            ico.corners[face.z] * (root * y));
+    const glm::vec3 tangent = glm::normalize(glm::cross(normal, std::fabs(normal.y) < 0.9f ? glm::vec3(0, 1, 0)
+                                                                                          : glm::vec3(1, 0, 0)));
+    const glm::vec3 bitangent = glm::cross(normal, tangent);
+    const glm::vec3 sway = tangent * (bend.first - 0.5f) + bitangent * (bend.second - 0.5f);
+    const float along = float(ring) / kSegments;
+    const glm::vec3 center = normal * (radius_ + length_ * along) + sway * (length_ * along * along);
+    const float ring_width = width_ * (1.0f - 0.7f * along);
+    const float angle = 2.0f * 3.14159265f * float(side) / kSides;
+    return center + (tangent * std::cos(angle) + bitangent * std::sin(angle)) * ring_width;
+  }
+  void corners(std::size_t first, std::size_t count, std::uint64_t* out) const override {
+    for (std::size_t t = first; t < first + count; ++t) {
+      const std::uint64_t strand = t / kTrianglesPerStrand;
+      const auto local = static_cast<std::uint32_t>(t % kTrianglesPerStrand);
+      const std::uint32_t ring = local / (2 * kSides), side = local % (2 * kSides) / 2;
+      const std::uint64_t base = strand * kVerticesPerStrand + ring * kSides;
+      const std::uint64_t a = base + side, b = base + (side + 1) % kSides;
+      std::uint64_t* corner = out + 3 * (t - first);
+      corner[0] = a;
+      corner[1] = local % 2 == 0 ? b : b + kSides;
+      corner[2] = local % 2 == 0 ? b + kSides : a + kSides;
+    }
+  }
+
+ private:
+  std::size_t strands_, per_face_, columns_;
+  float radius_, length_, width_;
+  std::uint32_t seed_;
+};
+
+// A mesh small enough to be listed: quads and the stadium's box.
+class ListedShape final : public ShapeGenerator {
+ public:
+  explicit ListedShape(TriangleMesh mesh) : mesh_(std::move(mesh)) {}
+  std::size_t triangle_count() const override { return mesh_.triangle_count(); }
+  std::size_t vertex_count() const override { return mesh_.vertex_count(); }
+  glm::vec3 position(std::uint64_t id) const override { return mesh_.positions[id]; }
+  void corners(std::size_t first, std::size_t count, std::uint64_t* out) const override {
+    for (std::size_t t = first; t < first + count; ++t) {
+      for (int k = 0; k < 3; ++k) out[3 * (t - first) + k] = mesh_.triangles[t][k];
+    }
+  }
+
+ private:
+  TriangleMesh mesh_;
+};
+
+// A box facing inward, each face a lattice of nearly square cells. A vertex is keyed by its
+// lattice point (21 bits per axis), so the faces meeting at an edge share it.
+class RoomShellShape final : public ShapeGenerator {
+ public:
+  RoomShellShape(const glm::vec3& lower, const glm::vec3& upper, std::size_t triangles) : lower_(lower), extent_(upper - lower) {
+    // Each face of cells h x h is two triangles per cell: 4 (xy + yz + zx) / h^2 in all.
+    const double face_area = double(extent_.x) * extent_.y + double(extent_.y) * extent_.z + double(extent_.z) * extent_.x;
+    const double cell = std::sqrt(4.0 * face_area / double(std::max<std::size_t>(triangles, 12)));
+    for (int axis = 0; axis < 3; ++axis) {
+      cells_[axis] = static_cast<std::uint32_t>(std::clamp(std::round(double(extent_[axis]) / cell), 1.0, double(kMaxCells)));
+    }
+    std::size_t start = 0;
+    for (int face = 0; face < 6; ++face) {
+      face_start_[face] = start;
+      const int axis = face / 2;
+      start += 2 * std::size_t(cells_[(axis + 1) % 3]) * cells_[(axis + 2) % 3];
+    }
+    face_start_[6] = start;
+  }
+  std::size_t triangle_count() const override { return face_start_[6]; }
+  std::size_t vertex_count() const override { return 0; }  // sparse: lattice points
+  std::size_t distinct_vertices() const override {  // the lattice's points minus its interior ones
+    const glm::u64vec3 c(cells_);
+    return (c.x + 1) * (c.y + 1) * (c.z + 1) - (c.x - 1) * (c.y - 1) * (c.z - 1);
+  }
+  glm::vec3 position(std::uint64_t key) const override {
+    const glm::uvec3 point(key >> 42, (key >> 21) & kMaxCells, key & kMaxCells);
+    return lower_ + extent_ * glm::vec3(point) / glm::vec3(cells_);
+  }
+  // Faces in the order -x, +x, -y, +y, -z, +z: -x is material 0, +x material 1, the rest 2.
+  std::uint32_t material(std::size_t triangle) const override {
+    const int face = this->face(triangle);
+    return face < 2 ? std::uint32_t(face) : 2u;
+  }
+  std::uint32_t material_count() const override { return 3; }
+  void corners(std::size_t first, std::size_t count, std::uint64_t* out) const override {
+    for (std::size_t t = first; t < first + count; ++t) {
+      const int face = this->face(t), axis = face / 2, side = face % 2;
+      const int u_axis = (axis + 1) % 3, v_axis = (axis + 2) % 3;
+      const std::size_t cell = (t - face_start_[face]) / 2;
+      const auto i = static_cast<std::uint32_t>(cell / cells_[v_axis]);
+      const auto j = static_cast<std::uint32_t>(cell % cells_[v_axis]);
+      const auto key = [&](std::uint32_t di, std::uint32_t dj) {
+        glm::uvec3 point;
+        point[axis] = side * cells_[axis];
+        point[u_axis] = i + di;
+        point[v_axis] = j + dj;
+        return std::uint64_t(point.x) << 42 | std::uint64_t(point.y) << 21 | point.z;
+      };
+      const std::uint64_t v00 = key(0, 0), v10 = key(1, 0), v11 = key(1, 1), v01 = key(0, 1);
+      // (u, v, axis) is right-handed, so this winding faces +axis: inward on the lower
+      // side, flipped on the upper.
+      const bool second = (t - face_start_[face]) % 2 == 1;
+      std::uint64_t* corner = out + 3 * (t - first);
+      corner[0] = v00;
+      if (side == 0) {
+        corner[1] = second ? v11 : v10;
+        corner[2] = second ? v01 : v11;
+      } else {
+        corner[1] = second ? v01 : v11;
+        corner[2] = second ? v11 : v10;
+      }
+    }
+  }
+
+ private:
+  static constexpr std::uint32_t kMaxCells = (1u << 21) - 1;
+  int face(std::size_t triangle) const {
+    int face = 0;
+    while (triangle >= face_start_[face + 1]) ++face;
+    return face;
+  }
+  glm::vec3 lower_, extent_;
+  glm::uvec3 cells_;
+  std::size_t face_start_[7];
+};
+
+TriangleMesh quad_mesh(const glm::vec3& corner, const glm::vec3& u, const glm::vec3& v) {
   TriangleMesh quad;
   quad.positions = {corner, corner + u, corner + u + v, corner + v};
   quad.triangles = {glm::uvec3(0, 1, 2), glm::uvec3(0, 2, 3)};
@@ -129,7 +391,7 @@ TriangleMesh make_quad(const glm::vec3& corner, const glm::vec3& u, const glm::v
 }
 
 // The six faces of a box, facing inward, as 12 triangles over 8 shared corners.
-TriangleMesh make_inward_box(const glm::vec3& lower, const glm::vec3& upper) {
+TriangleMesh inward_box_mesh(const glm::vec3& lower, const glm::vec3& upper) {
   TriangleMesh box;
   for (int c = 0; c < 8; ++c) {
     box.positions.emplace_back(c & 1 ? upper.x : lower.x, c & 2 ? upper.y : lower.y, c & 4 ? upper.z : lower.z);
@@ -150,152 +412,45 @@ TriangleMesh make_inward_box(const glm::vec3& lower, const glm::vec3& upper) {
   return box;
 }
 
+}  // namespace
+
+std::unique_ptr<ShapeGenerator> displaced_sphere_shape(std::size_t triangles, const glm::vec3& center, float radius,
+                                                       std::uint32_t seed) {
+  return std::make_unique<SphereShape>(triangles, center, radius, seed);
+}
+std::unique_ptr<ShapeGenerator> soup_shape(std::size_t triangles, std::uint32_t seed) {
+  return std::make_unique<SoupShape>(triangles, seed);
+}
+std::unique_ptr<ShapeGenerator> terrain_shape(std::size_t triangles, float size, float height, std::uint32_t seed) {
+  return std::make_unique<TerrainShape>(triangles, size, height, seed);
+}
+std::unique_ptr<ShapeGenerator> strands_shape(std::size_t triangles, float radius, float length, float width,
+                                              std::uint32_t seed) {
+  return std::make_unique<StrandsShape>(triangles, radius, length, width, seed);
+}
+std::unique_ptr<ShapeGenerator> quad_shape(const glm::vec3& corner, const glm::vec3& u, const glm::vec3& v) {
+  return std::make_unique<ListedShape>(quad_mesh(corner, u, v));
+}
+std::unique_ptr<ShapeGenerator> inward_box_shape(const glm::vec3& lower, const glm::vec3& upper) {
+  return std::make_unique<ListedShape>(inward_box_mesh(lower, upper));
+}
+std::unique_ptr<ShapeGenerator> room_shell_shape(const glm::vec3& lower, const glm::vec3& upper, std::size_t triangles) {
+  return std::make_unique<RoomShellShape>(lower, upper, triangles);
+}
+
+TriangleMesh make_quad(const glm::vec3& corner, const glm::vec3& u, const glm::vec3& v) { return quad_mesh(corner, u, v); }
+TriangleMesh make_inward_box(const glm::vec3& lower, const glm::vec3& upper) { return inward_box_mesh(lower, upper); }
 TriangleMesh make_terrain(std::size_t triangles, float size, float height, std::uint32_t seed) {
-  const auto cells = static_cast<std::uint32_t>(std::max(1.0, std::round(std::sqrt(double(triangles) / 2.0))));
-  const std::uint32_t row = cells + 1;
-  TriangleMesh mesh;
-  mesh.positions.resize(std::size_t(row) * row);
-  tbb::parallel_for(std::uint32_t{0}, row, [&](std::uint32_t z) {
-    for (std::uint32_t x = 0; x < row; ++x) {
-      const float fx = float(x) / cells, fz = float(z) / cells;
-      const glm::vec3 ground((fx - 0.5f) * size, 0.0f, (fz - 0.5f) * size);
-      const float y = height * fractal_noise(glm::vec3(fx * 4.0f, 0.37f, fz * 4.0f), 8, seed);
-      mesh.positions[std::size_t(z) * row + x] = ground + glm::vec3(0.0f, y, 0.0f);
-    }
-  });
-  mesh.triangles.resize(std::size_t(cells) * cells * 2);
-  tbb::parallel_for(std::uint32_t{0}, cells, [&](std::uint32_t z) {
-    for (std::uint32_t x = 0; x < cells; ++x) {
-      const std::uint32_t v00 = z * row + x, v10 = v00 + 1, v01 = v00 + row, v11 = v01 + 1;
-      const std::size_t t = (std::size_t(z) * cells + x) * 2;
-      mesh.triangles[t] = glm::uvec3(v00, v01, v11);  // counter-clockwise seen from +y
-      mesh.triangles[t + 1] = glm::uvec3(v00, v11, v10);
-    }
-  });
-  return mesh;
+  return generate_mesh(TerrainShape(triangles, size, height, seed));
 }
-
-// Thin open tubes of triangular cross-section growing from a sphere of radius `radius`.
 TriangleMesh make_strands(std::size_t triangles, float radius, float length, float width, std::uint32_t seed) {
-  constexpr std::uint32_t kSegments = 4, kSides = 3, kRings = kSegments + 1;
-  constexpr std::uint32_t kTrianglesPerStrand = kSegments * kSides * 2;
-  const std::size_t strands = std::max<std::size_t>(1, triangles / kTrianglesPerStrand);
-  TriangleMesh mesh;
-  mesh.positions.resize(strands * kRings * kSides);
-  mesh.triangles.resize(strands * kTrianglesPerStrand);
-  tbb::parallel_for(std::size_t{0}, strands, [&](std::size_t s) {
-    const UnitPair root = unit_pair(random_bits(std::uint32_t(s), seed, 0, RandomPurpose::scene_generation));
-    const UnitPair bend = unit_pair(random_bits(std::uint32_t(s), seed, 1, RandomPurpose::scene_generation));
-    const glm::vec3 normal = uniform_sphere(root.first, root.second);
-    const glm::vec3 tangent = glm::normalize(glm::cross(normal, std::fabs(normal.y) < 0.9f ? glm::vec3(0, 1, 0)
-                                                                                          : glm::vec3(1, 0, 0)));
-    const glm::vec3 bitangent = glm::cross(normal, tangent);
-    const glm::vec3 sway = tangent * (bend.first - 0.5f) + bitangent * (bend.second - 0.5f);
-    const std::size_t first_vertex = s * kRings * kSides;
-    for (std::uint32_t ring = 0; ring < kRings; ++ring) {
-      const float along = float(ring) / kSegments;
-      const glm::vec3 center = normal * (radius + length * along) + sway * (length * along * along);
-      const float ring_width = width * (1.0f - 0.7f * along);
-      for (std::uint32_t side = 0; side < kSides; ++side) {
-        const float angle = 2.0f * 3.14159265f * float(side) / kSides;
-        mesh.positions[first_vertex + ring * kSides + side] =
-            center + (tangent * std::cos(angle) + bitangent * std::sin(angle)) * ring_width;
-      }
-    }
-    std::size_t t = s * kTrianglesPerStrand;
-    for (std::uint32_t ring = 0; ring < kSegments; ++ring) {
-      for (std::uint32_t side = 0; side < kSides; ++side) {
-        const auto a = static_cast<std::uint32_t>(first_vertex + ring * kSides + side);
-        const auto b = static_cast<std::uint32_t>(first_vertex + ring * kSides + (side + 1) % kSides);
-        mesh.triangles[t++] = glm::uvec3(a, b, b + kSides);
-        mesh.triangles[t++] = glm::uvec3(a, b + kSides, a + kSides);
-      }
-    }
-  });
-  return mesh;
+  return generate_mesh(StrandsShape(triangles, radius, length, width, seed));
 }
-
-TriangleMesh make_displaced_sphere(std::size_t triangles, const glm::vec3& center, float radius,
-                                   std::uint32_t seed) {
-  const IcosphereLattice lattice(icosphere_frequency(triangles));
-  const std::uint32_t n = icosphere_frequency(triangles);
-  TriangleMesh mesh;
-  mesh.positions.resize(lattice.vertex_count());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, lattice.vertex_count(), 4096),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      for (std::size_t id = range.begin(); id != range.end(); ++id) {
-                        const glm::vec3 direction = lattice.direction(id);
-                        const float displacement =
-                            kDisplacementAmplitude *
-                            fractal_noise(direction * kDisplacementFrequency, kDisplacementOctaves, seed);
-                        mesh.positions[id] = center + direction * (radius * (1.0f + displacement));
-                      }
-                    });
-  mesh.triangles.resize(lattice.triangle_count());
-  tbb::parallel_for(std::uint32_t{0}, 20u * n, [&](std::uint32_t face_row) {
-    const std::uint32_t face = face_row / n, i = face_row % n;
-    // Row i of face f: n-i "up" triangles and n-i-1 "down" triangles, in a fixed order.
-    std::size_t t = std::size_t(face) * n * n + std::size_t(i) * (2 * n - i);
-    for (std::uint32_t j = 0; i + j < n; ++j) {
-      mesh.triangles[t++] = glm::uvec3(lattice.vertex(face, i, j), lattice.vertex(face, i + 1, j),
-                                       lattice.vertex(face, i, j + 1));
-      if (i + j + 1 < n) {
-        mesh.triangles[t++] = glm::uvec3(lattice.vertex(face, i + 1, j), lattice.vertex(face, i + 1, j + 1),
-                                         lattice.vertex(face, i, j + 1));
-      }
-    }
-  });
-  return mesh;
+TriangleMesh make_displaced_sphere(std::size_t triangles, const glm::vec3& center, float radius, std::uint32_t seed) {
+  return generate_mesh(SphereShape(triangles, center, radius, seed));
 }
-
 TriangleMesh make_room_shell(const glm::vec3& lower, const glm::vec3& upper, std::size_t triangles) {
-  const glm::vec3 extent = upper - lower;
-  // Each face of cells h x h is two triangles per cell: 4 (xy + yz + zx) / h^2 in all.
-  const double face_area = double(extent.x) * extent.y + double(extent.y) * extent.z + double(extent.z) * extent.x;
-  const double cell = std::sqrt(4.0 * face_area / double(std::max<std::size_t>(triangles, 12)));
-  glm::uvec3 cells;
-  for (int axis = 0; axis < 3; ++axis) {
-    cells[axis] = static_cast<std::uint32_t>(std::max(1.0, std::round(double(extent[axis]) / cell)));
-  }
-  // Vertices are named by their lattice point, so the faces meeting at an edge share them.
-  std::unordered_map<std::uint64_t, std::uint32_t> vertex_of_point;
-  TriangleMesh shell;
-  const auto vertex = [&](glm::uvec3 point) {
-    const std::uint64_t key = (std::uint64_t(point.x) << 42) | (std::uint64_t(point.y) << 21) | point.z;
-    const auto [slot, inserted] = vertex_of_point.emplace(key, static_cast<std::uint32_t>(shell.positions.size()));
-    if (inserted) shell.positions.push_back(lower + extent * glm::vec3(point) / glm::vec3(cells));
-    return slot->second;
-  };
-  for (int axis = 0; axis < 3; ++axis) {
-    const int first = (axis + 1) % 3, second = (axis + 2) % 3;
-    for (std::uint32_t side = 0; side < 2; ++side) {
-      const std::uint32_t material = axis == 0 ? side : 2;
-      for (std::uint32_t i = 0; i < cells[first]; ++i) {
-        for (std::uint32_t j = 0; j < cells[second]; ++j) {
-          const auto corner = [&](std::uint32_t di, std::uint32_t dj) {
-            glm::uvec3 point;
-            point[axis] = side * cells[axis];
-            point[first] = i + di;
-            point[second] = j + dj;
-            return vertex(point);
-          };
-          const std::uint32_t v00 = corner(0, 0), v10 = corner(1, 0), v11 = corner(1, 1), v01 = corner(0, 1);
-          // (first, second, axis) is right-handed, so this winding faces +axis: inward on the
-          // lower side, flipped on the upper.
-          if (side == 0) {
-            shell.triangles.emplace_back(v00, v10, v11);
-            shell.triangles.emplace_back(v00, v11, v01);
-          } else {
-            shell.triangles.emplace_back(v00, v11, v10);
-            shell.triangles.emplace_back(v00, v01, v11);
-          }
-          shell.material_of_triangle.push_back(material);
-          shell.material_of_triangle.push_back(material);
-        }
-      }
-    }
-  }
-  return shell;
+  return generate_mesh(RoomShellShape(lower, upper, triangles));
 }
 
 TriangleMesh translated(TriangleMesh mesh, const glm::vec3& offset) {

@@ -4,9 +4,11 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 
 #include <glm/vec3.hpp>
 
+#include "scene/shape_generator.hpp"
 #include "scene/triangle_mesh.hpp"
 
 namespace wavetrace {
@@ -32,6 +34,19 @@ TriangleMesh make_inward_box(const glm::vec3& lower, const glm::vec3& upper);
 // vertices shared across face edges: closed and manifold, with about `triangles` triangles.
 // Its per-triangle material is the face: 0 for -x, 1 for +x, 2 for every other face.
 TriangleMesh make_room_shell(const glm::vec3& lower, const glm::vec3& upper, std::size_t triangles);
+
+// The same shapes as generators of any triangle range (shape_generator.hpp); make_* above
+// are generate_mesh of these.
+std::unique_ptr<ShapeGenerator> displaced_sphere_shape(std::size_t triangles, const glm::vec3& center, float radius,
+                                                       std::uint32_t seed);
+// The unit sphere's triangles (centred at the origin), each with three vertices of its own.
+std::unique_ptr<ShapeGenerator> soup_shape(std::size_t triangles, std::uint32_t seed);
+std::unique_ptr<ShapeGenerator> terrain_shape(std::size_t triangles, float size, float height, std::uint32_t seed);
+std::unique_ptr<ShapeGenerator> strands_shape(std::size_t triangles, float radius, float length, float width,
+                                              std::uint32_t seed);
+std::unique_ptr<ShapeGenerator> quad_shape(const glm::vec3& corner, const glm::vec3& u, const glm::vec3& v);
+std::unique_ptr<ShapeGenerator> inward_box_shape(const glm::vec3& lower, const glm::vec3& upper);
+std::unique_ptr<ShapeGenerator> room_shell_shape(const glm::vec3& lower, const glm::vec3& upper, std::size_t triangles);
 
 // The mesh moved by `offset`.
 TriangleMesh translated(TriangleMesh mesh, const glm::vec3& offset);

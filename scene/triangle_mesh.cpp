@@ -44,6 +44,18 @@ bool is_degenerate(const TriangleMesh& mesh, const glm::uvec3& triangle) {
 
 }  // namespace
 
+void validate_bounds(const Bounds3& bounds, std::string_view source) {
+  if (bounds.empty()) throw SceneError(fmt::format("{}: the scene has no triangles", source));
+  for (const glm::vec3& p : {bounds.lower, bounds.upper}) {
+    for (int axis = 0; axis < 3; ++axis) {
+      if (!std::isfinite(p[axis]) || std::fabs(p[axis]) > kMaxCoordinateMagnitude) {
+        throw SceneError(fmt::format("{}: the scene's bounds reach ({}, {}, {}), not finite or beyond {:g}", source,
+                                     p.x, p.y, p.z, kMaxCoordinateMagnitude));
+      }
+    }
+  }
+}
+
 MeshCleanup validate_and_clean(TriangleMesh& mesh, std::string_view source) {
   if (mesh.triangles.empty()) throw SceneError(fmt::format("{}: the mesh has no triangles", source));
   for (std::size_t i = 0; i < mesh.positions.size(); ++i) {

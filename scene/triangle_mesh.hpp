@@ -69,4 +69,8 @@ struct MeshCleanup {
 // Leaves one vertex of spare capacity so an accelerator may read 16 bytes at the last vertex.
 MeshCleanup validate_and_clean(TriangleMesh& mesh, std::string_view source);
 
+// The checks of validate_and_clean that a streamed scene can make without its mesh: the box
+// of all its vertices is finite and within kMaxCoordinateMagnitude (throws SceneError).
+void validate_bounds(const Bounds3& bounds, std::string_view source);
+
 }  // namespace wavetrace

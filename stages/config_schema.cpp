@@ -5,7 +5,7 @@
 namespace wavetrace {
 
 const std::vector<std::string>& config_sections() {
-  static const std::vector<std::string> sections = {"scene", "camera", "render", "accel",
+  static const std::vector<std::string> sections = {"scene", "camera", "render", "accel", "build",
                                                     "proxy", "reorder", "memory", "pipeline"};
   return sections;
 }
@@ -78,6 +78,9 @@ const std::vector<ConfigKey>& config_schema() {
       {"accel.hmq.leaf_size", T::integer, std::int64_t{8}, 1, 14, {}, "most triangles per leaf (the paper: 4, 8, 12)"},
       {"accel.hmq.top_fraction", T::real, 0.05, 0.0, 1.0, {}, "share of the BVH's nodes kept uncompressed at the top"},
       {"accel.bvh.width", T::integer, std::int64_t{2}, 2, 8, {}, "2: binary 32-byte nodes; 8: AVX2 8-wide nodes"},
+
+      {"build.chunk_triangles", T::integer, std::int64_t{1} << 24, std::int64_t{1024}, std::int64_t{1} << 30, {},
+       "scenes of more triangles are built in chunks of at most this many under a top BVH (hmq, raystrips, bvh)"},
 
       {"memory.budget", T::text, std::string("none"), 0, 0, {},
        "simulated page pool: none, a share of the world (20%) or a size (512MiB, 2GB)"},

@@ -6,6 +6,8 @@
 #include <fmt/format.h>
 #include <tbb/info.h>
 
+#include "memory/process_memory.hpp"
+#include "scene/builtin_scenes.hpp"
 #include "stages/approx_hit.hpp"
 #include "stages/shade.hpp"
 #include "stages/spawn.hpp"
@@ -86,6 +88,7 @@ AcceleratorOptions accelerator_options(const Config& config) {
     throw ConfigError(fmt::format("accel.hmq.bits = {} and accel.hmq.epsilon = {}: set one of them",
                                   options.hmq.bits, options.hmq.epsilon));
   }
+  options.chunk_triangles = static_cast<std::size_t>(config.integer("build.chunk_triangles"));
   options.mlgrid.density = config.real("accel.mlgrid.density");
   options.mlgrid.max_cells = static_cast<std::size_t>(config.integer("accel.mlgrid.max_cells"));
   options.mlgrid.macrocell_factor = static_cast<std::uint32_t>(config.integer("accel.mlgrid.macrocell_factor"));
@@ -93,6 +96,38 @@ AcceleratorOptions accelerator_options(const Config& config) {
     throw ConfigError(fmt::format("accel.bvh.width = {}: must be 2 or 8", options.bvh.width));
   }
   return options;
+}
+
+std::unique_ptr<Accelerator> build_world_accelerator(const Scene& scene, const AcceleratorOptions& options) {
+  if (scene.streamed()) return make_world_accelerator(*scene.procedural, nullptr, options);
+  const MeshTriangleSource source(scene.mesh);
+  return make_world_accelerator(source, &scene.mesh, options);
+}
+
+void check_scene_fits(const RenderPlan& plan) {
+  const std::string& source = plan.scene.source;
+  if (!is_builtin_scene(source) || plan.scene.subdivide > 0) return;
+  const std::size_t colon = source.find(':', std::string_view("builtin:").size());
+  if (colon == std::string::npos) return;
+  const double triangles = double(parse_triangle_count(std::string_view(source).substr(colon + 1), source));
+  const std::size_t available = available_memory_bytes();
+  if (available == 0) return;
+  // Measured on builtin:room (README, "Memory at scale"): the finished structure, the mesh
+  // when it is built whole (positions, indices, a material per triangle), and the build's
+  // temporaries, bounded by a chunk where the type builds in chunks.
+  const double structure = estimated_bytes_per_triangle(plan.accelerator.type);
+  const double mesh = plan.scene.streamed ? 0.0 : 22.0;
+  const double build_triangles = builds_in_chunks(plan.accelerator.type)
+                                     ? std::min(triangles, double(plan.accelerator.chunk_triangles))
+                                     : triangles;
+  const double needed = triangles * (structure + mesh) + build_triangles * kBuildBytesPerTriangle;
+  if (needed > double(available)) {
+    throw SceneError(fmt::format(
+        "{}: about {:.1f} GB needed to build '{}' ({:.0f} bytes/triangle{} plus build temporaries) but {:.1f} GB "
+        "of memory is available; try fewer triangles or a more compact accelerator (hmq)",
+        source, needed * 1e-9, plan.accelerator.type, structure, mesh > 0.0 ? " and the whole mesh" : "",
+        double(available) * 1e-9));
+  }
 }
 
 RenderPlan plan_render(const Config& config) {
@@ -158,7 +193,7 @@ std::unique_ptr<Proxy> build_proxy(const RenderPlan& plan, const Scene& scene, c
 }
 
 Camera resolve_camera(const CameraOverride& override, const Scene& scene) {
-  Camera camera = scene.camera.value_or(frame_bounds(scene.mesh.bounds()));
+  Camera camera = scene.camera.value_or(frame_bounds(scene.bounds));
   if (override.position) camera.position = *override.position;
   if (override.look_at) camera.look_at = *override.look_at;
   if (override.up) camera.up = *override.up;
@@ -176,11 +211,14 @@ StageChain::StageChain(const RenderPlan& plan, const World& world, Film& film, c
       owned_.push_back(std::make_unique<ApproxHitStage>(*world.proxy, film, world.scene.background, &hit_rates_, observers));
     }
     if (name == "zsort") {
-      auto zsort = std::make_unique<ZSortStage>(plan.reorder, world.scene.mesh.bounds());
+      auto zsort = std::make_unique<ZSortStage>(plan.reorder, world.scene.bounds);
       zsort_ = zsort.get();
       owned_.push_back(std::move(zsort));
     }
-    if (name == "trace") owned_.push_back(std::make_unique<TraceStage>(world.accelerator, TraceInstruments{&hit_rates_, observers, &trace_times_}));
+    if (name == "trace") {
+      owned_.push_back(std::make_unique<TraceStage>(world.accelerator, world.scene.material_runs,
+                                                    TraceInstruments{&hit_rates_, observers, &trace_times_}));
+    }
     if (name == "shade") owned_.push_back(std::make_unique<ShadeStage>(world, film, rules));
     if (name == "spawn") {
       owned_.push_back(std::make_unique<SpawnStage>(world, rules));
@@ -193,13 +231,6 @@ std::vector<const Stage*> StageChain::stages() const {
   std::vector<const Stage*> stages;
   for (const auto& stage : owned_) stages.push_back(stage.get());
   return stages;
-}
-
-bool adopt_represented_surface(Scene& scene, const Accelerator& accelerator) {
-  std::optional<TriangleMesh> represented = accelerator.represented_mesh(scene.mesh);
-  if (!represented) return false;
-  scene.mesh.positions = std::move(represented->positions);
-  return true;
 }
 
 RenderOutput render_image(const RenderPlan& plan, const World& world, const Camera& camera,

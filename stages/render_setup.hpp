@@ -55,6 +55,15 @@ std::unique_ptr<Proxy> build_proxy(const RenderPlan& plan, const Scene& scene, c
 // The accel.* keys as options for make_accelerator.
 AcceleratorOptions accelerator_options(const Config& config);
 
+// The scene's accelerator (make_world_accelerator): from its generators when the scene is
+// streamed, else from its mesh, which must then outlive the accelerator.
+std::unique_ptr<Accelerator> build_world_accelerator(const Scene& scene, const AcceleratorOptions& options);
+
+// Before anything is allocated: throws SceneError when a builtin scene of the requested
+// size would not fit in the memory the machine has available, by the accelerator's bytes
+// per triangle (and the whole mesh's, when the scene is not streamed).
+void check_scene_fits(const RenderPlan& plan);
+
 // Reads every key; throws ConfigError for a stage list that cannot run.
 RenderPlan plan_render(const Config& config);
 
@@ -90,11 +99,6 @@ struct RenderOutput {
   double any_mrays_per_s = 0.0;      // trace's shadow rays per busy second
   std::uint64_t rejected_contributions = 0;
 };
-
-// Shading and spawning read the scene's mesh (normals, hit points from barycentrics); with
-// a lossy accelerator (hmq) they must read the surface it answers for, or secondary rays
-// start off that surface. Replaces the mesh's positions with it; returns whether it did.
-bool adopt_represented_surface(Scene& scene, const Accelerator& accelerator);
 
 RenderOutput render_image(const RenderPlan& plan, const World& world, const Camera& camera,
                           const std::function<void(const Progress&)>& on_progress = {});

@@ -25,15 +25,11 @@ void ShadeStage::process(Batch* batch, StageOutput& out) const {
       continue;
     }
     const glm::vec3 throughput(rays.throughput_r[i], rays.throughput_g[i], rays.throughput_b[i]);
-    const std::uint32_t triangle = hits.primitive[i];
-    const Material& material = scene.materials[scene.mesh.material(triangle)];
+    const Material& material = scene.materials[hits.material[i]];
     if (material.emissive() && rays.kind[i] == RayKind::camera) {
       // Bounce rays do not count emission: next-event estimation already sampled the lights.
-      const glm::uvec3& corners = scene.mesh.triangles[triangle];
-      const glm::vec3& a = scene.mesh.positions[corners.x];
-      const glm::vec3 normal = glm::cross(scene.mesh.positions[corners.y] - a, scene.mesh.positions[corners.z] - a);
       const glm::vec3 direction(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]);
-      if (glm::dot(normal, direction) < 0.0f) {
+      if (glm::dot(hits.normal(i), direction) < 0.0f) {
         const glm::vec3 light = throughput * material.emission;
         film_.add(rays.pixel[i], light.r, light.g, light.b);
       }

@@ -33,23 +33,20 @@ void write_ray(RayBatch& to, std::size_t slot, const RayBatch& parent, std::size
 void SpawnStage::process(Batch* batch, StageOutput& out) const {
   const RayBatch& rays = batch->rays;
   const HitBatch& hits = batch->hits;
-  const TriangleMesh& mesh = world_.scene.mesh;
   const bool has_lights = !world_.lights.empty();
   Batch* bounces = out.acquire();
   Batch* shadows = has_lights ? out.acquire() : nullptr;
 
   for (std::size_t i = 0; i < rays.count; ++i) {
     if (!(rays.flags[i] & ray_flags::alive)) continue;
-    const std::uint32_t triangle = hits.primitive[i];
-    const glm::uvec3& corners = mesh.triangles[triangle];
-    const glm::vec3 a = mesh.positions[corners.x], b = mesh.positions[corners.y], c = mesh.positions[corners.z];
-    // From barycentrics rather than origin + t * direction: exact to the triangle's plane.
-    const glm::vec3 point = a + (b - a) * hits.u[i] + (c - a) * hits.v[i];
+    // The accelerator's point is from barycentrics rather than origin + t * direction:
+    // exact to the triangle's plane.
+    const glm::vec3 point = hits.point(i);
     const glm::vec3 direction(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]);
-    glm::vec3 normal = glm::normalize(glm::cross(b - a, c - a));
+    glm::vec3 normal = glm::normalize(hits.normal(i));
     if (glm::dot(normal, direction) > 0.0f) normal = -normal;  // two-sided: face the incoming ray
     const glm::vec3 origin = offset_ray_origin(point, normal);
-    const glm::vec3 albedo = world_.scene.materials[mesh.material(triangle)].albedo;
+    const glm::vec3 albedo = world_.scene.materials[hits.material[i]].albedo;
     const glm::vec3 throughput(rays.throughput_r[i], rays.throughput_g[i], rays.throughput_b[i]);
     const std::uint32_t depth = rays.depth[i];
 

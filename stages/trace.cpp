@@ -47,7 +47,13 @@ void TraceStage::process(Batch* batch, StageOutput& out) const {
       (shadow ? instruments_.times->any_rays : instruments_.times->closest_rays).fetch_add(end - begin);
       (shadow ? instruments_.times->any_nanoseconds : instruments_.times->closest_nanoseconds).fetch_add(nanoseconds);
     }
-    if (!shadow && instruments_.hit_rates != nullptr) instruments_.hit_rates->record(rays, batch->hits, {begin, end});
+    if (!shadow) {
+      HitBatch& hits = batch->hits;
+      for (std::uint32_t i = begin; i < end; ++i) {
+        if (hits.is_hit(i)) hits.material[i] = materials_.material(hits.primitive[i]);
+      }
+      if (instruments_.hit_rates != nullptr) instruments_.hit_rates->record(rays, hits, {begin, end});
+    }
     begin = end;
   }
   out.emit(batch);

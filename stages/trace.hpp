@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include "accel/accelerator.hpp"
+#include "scene/material_runs.hpp"
 #include "stages/hit_rates.hpp"
 #include "stages/stage.hpp"
 
@@ -31,10 +32,12 @@ struct TraceInstruments {
   TraceTimes* times = nullptr;                 // seconds by query kind
 };
 
+// Besides the accelerator's hits (point and normal included), writes each closest hit's
+// material from `materials`, so that shade and spawn never read the mesh.
 class TraceStage final : public Stage {
  public:
-  explicit TraceStage(const Accelerator& accelerator, const TraceInstruments& instruments = {})
-      : accelerator_(accelerator), instruments_(instruments) {
+  TraceStage(const Accelerator& accelerator, const MaterialRuns& materials, const TraceInstruments& instruments = {})
+      : accelerator_(accelerator), materials_(materials), instruments_(instruments) {
     if (instruments_.observers != nullptr && !(instruments_.observers->any() && accelerator.probed())) {
       instruments_.observers = nullptr;
     }
@@ -44,6 +47,7 @@ class TraceStage final : public Stage {
 
  private:
   const Accelerator& accelerator_;
+  const MaterialRuns& materials_;
   TraceInstruments instruments_;
 };
 

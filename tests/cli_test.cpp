@@ -31,7 +31,7 @@ TEST(Cli, RenderWritesExrPngAndStats) {
   const nlohmann::json stats = nlohmann::json::parse(file);
   EXPECT_EQ(stats["scene"]["triangles"].get<std::size_t>(), 2000u + 4);
   for (const char* key : {"vertices", "bounds", "degenerate_dropped"}) EXPECT_TRUE(stats["scene"].contains(key)) << key;
-  for (const char* key : {"type", "bytes", "bytes_per_triangle", "parts", "build_seconds", "build_peak_bytes"}) {
+  for (const char* key : {"type", "bytes", "bytes_per_triangle", "parts", "build_seconds", "build_peak_accounted_bytes"}) {
     EXPECT_TRUE(stats["accel"].contains(key)) << key;
   }
   EXPECT_EQ(stats["accel"]["type"], "embree");
@@ -43,6 +43,25 @@ TEST(Cli, RenderWritesExrPngAndStats) {
   EXPECT_EQ(stats["image"]["width"], 32);
   EXPECT_EQ(stats["image"]["spp"], 1);
   EXPECT_EQ(stats["image"]["path"], dir + "/image.exr");
+}
+
+TEST(Cli, RenderReportsResidentMemoryByPhaseFromTheOs) {
+  const std::string dir = temp_dir();
+  const auto result = run_wavetrace("render builtin:room:200k --accel hmq --size 32x24 --spp 1 --set "
+                                    "build.chunk_triangles=50000 --out " + dir + "/memory.exr --stats " + dir +
+                                    "/memory.json");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("memory (resident, from the OS): peak"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("chunks of up to"), std::string::npos) << result.output;
+  std::ifstream file(dir + "/memory.json");
+  const nlohmann::json memory = nlohmann::json::parse(file)["memory"];
+  const auto after_load = memory["after_load_bytes"].get<std::size_t>();
+  const auto after_build = memory["after_build_bytes"].get<std::size_t>();
+  const auto after_render = memory["after_render_bytes"].get<std::size_t>();
+  const auto peak = memory["peak_rss_bytes"].get<std::size_t>();
+  EXPECT_GT(after_load, 0u);
+  EXPECT_GT(after_build, after_load) << "the accelerator is resident after the build";
+  EXPECT_GE(peak, std::max({after_load, after_build, after_render}));
 }
 
 TEST(Cli, RenderReadsConfigFileAndOverrides) {
@@ -91,7 +110,12 @@ INSTANTIATE_TEST_SUITE_P(
                       BadInput{"render --set reorder.heuristic=magic", "reorder.heuristic = 'magic' is not one of"},
                       BadInput{"render --set proxy.share=2", "proxy.share = 2 is out of range"},
                       BadInput{"render --set reorder.heuristic=hph --set pipeline.stages=generate,zsort,trace",
-                               "needs 'approx_hit' before 'zsort'"}),
+                               "needs 'approx_hit' before 'zsort'"},
+                      BadInput{"render --set build.chunk_triangles=10", "build.chunk_triangles = 10 is out of range"},
+                      // Refused from its size before anything is allocated: no out-of-memory kill.
+                      BadInput{"render builtin:room:4G --accel embree", "GB of memory is available"},
+                      BadInput{"render builtin:room:4G --accel hmq --set build.chunk_triangles=1073741824",
+                               "GB of memory is available"}),
     [](const ::testing::TestParamInfo<BadInput>& info) { return "case" + std::to_string(info.index); });
 
 TEST(Cli, InfoReportsTopology) {

@@ -66,10 +66,10 @@ class LeafQuery {
     if constexpr (Probe::kRecords) {
       if (const std::uint32_t* id = geometry_.input_id_address(found_)) probe.read(id, sizeof *id);
     }
-    hits.t[i] = best_.t;
-    hits.primitive[i] = geometry_.input_id(found_);
-    hits.u[i] = best_.u;
-    hits.v[i] = best_.v;
+    hits.set_hit(i, best_.t, geometry_.input_id(found_), best_.u, best_.v);
+    const glm::uvec3& tri = geometry_.triangles()[found_];
+    const glm::vec3* positions = geometry_.positions();
+    hits.set_surface(i, positions[tri.x], positions[tri.y], positions[tri.z]);
   }
 
  private:

@@ -1,6 +1,7 @@
 // Embree 3 wrapper: one triangle geometry with shared buffers, rtcIntersect1/rtcOccluded1
 // per ray (the configuration the papers and PLATFORM.md measure).
 #include "accel/embree/embree_accelerator.hpp"
+#include "accel/hit_surface.hpp"
 
 #include <atomic>
 #include <chrono>
@@ -97,10 +98,8 @@ class EmbreeAccelerator final : public Accelerator {
       if (query.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
         mark_miss(hits, i);
       } else {
-        hits.t[i] = query.ray.tfar;
-        hits.primitive[i] = query.hit.primID;
-        hits.u[i] = query.hit.u;
-        hits.v[i] = query.hit.v;
+        hits.set_hit(i, query.ray.tfar, query.hit.primID, query.hit.u, query.hit.v);
+        set_surface_from_mesh(hits, i, mesh_, query.hit.primID);
       }
     }
   }

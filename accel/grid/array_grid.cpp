@@ -1,6 +1,7 @@
 // Recursive build (items bucketed into a node's cells by counting, then each crowded cell
 // refined) and recursive 3D-DDA traversal, each grid stopping once its nearest hit lies
 // before its next cell.
+#include "accel/hit_surface.hpp"
 #include "accel/grid/array_grid.hpp"
 
 #include <algorithm>
@@ -249,6 +250,7 @@ class ArrayGridAccelerator final : public Accelerator {
       traverse_grid<kAnyHit>(nodes_[0], state, state.tmin, state.best, probe);
       if (state.found_triangle != kInvalidPrimitive) {
         hits.set_hit(i, state.found.t, state.found_triangle, state.found.u, state.found.v);
+        set_surface_from_mesh(hits, i, mesh_, state.found_triangle);
       }
     }
   }

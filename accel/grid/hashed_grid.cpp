@@ -1,6 +1,7 @@
 // Counting construction of the hashed grid (D bits, first-fit row displacement for O, counts
 // and prefix sums for H, reverse insertion for L) and 3D-DDA traversal that stops once the
 // nearest hit found lies before the next cell.
+#include "accel/hit_surface.hpp"
 #include "accel/grid/hashed_grid.hpp"
 
 #include <algorithm>
@@ -332,6 +333,7 @@ class HashedGridAccelerator final : public Accelerator {
       }
       if (found_triangle != kInvalidPrimitive) {
         hits.set_hit(i, found.t, found_triangle, found.u, found.v);
+        set_surface_from_mesh(hits, i, mesh_, found_triangle);
       }
     }
   }

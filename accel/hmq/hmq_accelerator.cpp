@@ -15,6 +15,7 @@
 #include "accel/bvh/bvh_walk.hpp"
 #include "accel/bvh/leaf_query.hpp"
 #include "accel/bvh/sah_builder.hpp"
+#include "accel/hit_surface.hpp"
 #include "accel/hmq/child_pair.hpp"
 #include "accel/hmq/global_grid.hpp"
 #include "accel/hmq/hmq_format.hpp"
@@ -184,6 +185,7 @@ struct HmqHit {
   const std::byte* ids = nullptr;
   const std::byte* corners = nullptr;
   std::uint32_t triangle = 0;
+  glm::vec3 corner[3];  // the strip triangle's decoded corners, for the hit's point and normal
   bool found = false;
 };
 
@@ -195,8 +197,8 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
     check_options(options);
     if (mesh.triangle_count() == 0) throw std::invalid_argument("hmq: the mesh has no triangles");
     const auto start = Clock::now();
-    grid_ = options.epsilon > 0.0 ? grid_from_epsilon(mesh.bounds(), options.epsilon)
-                                  : grid_from_bits(mesh.bounds(), options.bits);
+    const Bounds3 grid_box = options.grid_bounds.value_or(mesh.bounds());
+    grid_ = options.epsilon > 0.0 ? grid_from_epsilon(grid_box, options.epsilon) : grid_from_bits(grid_box, options.bits);
     QuantizedMesh quantized{&mesh, std::vector<glm::ivec3>(mesh.vertex_count())};
     tbb::parallel_for(std::size_t{0}, mesh.vertex_count(),
                       [&](std::size_t v) { quantized.lines[v] = grid_.snap(mesh.positions[v]); });
@@ -431,8 +433,11 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
       TriangleHit hit;
       if (intersect_watertight(sheared, corner[0], corner[1], corner[2], tmin, tmax, hit)) {
         tmax = hit.t;
-        best = {hit.t, hit.u, hit.v, decoded.header, decoded.ids, decoded.corners, k, true};
+        best = {hit.t, hit.u, hit.v, decoded.header, decoded.ids, decoded.corners, k, {}, true};
         if constexpr (kAnyHit) return;
+        best.corner[0] = corner[0];
+        best.corner[1] = corner[1];
+        best.corner[2] = corner[2];
       }
     }
   }
@@ -446,6 +451,7 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
     const float weight[3] = {1.0f - best.u - best.v, best.u, best.v};
     hits.set_hit(i, best.t, best.header.id_base + delta[best.triangle], weight[code[best.triangle] / 3],
                  weight[code[best.triangle] % 3]);
+    set_surface_from_strip(hits, i, best.corner, code[best.triangle]);
   }
 
   HmqOptions options_;

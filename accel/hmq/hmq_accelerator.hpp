@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 
 #include "accel/accelerator.hpp"
 #include "scene/triangle_mesh.hpp"
@@ -23,6 +24,9 @@ struct HmqOptions {
   std::uint32_t leaf_size = 8;   // most triangles per leaf, 1 .. 14 (the paper's table: 4, 8, 12)
   double top_fraction = 0.05;    // share of the BVH's nodes kept uncompressed at its top, 0 .. 1
   std::uint32_t bins = 16;       // SAH bins
+  // The box the global grid spans: the whole scene's when a chunk is built, so that every
+  // chunk snaps to the same grid and shared vertices decode alike; unset: the mesh's box.
+  std::optional<Bounds3> grid_bounds;
 };
 
 // Throws std::invalid_argument for options outside their ranges or set together.

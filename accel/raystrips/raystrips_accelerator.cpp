@@ -12,6 +12,7 @@
 #include <tbb/parallel_for.h>
 
 #include "accel/bvh/bvh_node.hpp"
+#include "accel/hit_surface.hpp"
 #include "accel/bvh/bvh_walk.hpp"
 #include "accel/bvh/leaf_query.hpp"
 #include "accel/bvh/node_layout.hpp"
@@ -273,13 +274,17 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
 
   // The hit in the mesh's numbering: triangle id and barycentrics in its corner order.
   template <typename Probe = NullProbe>
-  static void write_hit(const StripRay& ray, HitBatch& hits, std::uint32_t i, Probe* probe = nullptr) {
+  void write_hit(const StripRay& ray, HitBatch& hits, std::uint32_t i, Probe* probe = nullptr) const {
     if (!ray.found()) return write_miss(hits, i);
     const StripView strip(ray.hit.strip);
     if constexpr (Probe::kRecords) probe->read(strip.record_address(ray.hit.triangle), 4);
     const std::uint32_t corners = strip.corners(ray.hit.triangle);
     hits.set_hit(i, ray.hit.t, strip.triangle(ray.hit.triangle), ray.hit.weights[corners / 3],
                  ray.hit.weights[corners % 3]);
+    const glm::vec3 strip_corner[3] = {positions_[strip.vertex(ray.hit.triangle)],
+                                       positions_[strip.vertex(ray.hit.triangle + 1)],
+                                       positions_[strip.vertex(ray.hit.triangle + 2)]};
+    set_surface_from_strip(hits, i, strip_corner, corners);
   }
 
   template <bool kAnyHit, typename Probe>

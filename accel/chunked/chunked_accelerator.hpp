@@ -1,0 +1,43 @@
+// A world of chunks: the scene's triangles cut into runs of at most `chunk_triangles`, each
+// built into a sub-accelerator of its own (its build temporaries freed before the next
+// chunk), joined by a top-level BVH over the chunks' boxes. The chunk is the unit of building
+// and, later, of saving and paging. See ../shared/DESIGN.md, "The world at scale".
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "accel/accelerator.hpp"
+#include "scene/triangle_source.hpp"
+
+namespace wavetrace {
+
+inline constexpr std::size_t kMinChunkTriangles = 1024;
+inline constexpr std::size_t kMaxChunkTriangles = std::size_t{1} << 30;
+
+struct ChunkRange {
+  std::size_t first = 0;  // the chunk's first triangle in the source's numbering
+  std::size_t count = 0;
+};
+
+// Cuts [0, triangles) into chunks of at most `chunk_triangles`: whole small objects share a
+// chunk, a larger object is split into equal runs, and no chunk spans two objects unless
+// both are whole in it.
+std::vector<ChunkRange> plan_chunks(std::span<const std::size_t> object_starts, std::size_t triangles,
+                                    std::size_t chunk_triangles);
+
+// Builds a chunk's sub-accelerator from the chunk's own mesh (triangles numbered from 0).
+using ChunkBuilder = std::function<std::unique_ptr<Accelerator>(const TriangleMesh&)>;
+
+// `keeps_mesh`: the sub-accelerators read their chunk's mesh in place (bvh), so the world
+// keeps each chunk's mesh; otherwise (hmq, raystrips) a chunk's mesh is freed once built.
+// Primitive ids in hits are the source's; throws std::invalid_argument for chunk_triangles
+// outside [kMinChunkTriangles, kMaxChunkTriangles].
+std::unique_ptr<Accelerator> make_chunked_accelerator(const TriangleSource& source, std::size_t chunk_triangles,
+                                                      const ChunkBuilder& build_chunk, bool keeps_mesh);
+
+}  // namespace wavetrace

@@ -1,0 +1,29 @@
+// Filling a closest hit's point and normal (HitBatch::set_surface) from the triangle an
+// accelerator found: read from the mesh it traces in place, or from corners it decoded
+// from a strip, whose order must first be turned back into the mesh's winding.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include <glm/vec3.hpp>
+
+#include "memory/ray_batch.hpp"
+#include "scene/triangle_mesh.hpp"
+
+namespace wavetrace {
+
+inline void set_surface_from_mesh(HitBatch& hits, std::size_t ray, const TriangleMesh& mesh, std::uint32_t triangle) {
+  const glm::uvec3& corners = mesh.triangles[triangle];
+  hits.set_surface(ray, mesh.positions[corners.x], mesh.positions[corners.y], mesh.positions[corners.z]);
+}
+
+// `strip_corner` holds the triangle's corners in strip order; `code` is the strip formats'
+// corner code: the mesh's second corner is strip corner code / 3, its third code % 3 (and
+// the first the remaining one), the same code that maps the barycentrics back.
+inline void set_surface_from_strip(HitBatch& hits, std::size_t ray, const glm::vec3 (&strip_corner)[3], std::uint32_t code) {
+  const std::uint32_t second = code / 3, third = code % 3;
+  hits.set_surface(ray, strip_corner[3 - second - third], strip_corner[second], strip_corner[third]);
+}
+
+}  // namespace wavetrace

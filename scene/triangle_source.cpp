@@ -1,0 +1,32 @@
+// Extraction of a range of an in-memory mesh: its vertices in first-use order.
+#include "scene/triangle_source.hpp"
+
+#include <stdexcept>
+#include <unordered_map>
+
+#include <fmt/format.h>
+
+namespace wavetrace {
+
+TriangleMesh MeshTriangleSource::extract(std::size_t first, std::size_t count) const {
+  if (first > mesh_.triangle_count() || count > mesh_.triangle_count() - first) {
+    throw std::out_of_range(fmt::format("mesh range [{}, {}) beyond its {} triangles", first, first + count,
+                                        mesh_.triangle_count()));
+  }
+  TriangleMesh part;
+  part.triangles.resize(count);
+  std::unordered_map<std::uint32_t, std::uint32_t> local_of;
+  local_of.reserve(count);
+  for (std::size_t t = 0; t < count; ++t) {
+    const glm::uvec3& corners = mesh_.triangles[first + t];
+    for (int k = 0; k < 3; ++k) {
+      const auto [slot, added] = local_of.emplace(corners[k], static_cast<std::uint32_t>(part.positions.size()));
+      if (added) part.positions.push_back(mesh_.positions[corners[k]]);
+      part.triangles[t][k] = slot->second;
+    }
+  }
+  part.positions.reserve(part.positions.size() + 1);  // read slack, as validate_and_clean leaves
+  return part;
+}
+
+}  // namespace wavetrace

@@ -1,0 +1,144 @@
+// The chunked world: chunks cut at object borders, and a world of chunks that answers as
+// the monolithic build does (against robust Embree), keeps HMQ's grid global, and reads
+// only its own memory when probed.
+#include <gtest/gtest.h>
+
+#include <limits>
+
+#include "accel/chunked/chunked_accelerator.hpp"
+#include "accel/registry.hpp"
+#include "bench/ray_sets.hpp"
+#include "memory/pager.hpp"
+#include "scene/builtin_scenes.hpp"
+#include "stages/config.hpp"
+#include "stages/render_setup.hpp"
+#include "stages/tracing_arena.hpp"
+#include "accel_agreement.hpp"
+
+namespace wavetrace {
+namespace {
+
+TEST(PlanChunks, SmallObjectsShareAChunkLargeOnesSplitEvenly) {
+  const std::vector<std::size_t> starts = {0, 10, 12, 40, 140};
+  const std::vector<ChunkRange> chunks = plan_chunks(starts, 150, 30);
+  // [0,12) two whole objects; [12,40) whole; [40,140) in 4 runs of 25; [140,150) whole.
+  const std::vector<std::pair<std::size_t, std::size_t>> expected = {{0, 12}, {12, 28}, {40, 25}, {65, 25},
+                                                                     {90, 25}, {115, 25}, {140, 10}};
+  ASSERT_EQ(chunks.size(), expected.size());
+  for (std::size_t c = 0; c < chunks.size(); ++c) {
+    EXPECT_EQ(chunks[c].first, expected[c].first) << c;
+    EXPECT_EQ(chunks[c].count, expected[c].second) << c;
+  }
+  std::size_t covered = 0;
+  for (const ChunkRange& chunk : plan_chunks(std::vector<std::size_t>{0}, 1000003, 1024)) {
+    EXPECT_EQ(chunk.first, covered);
+    EXPECT_LE(chunk.count, 1024u);
+    covered += chunk.count;
+  }
+  EXPECT_EQ(covered, 1000003u);
+}
+
+AcceleratorOptions options_for(const std::string& type, std::size_t chunk_triangles) {
+  Config config;
+  config.set("accel.type=" + type);
+  config.set("build.chunk_triangles=" + std::to_string(chunk_triangles));
+  return accelerator_options(config);
+}
+
+class ChunkedWorld : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(ChunkedWorld, AnswersAsTheMonolithicBuildDoes) {
+  const Scene scene = make_builtin_scene("builtin:room:100k");
+  AcceleratorOptions robust;
+  robust.embree.mode = EmbreeMode::robust;
+  const auto reference = make_accelerator(scene.mesh, robust);
+  const auto whole = build_world_accelerator(scene, options_for(GetParam(), std::size_t{1} << 24));
+  const auto chunked = build_world_accelerator(scene, options_for(GetParam(), 8192));
+  EXPECT_NE(chunked->build_notes().find("chunks of up to"), std::string::npos) << chunked->build_notes();
+  EXPECT_EQ(whole->build_notes().find("chunks of up to"), std::string::npos);
+  // Bytes: the same structures cut smaller, plus a top BVH.
+  const double ratio = double(chunked->memory().total()) / double(whole->memory().total());
+  EXPECT_NEAR(ratio, 1.0, 0.05) << "chunked " << chunked->memory().total() << " whole " << whole->memory().total();
+  const float diagonal = scene.bounds.diagonal();
+  // hmq answers for the surface it represents; bvh and raystrips for the mesh.
+  const TriangleMesh represented = whole->represented_mesh(scene.mesh).value_or(scene.mesh);
+  Scene represented_scene = scene;
+  represented_scene.mesh = represented;
+  const auto represented_reference = make_accelerator(represented, robust);
+  for (const RaySetKind kind : {RaySetKind::primary, RaySetKind::diffuse, RaySetKind::shadow, RaySetKind::random}) {
+    for (const bool packets : {false, true}) {
+      if (packets && kind != RaySetKind::primary) continue;
+      const std::string label = to_string(kind) + (packets ? " packets" : "");
+      for (const Accelerator* tested : {whole.get(), chunked.get()}) {
+        const testing::Agreement result = testing::compare_on_rays(represented_scene, *represented_reference, *tested,
+                                                                   kind, 20000, 1e-5f * diagonal, 1e-3f, packets);
+        EXPECT_LE(double(result.hit_differs), 1e-4 * double(result.rays)) << label;
+        EXPECT_LE(double(result.far_t), 1e-4 * double(result.rays)) << label;
+        if (kind != RaySetKind::shadow) EXPECT_GT(result.same_primitive, result.rays * 9 / 10) << label;
+      }
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Types, ChunkedWorld, ::testing::Values("hmq", "raystrips", "bvh"));
+
+TEST(ChunkedWorld, HmqChunksShareOneGlobalGrid) {
+  // Every chunk snaps to the scene's grid: a vertex on a chunk border decodes alike in both
+  // chunks, so the represented surface is the monolithic build's, vertex for vertex.
+  const Scene scene = make_builtin_scene("builtin:sphere:50k");
+  const auto whole = build_world_accelerator(scene, options_for("hmq", std::size_t{1} << 24));
+  const auto chunked = build_world_accelerator(scene, options_for("hmq", 4096));
+  EXPECT_EQ(chunked->represented_mesh(scene.mesh)->positions, whole->represented_mesh(scene.mesh)->positions);
+}
+
+TEST(ChunkedWorld, ProbedAnswersAsUnprobedAndReadsOnlyItsWorld) {
+  const Scene scene = make_builtin_scene("builtin:room:50k");
+  const auto chunked = build_world_accelerator(scene, options_for("hmq", 4096));
+  ASSERT_TRUE(chunked->probed());
+  const RaySet rays = make_ray_set(RaySetKind::diffuse, scene, *chunked, 4000);
+  const auto plain = trace_ray_set(*chunked, rays);
+  Pager pager(chunked->memory_spans(), 16384, MemoryBudget{}, io_preset("nvme"));
+  TracingArena arena(1);
+  std::vector<std::unique_ptr<HitBatch>> probed;
+  arena.execute([&] { probed = trace_ray_set_probed(*chunked, rays, MemoryObservers{&pager, nullptr}); });
+  for (std::size_t b = 0; b < rays.batches.size(); ++b) {
+    for (std::size_t i = 0; i < rays.batches[b]->count; ++i) {
+      ASSERT_EQ(plain[b]->primitive[i], probed[b]->primitive[i]);
+      ASSERT_EQ(plain[b]->t[i], probed[b]->t[i]);
+    }
+  }
+  EXPECT_GT(pager.counters(0).accesses, 4000u);
+  EXPECT_EQ(pager.outside_accesses(), 0u);
+}
+
+// A source that claims more triangles than hits can name, without holding any.
+class HugeSource final : public TriangleSource {
+ public:
+  std::size_t triangle_count() const override { return std::size_t{5} << 30; }
+  Bounds3 bounds() const override { return {glm::vec3(0.0f), glm::vec3(1.0f)}; }
+  std::vector<std::size_t> object_starts() const override { return {0}; }
+  TriangleMesh extract(std::size_t, std::size_t) const override { throw std::logic_error("must not be reached"); }
+};
+
+TEST(ChunkedWorld, LimitsAreClearErrors) {
+  const auto build = [](const TriangleMesh& mesh) { return make_accelerator(mesh, AcceleratorOptions{}); };
+  try {
+    make_chunked_accelerator(HugeSource{}, 1 << 24, build, false);
+    FAIL() << "5G triangles cannot be named by 32-bit hit ids";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("32-bit ids"), std::string::npos) << error.what();
+  }
+  const Scene scene = make_builtin_scene("builtin:sphere:2000");
+  const MeshTriangleSource source(scene.mesh);
+  EXPECT_THROW(make_chunked_accelerator(source, 100, build, false), std::invalid_argument);
+  Config config;
+  try {
+    config.set("build.chunk_triangles=12");
+    FAIL() << "a chunk of 12 triangles is out of range";
+  } catch (const ConfigError& error) {
+    EXPECT_NE(std::string(error.what()).find("build.chunk_triangles"), std::string::npos) << error.what();
+  }
+}
+
+}  // namespace
+}  // namespace wavetrace
