@@ -1,4 +1,4 @@
-// The `wavetrace` command line: render, info, bench.
+// The `wavetrace` command line: render, info, bench, export.
 #include <cstdio>
 #include <exception>
 
@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   wavetrace::add_render_command(app, exit_code);
   wavetrace::add_info_command(app, exit_code);
   wavetrace::add_bench_command(app, exit_code);
+  wavetrace::add_export_command(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {

@@ -55,7 +55,7 @@ class ObjectList {
     scene.bounds = procedural->bounds();
     validate_bounds(scene.bounds, scene.name);
     scene.material_runs = procedural->material_runs();
-    scene.procedural = std::move(procedural);
+    scene.stream = std::move(procedural);
     return scene;
   }
 

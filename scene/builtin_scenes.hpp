@@ -23,7 +23,7 @@ std::vector<std::string> builtin_scene_names();
 
 // Parses "builtin:NAME[:COUNT]" (COUNT with an optional k, M or G suffix) and builds it.
 // The triangle count is met as closely as the generator's structure allows. Streamed, the
-// scene keeps its generators (Scene::procedural) and no mesh.
+// scene keeps its generators (Scene::stream) and no mesh.
 Scene make_builtin_scene(std::string_view source, bool streamed = false);
 
 // Parses a count such as "8M", "250k" or "1000"; throws SceneError naming `what`.

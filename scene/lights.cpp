@@ -16,7 +16,7 @@ LightSampler::LightSampler(const Scene& scene) {
   if (scene.streamed()) {
     std::vector<bool> emissive(scene.materials.size());
     for (std::size_t m = 0; m < emissive.size(); ++m) emissive[m] = scene.materials[m].emissive();
-    generated = scene.procedural->objects_with_materials(emissive);
+    generated = scene.stream->triangles_with_materials(emissive);
   } else if (scene.mesh.triangles.empty() && scene.triangle_count > 0) {
     throw std::logic_error("LightSampler needs the scene's mesh: build it before the mesh is released");
   }

@@ -23,7 +23,7 @@ TriangleMesh ProceduralScene::extract(std::size_t first, std::size_t count) cons
 
 TriangleMesh ProceduralScene::assemble() const { return extract_objects(0, triangle_count(), true, nullptr); }
 
-TriangleMesh ProceduralScene::objects_with_materials(const std::vector<bool>& wanted_material) const {
+TriangleMesh ProceduralScene::triangles_with_materials(const std::vector<bool>& wanted_material) const {
   return extract_objects(0, triangle_count(), true, &wanted_material);
 }
 

@@ -31,13 +31,13 @@ class ProceduralScene final : public TriangleSource {
   // Vertices shared inside one object stay shared; material_of_triangle stays empty.
   TriangleMesh extract(std::size_t first, std::size_t count) const override;
 
+  MaterialRuns material_runs() const override;
+  // Every object that has a wanted material, whole, without generating the rest.
+  TriangleMesh triangles_with_materials(const std::vector<bool>& wanted_material) const override;
+
   const std::vector<ProceduralObject>& objects() const { return objects_; }
-  MaterialRuns material_runs() const;
   // The whole scene as one mesh with material_of_triangle (scene indices).
   TriangleMesh assemble() const;
-  // Every object that has an emissive material, whole, with material_of_triangle: what
-  // the light sampler needs, without generating the rest.
-  TriangleMesh objects_with_materials(const std::vector<bool>& wanted_material) const;
 
  private:
   TriangleMesh extract_objects(std::size_t first, std::size_t count, bool with_materials,

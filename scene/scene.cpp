@@ -6,6 +6,7 @@
 
 #include "scene/builtin_scenes.hpp"
 #include "scene/mesh_io.hpp"
+#include "scene/ply_file.hpp"
 #include "scene/scene_file.hpp"
 #include "scene/subdivide.hpp"
 
@@ -20,6 +21,21 @@ Scene load_scene(const SceneRequest& request) {
     scene = make_builtin_scene(request.source, request.streamed && request.subdivide == 0);
   } else if (is_scene_file(request.source)) {
     scene = load_scene_file(request.source);
+  } else if (is_binary_ply(request.source)) {
+    auto ply = std::make_shared<const PlyTriangleSource>(request.source);
+    scene.name = request.source;
+    scene.cleanup.degenerate_dropped = ply->degenerate_dropped();
+    scene.materials = {Material{}};
+    scene.background = glm::vec3(1.0f);
+    if (request.streamed && request.subdivide == 0) {
+      scene.triangle_count = ply->triangle_count();
+      scene.vertex_count = ply->vertex_count();
+      scene.bounds = ply->bounds();
+      scene.material_runs = ply->material_runs();
+      scene.stream = std::move(ply);
+    } else {
+      scene.mesh = ply->extract(0, ply->triangle_count());
+    }
   } else {
     LoadedMesh loaded = load_mesh_file(request.source);
     scene.name = request.source;

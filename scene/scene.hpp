@@ -25,10 +25,10 @@ struct Material {
 
 struct Scene {
   std::string name;
-  // The flattened mesh; empty when the scene is streamed (procedural holds its triangles)
-  // or was released once an accelerator that keeps its own geometry was built.
+  // The flattened mesh; empty when the scene is streamed (`stream` makes its triangles a
+  // range at a time) or was released once an accelerator that keeps its own geometry was built.
   TriangleMesh mesh;
-  std::shared_ptr<const ProceduralScene> procedural;  // set when streamed
+  std::shared_ptr<const TriangleSource> stream;  // set when streamed
   // What stays known without the mesh: counts, bounds, each triangle's material.
   std::size_t triangle_count = 0;
   std::size_t vertex_count = 0;
@@ -44,7 +44,7 @@ struct Scene {
   std::size_t subdivision_levels = 0;
   std::size_t non_manifold_faces_dropped = 0;
 
-  bool streamed() const { return procedural != nullptr; }
+  bool streamed() const { return stream != nullptr; }
   // Frees the mesh (and its per-triangle materials); counts, bounds and runs stay.
   void release_mesh();
   // Sets counts, bounds and material runs from the mesh.
@@ -54,9 +54,9 @@ struct Scene {
 struct SceneRequest {
   std::string source = "builtin:default";  // a mesh file, a scene file (.toml) or builtin:NAME[:TRIANGLES]
   int subdivide = 0;                       // Loop subdivision levels applied after loading
-  // A builtin is left as its generators (Scene::procedural) rather than assembled into one
-  // mesh, for a chunked build that makes it a range at a time. Ignored for files and when
-  // subdividing.
+  // A builtin is left as its generators, a binary PLY file as its vertices and a reader of
+  // its faces (Scene::stream), rather than assembled into one mesh, for a chunked build that
+  // reads it a range at a time. Ignored for other files and when subdividing.
   bool streamed = false;
 };
 

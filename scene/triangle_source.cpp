@@ -8,6 +8,13 @@
 
 namespace wavetrace {
 
+TriangleMesh TriangleSource::triangles_with_materials(const std::vector<bool>& wanted) const {
+  if (wanted.empty() || !wanted[0]) return {};
+  TriangleMesh all = extract(0, triangle_count());
+  all.material_of_triangle.assign(all.triangle_count(), 0);
+  return all;
+}
+
 TriangleMesh MeshTriangleSource::extract(std::size_t first, std::size_t count) const {
   if (first > mesh_.triangle_count() || count > mesh_.triangle_count() - first) {
     throw std::out_of_range(fmt::format("mesh range [{}, {}) beyond its {} triangles", first, first + count,

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "scene/material_runs.hpp"
 #include "scene/triangle_mesh.hpp"
 
 namespace wavetrace {
@@ -21,6 +22,11 @@ class TriangleSource {
   // Triangles [first, first + count) as a mesh of their own: vertices renumbered from 0,
   // triangle i of the result is triangle first + i of the source, material_of_triangle empty.
   virtual TriangleMesh extract(std::size_t first, std::size_t count) const = 0;
+  // Each triangle's material (scene indices); a source without materials has only material 0.
+  virtual MaterialRuns material_runs() const { return MaterialRuns::from_triangles({}, triangle_count()); }
+  // Every triangle whose material is `wanted` (by index), with material_of_triangle: what
+  // a light sampler needs without the rest of the scene.
+  virtual TriangleMesh triangles_with_materials(const std::vector<bool>& wanted) const;
 };
 
 // The ranges of a mesh that is already in memory (read in place; it must outlive the source).

@@ -99,7 +99,7 @@ AcceleratorOptions accelerator_options(const Config& config) {
 }
 
 std::unique_ptr<Accelerator> build_world_accelerator(const Scene& scene, const AcceleratorOptions& options) {
-  if (scene.streamed()) return make_world_accelerator(*scene.procedural, nullptr, options);
+  if (scene.streamed()) return make_world_accelerator(*scene.stream, nullptr, options);
   const MeshTriangleSource source(scene.mesh);
   return make_world_accelerator(source, &scene.mesh, options);
 }

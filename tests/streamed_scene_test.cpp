@@ -86,7 +86,7 @@ TEST(ProceduralScene, StreamedDescribesTheSameSceneAsAssembled) {
     }
     EXPECT_LE(streamed.material_runs.run_count(), 16u) << source;
     const std::size_t third = streamed.triangle_count / 3;
-    expect_same_triangles(assembled.mesh, third, streamed.procedural->extract(third, third), source);
+    expect_same_triangles(assembled.mesh, third, streamed.stream->extract(third, third), source);
     // The light sampler generates only the emissive objects of a streamed scene.
     EXPECT_EQ(LightSampler(streamed).count(), LightSampler(assembled).count()) << source;
   }
