@@ -2,6 +2,7 @@
 #include "accel/registry.hpp"
 
 #include "accel/chunked/chunked_accelerator.hpp"
+#include "kernels/checked_narrowing.hpp"
 
 #include <stdexcept>
 
@@ -24,6 +25,7 @@ bool holds_own_geometry(const std::string& type) { return type == "hmq" || type 
 
 std::unique_ptr<Accelerator> make_world_accelerator(const TriangleSource& source, const TriangleMesh* whole,
                                                     const AcceleratorOptions& options) {
+  checked_uint32(source.triangle_count(), "triangles of a scene, which hits name by 32-bit ids");
   AcceleratorOptions chunk_options = options;
   chunk_options.hmq.grid_bounds = source.bounds();  // one global grid, whether chunked or not
   if (builds_in_chunks(options.type) && source.triangle_count() > options.chunk_triangles) {

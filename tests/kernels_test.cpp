@@ -6,6 +6,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "kernels/checked_narrowing.hpp"
 #include "kernels/morton.hpp"
 #include "kernels/random.hpp"
 #include "kernels/ray_offset.hpp"
@@ -88,6 +89,22 @@ TEST(RayOffset, MovesOffTheSurfaceAtEveryScale) {
     EXPECT_LT(below.z, point.z) << scale;
   }
   EXPECT_GT(offset_ray_origin(glm::vec3(0.0f), normal).z, 0.0f);
+}
+
+}  // namespace
+}  // namespace wavetrace
+
+namespace wavetrace {
+namespace {
+
+TEST(CheckedNarrowing, PassesWhatFitsAndNamesTheFieldOfWhatDoesNot) {
+  EXPECT_EQ(checked_uint32(0xffffffffu, "x"), 0xffffffffu);
+  try {
+    checked_uint32(std::uint64_t{1} << 32, "hmq block offset");
+    FAIL() << "2^32 does not fit";
+  } catch (const std::length_error& error) {
+    EXPECT_NE(std::string(error.what()).find("hmq block offset is 4294967296"), std::string::npos) << error.what();
+  }
 }
 
 }  // namespace

@@ -14,6 +14,8 @@
 #include <tbb/parallel_reduce.h>
 #include <tbb/task_group.h>
 
+#include "kernels/checked_narrowing.hpp"
+
 namespace wavetrace {
 namespace {
 
@@ -69,6 +71,8 @@ class Builder {
   Builder(std::span<const Bounds3> primitive_bounds, const SahOptions& options, BuildTree& tree)
       : options_(options), tree_(tree), references_(primitive_bounds.size()) {
     const std::size_t count = primitive_bounds.size();
+    // Node and primitive ids are 32-bit, and a tree of n leaves has 2n - 1 nodes.
+    checked_uint32(2 * std::uint64_t(count), "SAH build: twice the primitive count; build in chunks (build.chunk_triangles)");
     tbb::parallel_for(std::size_t{0}, count, [&](std::size_t i) {
       references_[i] = {primitive_bounds[i], static_cast<std::uint32_t>(i), 0};
     });

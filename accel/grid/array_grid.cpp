@@ -1,7 +1,6 @@
 // Recursive build (items bucketed into a node's cells by counting, then each crowded cell
 // refined) and recursive 3D-DDA traversal, each grid stopping once its nearest hit lies
 // before its next cell.
-#include "accel/hit_surface.hpp"
 #include "accel/grid/array_grid.hpp"
 
 #include <algorithm>
@@ -13,6 +12,8 @@
 #include <tbb/parallel_for.h>
 
 #include "accel/grid/grid_walk.hpp"
+#include "accel/hit_surface.hpp"
+#include "kernels/checked_narrowing.hpp"
 #include "kernels/ray_box.hpp"
 #include "kernels/triangle_intersect.hpp"
 #include "memory/cache_aligned_allocator.hpp"
@@ -162,7 +163,10 @@ class ArrayGridAccelerator final : public Accelerator {
         const std::uint32_t child_node = build_grid(child, child_items, depth + 1);
         cells_[node.first_cell + c] = {(child_node << 1) | 1u, in_cell};
       } else {
-        cells_[node.first_cell + c] = {static_cast<std::uint32_t>(items_.size()) << 1, in_cell};
+        // The list start shares its word with the refined-cell flag: 31 bits.
+        cells_[node.first_cell + c] = {checked_uint32(std::uint64_t(items_.size()) << 1,
+                                                      "arraygrid list start (31 bits); lower accel.arraygrid.max_entries"),
+                                       in_cell};
         items_.insert(items_.end(), bucketed.begin() + start[c], bucketed.begin() + start[c + 1]);
       }
     }

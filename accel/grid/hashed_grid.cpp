@@ -1,7 +1,6 @@
 // Counting construction of the hashed grid (D bits, first-fit row displacement for O, counts
 // and prefix sums for H, reverse insertion for L) and 3D-DDA traversal that stops once the
 // nearest hit found lies before the next cell.
-#include "accel/hit_surface.hpp"
 #include "accel/grid/hashed_grid.hpp"
 
 #include <algorithm>
@@ -15,6 +14,8 @@
 #include <tbb/parallel_for.h>
 
 #include "accel/grid/grid_walk.hpp"
+#include "accel/hit_surface.hpp"
+#include "kernels/checked_narrowing.hpp"
 #include "kernels/ray_box.hpp"
 #include "kernels/triangle_intersect.hpp"
 #include "memory/cache_aligned_allocator.hpp"
@@ -181,7 +182,7 @@ class HashedGridAccelerator final : public Accelerator {
         const std::size_t end = offset + row.back() + 1;
         if ((end + 63) / 64 > taken.size()) taken.resize(std::max(taken.size() * 2, (end + 63) / 64), 0);
         for (std::uint32_t x : row) taken[(offset + x) / 64] |= std::uint64_t{1} << ((offset + x) % 64);
-        offsets_[std::size_t(z) * cells_.y + y] = static_cast<std::uint32_t>(offset);
+        offsets_[std::size_t(z) * cells_.y + y] = checked_uint32(offset, "grid row offset; lower accel.grid.max_cells");
         used_slots = std::max(used_slots, end);
         last_offset = offset;
       }

@@ -21,6 +21,7 @@
 #include "accel/hmq/hmq_format.hpp"
 #include "accel/hmq/leaf_codec.hpp"
 #include "accel/probed_accelerator.hpp"
+#include "kernels/checked_narrowing.hpp"
 #include "kernels/ray_box.hpp"
 #include "kernels/triangle_intersect.hpp"
 #include "memory/cache_aligned_allocator.hpp"
@@ -166,7 +167,7 @@ class BlockEncoder {
       const std::uint32_t child_block = encode({node.left, node.right}, slot.box);
       std::memcpy(blocks_.data() + start + kBlockHeaderBytes + 4 * (node_slots + f), &child_block, 4);
     }
-    return static_cast<std::uint32_t>(start / 4);
+    return checked_uint32(start / 4, "hmq block offset in 4-byte words; build in smaller chunks (build.chunk_triangles)");
   }
 
  private:

@@ -21,6 +21,7 @@
 #include "accel/raystrips/strip_encode.hpp"
 #include "accel/raystrips/strip_packet.hpp"
 #include "accel/raystrips/strip_traversal.hpp"
+#include "kernels/checked_narrowing.hpp"
 #include "memory/cache_aligned_allocator.hpp"
 
 namespace wavetrace {
@@ -181,7 +182,8 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
     // Flatten the top BVH: a leaf's `first` is the word offset of its first strip.
     std::size_t next_strip = 0;
     flatten_tree(top, node_order_list, nodes_, [&](const BuildNode& leaf) {
-      const auto first = static_cast<std::uint32_t>(offset[next_strip] / 4);
+      const std::uint32_t first = checked_uint32(
+          offset[next_strip] / 4, "raystrips strip offset in 4-byte words; build in smaller chunks (build.chunk_triangles)");
       next_strip += leaf.count;
       return first;
     });
