@@ -27,7 +27,7 @@ struct AcceleratorOptions {
   RayStripsOptions raystrips;
   HmqOptions hmq;
   // Scenes of more triangles are built in chunks of at most this many (hmq, raystrips, bvh).
-  std::size_t chunk_triangles = std::size_t{1} << 24;
+  std::size_t chunk_triangles = std::size_t{1} << 22;
 };
 
 std::vector<std::string> accelerator_names();
@@ -35,11 +35,12 @@ std::vector<std::string> accelerator_names();
 // Throws std::invalid_argument naming an unknown type.
 std::unique_ptr<Accelerator> make_accelerator(const TriangleMesh& mesh, const AcceleratorOptions& options);
 
-// What a type's finished structure costs per triangle on builtin:room, measured (README,
-// "Memory at scale"), for refusing a scene that will not fit before building it; and what a
-// build holds per triangle of the mesh it builds at once, at most (the SAH build's arrays).
+// What a type's finished structure costs per triangle on builtin:room, and what its build
+// holds beyond it per triangle built at once (a chunk, where the type builds in chunks),
+// both measured (README, "Memory at scale"): for refusing a scene that will not fit before
+// building it.
 double estimated_bytes_per_triangle(const std::string& type);
-inline constexpr double kBuildBytesPerTriangle = 200.0;
+double estimated_build_bytes_per_triangle(const std::string& type);
 
 // Types that can be built chunk by chunk under a top-level BVH.
 bool builds_in_chunks(const std::string& type);

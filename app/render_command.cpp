@@ -1,4 +1,5 @@
 // `wavetrace render`: config and flags to a plan, scene and accelerator to an image.
+#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <memory>
@@ -50,13 +51,15 @@ int run_render(const RenderArguments& args) {
   const Config config = build_config(args);
   const RenderPlan plan = plan_render(config);
 
-  ProcessMemory measured;
+  RenderPhases measured;
   // An accelerator that holds its own geometry never needs the whole mesh: a builtin scene
   // is then generated a chunk at a time as it is built. The proxy is simplified from the mesh.
   RenderPlan load_plan = plan;
   load_plan.scene.streamed = holds_own_geometry(plan.accelerator.type) && !plan.needs_proxy();
   check_scene_fits(load_plan);
+  const auto load_start = std::chrono::steady_clock::now();
   Scene scene = load_scene(load_plan.scene);
+  measured.load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
   measured.after_load_bytes = read_resident_memory().current_bytes;
   const Camera camera = resolve_camera(plan.camera, scene);
   const std::unique_ptr<Accelerator> accelerator = build_world_accelerator(scene, plan.accelerator);

@@ -101,7 +101,8 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
         {"triangles", facts.scene.triangle_count},
         {"vertices", facts.scene.vertex_count},
         {"bounds", bounds_json(facts.scene.bounds)},
-        {"degenerate_dropped", facts.scene.cleanup.degenerate_dropped}}},
+        {"degenerate_dropped", facts.scene.cleanup.degenerate_dropped},
+        {"load_seconds", facts.phases.load_seconds}}},
       {"accel",
        {{"type", facts.accelerator.name()},
         {"bytes", memory.total()},
@@ -120,7 +121,7 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
         {"path", facts.image_path}}},
   };
   if (facts.proxy != nullptr) stats["proxy"] = proxy_json(*facts.proxy);
-  const ProcessMemory& measured = facts.memory;
+  const RenderPhases& measured = facts.phases;
   stats["memory"] = {{"peak_rss_bytes", measured.peak_rss_bytes},
                      {"after_load_bytes", measured.after_load_bytes},
                      {"after_build_bytes", measured.after_build_bytes},
@@ -172,12 +173,12 @@ std::string render_table(const RenderFacts& facts) {
   if (const std::string notes = facts.accelerator.build_notes(); !notes.empty()) {
     table += fmt::format("accel {}: {}\n", facts.accelerator.name(), notes);
   }
-  const ProcessMemory& measured = facts.memory;
+  const RenderPhases& measured = facts.phases;
   table += fmt::format(
-      "memory (resident, from the OS): peak {:.2f} GB ({:.1f} bytes/triangle); after load {:.2f} GB, after build {:.2f} GB, "
-      "after render {:.2f} GB\n",
+      "memory (resident, from the OS): peak {:.2f} GB ({:.1f} bytes/triangle); after load ({:.1f} s) {:.2f} GB, after "
+      "build {:.2f} GB, after render {:.2f} GB\n",
       double(measured.peak_rss_bytes) * 1e-9, double(measured.peak_rss_bytes) / double(facts.scene.triangle_count),
-      double(measured.after_load_bytes) * 1e-9, double(measured.after_build_bytes) * 1e-9,
+      measured.load_seconds, double(measured.after_load_bytes) * 1e-9, double(measured.after_build_bytes) * 1e-9,
       double(measured.after_render_bytes) * 1e-9);
   table += memory_lines(run.stages);
   if (facts.output.memory_unobserved) table += "memory: " + *facts.output.memory_unobserved + "\n";

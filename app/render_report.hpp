@@ -11,13 +11,14 @@
 
 namespace wavetrace {
 
-// Resident memory read from the OS (VmRSS) at the end of each phase of a render, and the
-// process's peak (VmHWM).
-struct ProcessMemory {
+// What each phase of a render left: resident memory read from the OS (VmRSS) at its end,
+// the process's peak (VmHWM), and the load's wall time.
+struct RenderPhases {
   std::size_t after_load_bytes = 0;
   std::size_t after_build_bytes = 0;
   std::size_t after_render_bytes = 0;
   std::size_t peak_rss_bytes = 0;
+  double load_seconds = 0.0;  // wall time of the scene load (a streamed scene: its bounds pass)
 };
 
 struct RenderFacts {
@@ -27,7 +28,7 @@ struct RenderFacts {
   const RenderOutput& output;
   std::string image_path;
   const Proxy* proxy = nullptr;
-  ProcessMemory memory;
+  RenderPhases phases;
 };
 
 nlohmann::json proxy_json(const Proxy& proxy);

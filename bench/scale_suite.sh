@@ -22,7 +22,13 @@ for size in 8M 64M; do
   "$wavetrace" bench accel --scene "builtin:room:$size" --accel embree,bvh,raystrips,hmq --rays diffuse \
       --count 1000000 --threads 2 --repeat 3 --json "$out/bench_${size}.json" > "$out/bench_${size}.txt" 2>&1
 done
-"$wavetrace" bench accel --scene builtin:room:8M --rays diffuse --count 1000000 --threads 2 --repeat 3 \
-    --accel hmq,hmq:chunk_triangles=1048576,raystrips,raystrips:chunk_triangles=1048576,bvh,bvh:chunk_triangles=1048576 \
-    --json "$out/chunked_8M.json" > "$out/chunked_8M.txt" 2>&1
+# Chunked (1M) against monolithic (one chunk of 2^30) on the same mesh, against robust Embree.
+whole=chunk_triangles=1073741824
+chunked=chunk_triangles=1048576
+for rays in primary diffuse; do
+  "$wavetrace" bench accel --scene builtin:room:8M --rays "$rays" --count 1000000 --threads 2 --repeat 3 \
+      --reference embree:mode=robust \
+      --accel "hmq:$whole,hmq:$chunked,raystrips:$whole,raystrips:$chunked,bvh:$whole,bvh:$chunked" \
+      --json "$out/chunked_8M_$rays.json" > "$out/chunked_8M_$rays.txt" 2>&1
+done
 /usr/bin/python3 "$(dirname "$0")/scale_table.py" "$out" $sizes

@@ -17,6 +17,14 @@ ProceduralScene::ProceduralScene(std::vector<ProceduralObject> objects) : object
   }
 }
 
+std::vector<std::size_t> ProceduralScene::object_starts() const {
+  std::vector<std::size_t> starts;
+  for (std::size_t o = 0; o < objects_.size(); ++o) {
+    for (const std::size_t part : objects_[o].shape->part_starts()) starts.push_back(starts_[o] + part);
+  }
+  return starts;
+}
+
 TriangleMesh ProceduralScene::extract(std::size_t first, std::size_t count) const {
   return extract_objects(first, count, false, nullptr);
 }

@@ -27,7 +27,8 @@ class ProceduralScene final : public TriangleSource {
 
   std::size_t triangle_count() const override { return starts_.back(); }
   Bounds3 bounds() const override { return bounds_; }
-  std::vector<std::size_t> object_starts() const override { return {starts_.begin(), starts_.end() - 1}; }
+  // Every object's parts (ShapeGenerator::part_starts).
+  std::vector<std::size_t> object_starts() const override;
   // Vertices shared inside one object stay shared; material_of_triangle stays empty.
   TriangleMesh extract(std::size_t first, std::size_t count) const override;
 

@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include <glm/vec3.hpp>
 
@@ -29,6 +30,9 @@ class ShapeGenerator {
   // The shape's own material index of a triangle (see material_count).
   virtual std::uint32_t material(std::size_t triangle) const { return 0; }
   virtual std::uint32_t material_count() const { return 1; }
+  // Where the shape's natural parts begin (ascending, from 0), as cut points for chunks: a
+  // part of its own has a box of its own (a room's six walls, not the room).
+  virtual std::vector<std::size_t> part_starts() const { return {0}; }
 };
 
 // The shape's triangles [first, first + count) as a mesh of their own, moved by `offset`:

@@ -341,6 +341,7 @@ class RoomShellShape final : public ShapeGenerator {
     return face < 2 ? std::uint32_t(face) : 2u;
   }
   std::uint32_t material_count() const override { return 3; }
+  std::vector<std::size_t> part_starts() const override { return {face_start_, face_start_ + 6}; }
   void corners(std::size_t first, std::size_t count, std::uint64_t* out) const override {
     for (std::size_t t = first; t < first + count; ++t) {
       const int face = this->face(t), axis = face / 2, side = face % 2;

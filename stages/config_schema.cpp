@@ -79,7 +79,7 @@ const std::vector<ConfigKey>& config_schema() {
       {"accel.hmq.top_fraction", T::real, 0.05, 0.0, 1.0, {}, "share of the BVH's nodes kept uncompressed at the top"},
       {"accel.bvh.width", T::integer, std::int64_t{2}, 2, 8, {}, "2: binary 32-byte nodes; 8: AVX2 8-wide nodes"},
 
-      {"build.chunk_triangles", T::integer, std::int64_t{1} << 24, std::int64_t{1024}, std::int64_t{1} << 30, {},
+      {"build.chunk_triangles", T::integer, std::int64_t{1} << 22, std::int64_t{1024}, std::int64_t{1} << 30, {},
        "scenes of more triangles are built in chunks of at most this many under a top BVH (hmq, raystrips, bvh)"},
 
       {"memory.budget", T::text, std::string("none"), 0, 0, {},

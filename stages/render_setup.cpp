@@ -120,7 +120,8 @@ void check_scene_fits(const RenderPlan& plan) {
   const double build_triangles = builds_in_chunks(plan.accelerator.type)
                                      ? std::min(triangles, double(plan.accelerator.chunk_triangles))
                                      : triangles;
-  const double needed = triangles * (structure + mesh) + build_triangles * kBuildBytesPerTriangle;
+  const double needed =
+      triangles * (structure + mesh) + build_triangles * estimated_build_bytes_per_triangle(plan.accelerator.type);
   if (needed > double(available)) {
     throw SceneError(fmt::format(
         "{}: about {:.1f} GB needed to build '{}' ({:.0f} bytes/triangle{} plus build temporaries) but {:.1f} GB "

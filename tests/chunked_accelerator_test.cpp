@@ -18,11 +18,11 @@
 namespace wavetrace {
 namespace {
 
-TEST(PlanChunks, SmallObjectsShareAChunkLargeOnesSplitEvenly) {
+TEST(PlanChunks, ObjectsSplitEvenlyAndNeverShareAChunk) {
   const std::vector<std::size_t> starts = {0, 10, 12, 40, 140};
   const std::vector<ChunkRange> chunks = plan_chunks(starts, 150, 30);
-  // [0,12) two whole objects; [12,40) whole; [40,140) in 4 runs of 25; [140,150) whole.
-  const std::vector<std::pair<std::size_t, std::size_t>> expected = {{0, 12}, {12, 28}, {40, 25}, {65, 25},
+  // [0,10), [10,12) and [12,40) whole; [40,140) in 4 runs of 25; [140,150) whole.
+  const std::vector<std::pair<std::size_t, std::size_t>> expected = {{0, 10}, {10, 2}, {12, 28}, {40, 25}, {65, 25},
                                                                      {90, 25}, {115, 25}, {140, 10}};
   ASSERT_EQ(chunks.size(), expected.size());
   for (std::size_t c = 0; c < chunks.size(); ++c) {

@@ -64,6 +64,28 @@ TEST(Cli, RenderReportsResidentMemoryByPhaseFromTheOs) {
   EXPECT_GE(peak, std::max({after_load, after_build, after_render}));
 }
 
+TEST(Cli, ExportedPlyRendersStreamedInChunksAsTheBuiltinDoes) {
+  const std::string dir = temp_dir();
+  const auto exported = run_wavetrace("export builtin:sphere:20k --out " + dir + "/sphere.ply");
+  ASSERT_EQ(exported.exit_code, 0) << exported.output;
+  EXPECT_NE(exported.output.find("20480 triangles"), std::string::npos) << exported.output;
+  const std::string common = " --accel hmq --size 32x24 --spp 1 --set build.chunk_triangles=4096 --out " + dir;
+  const auto from_file = run_wavetrace("render " + dir + "/sphere.ply" + common + "/ply.exr --stats " + dir + "/ply.json");
+  ASSERT_EQ(from_file.exit_code, 0) << from_file.output;
+  EXPECT_NE(from_file.output.find("5 chunks of up to"), std::string::npos) << from_file.output;
+  const auto builtin = run_wavetrace("render builtin:sphere:20k" + common + "/builtin.exr --stats " + dir + "/builtin.json");
+  ASSERT_EQ(builtin.exit_code, 0) << builtin.output;
+  const nlohmann::json a = nlohmann::json::parse(std::ifstream(dir + "/ply.json"));
+  const nlohmann::json b = nlohmann::json::parse(std::ifstream(dir + "/builtin.json"));
+  EXPECT_EQ(a["scene"]["triangles"], b["scene"]["triangles"]);
+  EXPECT_EQ(a["scene"]["bounds"], b["scene"]["bounds"]);
+  // The same triangles in the same chunks; only vertex numbering (and so strips) may differ.
+  EXPECT_NEAR(a["accel"]["bytes"].get<double>() / b["accel"]["bytes"].get<double>(), 1.0, 0.03);
+  const auto bad = run_wavetrace("export builtin:sphere:2000 --out " + dir + "/sphere.obj");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.output.find("export writes .ply files"), std::string::npos) << bad.output;
+}
+
 TEST(Cli, RenderReadsConfigFileAndOverrides) {
   const std::string dir = temp_dir();
   const std::string config = testing::write_temp_file(

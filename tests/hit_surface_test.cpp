@@ -4,6 +4,7 @@
 
 #include "accel/hit_surface.hpp"
 #include "accel/registry.hpp"
+#include "bench/accel_bench.hpp"
 #include "bench/ray_sets.hpp"
 #include "scene/builtin_scenes.hpp"
 #include "stages/config.hpp"
@@ -17,11 +18,11 @@ class HitSurface : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(HitSurface, IsTheFoundTrianglesPointAndNormal) {
   const Scene scene = make_builtin_scene("builtin:room:20k");
-  Config config;
-  config.set("accel.type=" + GetParam());
-  const auto accelerator = build_world_accelerator(scene, accelerator_options(config));
-  // The surface the accelerator answers for (hmq's is snapped to its grid).
+  const auto accelerator = build_world_accelerator(scene, parse_accelerator_spec(GetParam(), Config{}).options);
+  // The surface the accelerator answers for: hmq's is snapped to its grid (8 bits: visibly),
+  // and secondary rays must leave that surface, not the mesh's.
   const TriangleMesh surface = accelerator->represented_mesh(scene.mesh).value_or(scene.mesh);
+  EXPECT_EQ(surface.positions != scene.mesh.positions, GetParam().starts_with("hmq"));
   for (const RaySetKind kind : {RaySetKind::primary, RaySetKind::diffuse}) {
     const RaySet rays = make_ray_set(kind, scene, *accelerator, 3000);
     const auto hits = trace_ray_set(*accelerator, rays, kind == RaySetKind::primary);
@@ -42,7 +43,8 @@ TEST_P(HitSurface, IsTheFoundTrianglesPointAndNormal) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Types, HitSurface, ::testing::Values("embree", "bvh", "raystrips", "hmq", "grid", "arraygrid"));
+INSTANTIATE_TEST_SUITE_P(Types, HitSurface, ::testing::Values("embree", "bvh", "raystrips", "hmq:bits=8", "grid", "arraygrid"),
+                         [](const ::testing::TestParamInfo<std::string>& info) { return "type" + std::to_string(info.index); });
 
 TEST(HitSurface, TraceWritesEachHitsMaterialFromTheRuns) {
   const Scene scene = make_builtin_scene("builtin:room:20k");

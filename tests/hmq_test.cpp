@@ -16,7 +16,6 @@
 #include "accel/hmq/leaf_codec.hpp"
 #include "accel/hmq/packed_stream.hpp"
 #include "accel/hmq/strip_table.hpp"
-#include "accel/hit_surface.hpp"
 #include "accel/registry.hpp"
 #include "bench/accel_bench.hpp"
 #include "bench/image_bench.hpp"
@@ -294,33 +293,6 @@ TEST(Hmq, HitPointsStayWithinThePromisedErrorOfTheMesh) {
     EXPECT_GT(*result.surface_error_max, promised * 0.1) << result.label;   // it does move the surface
   }
   EXPECT_FALSE(report.results[2].surface_error_max) << "bvh is exact: nothing to report";
-}
-
-TEST(Hmq, HitsCarryTheSurfaceItRepresents) {
-  // Shading reads the hit's point and normal: they must be those of the snapped triangle,
-  // so that secondary rays leave the surface the accelerator traces.
-  const Scene scene = make_builtin_scene("builtin:sphere:5000");
-  HmqOptions coarse;
-  coarse.bits = 8;
-  const auto hmq = make_hmq_accelerator(scene.mesh, coarse);
-  const TriangleMesh snapped = *hmq->represented_mesh(scene.mesh);
-  EXPECT_NE(snapped.positions, scene.mesh.positions);
-  const RaySet rays = make_ray_set(RaySetKind::primary, scene, *hmq, 4000);
-  const auto hits = trace_ray_set(*hmq, rays);
-  std::size_t checked = 0;
-  for (std::size_t b = 0; b < rays.batches.size(); ++b) {
-    const HitBatch& hit = *hits[b];
-    for (std::size_t i = 0; i < rays.batches[b]->count; ++i) {
-      if (!hit.is_hit(i)) continue;
-      HitBatch expected(1);
-      expected.set_hit(0, hit.t[i], hit.primitive[i], hit.u[i], hit.v[i]);
-      set_surface_from_mesh(expected, 0, snapped, hit.primitive[i]);
-      ASSERT_EQ(hit.point(i), expected.point(0)) << "ray " << i;
-      ASSERT_EQ(hit.normal(i), expected.normal(0)) << "ray " << i;
-      ++checked;
-    }
-  }
-  EXPECT_GT(checked, 1000u);
 }
 
 TEST(Hmq, ImagesApproachTheReferenceAsTheGridRefines) {

@@ -11,12 +11,15 @@
 #include <stdexcept>
 
 #include <fmt/format.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include "accel/bvh/bvh_node.hpp"
 #include "accel/bvh/bvh_walk.hpp"
 #include "accel/bvh/node_layout.hpp"
 #include "accel/bvh/sah_builder.hpp"
 #include "kernels/ray_box.hpp"
+#include "memory/process_memory.hpp"
 
 namespace wavetrace {
 namespace {
@@ -56,6 +59,14 @@ struct RoundScratch {
   }
 };
 
+// Chunks built at the same time: one per worker thread, as many as half the memory the
+// machine has available now can hold at a build's measured 200 bytes per triangle.
+std::size_t chunks_built_at_once(std::size_t chunk_triangles) {
+  const std::size_t threads = static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
+  const std::size_t affordable = available_memory_bytes() / 2 / (chunk_triangles * 200);
+  return std::clamp<std::size_t>(affordable, 1, threads);
+}
+
 class ChunkedAccelerator final : public Accelerator {
  public:
   ChunkedAccelerator(const TriangleSource& source, std::size_t chunk_triangles, const ChunkBuilder& build_chunk,
@@ -69,19 +80,34 @@ class ChunkedAccelerator final : public Accelerator {
                                               source.triangle_count(), kInvalidPrimitive - 1));
     }
     const auto start = std::chrono::steady_clock::now();
-    const std::vector<std::size_t> starts = source.object_starts();
+    const std::vector<ChunkRange> ranges = plan_chunks(source.object_starts(), source.triangle_count(), chunk_triangles);
+    chunks_.resize(ranges.size());
     std::size_t finished_bytes = 0;
-    for (const ChunkRange& range : plan_chunks(starts, source.triangle_count(), chunk_triangles)) {
-      auto mesh = std::make_unique<const TriangleMesh>(source.extract(range.first, range.count));
-      Chunk chunk{range.first, range.count, mesh->bounds(), nullptr, build_chunk(*mesh)};
-      // The chunk's build held its mesh, its temporaries and every chunk finished before it.
-      accounted_peak_ = std::max(accounted_peak_, finished_bytes + mesh->bytes() + chunk.accelerator->build().peak_bytes);
-      finished_bytes += chunk.accelerator->memory().total();
-      if (keeps_mesh) {
-        chunk.mesh = std::move(mesh);
-        finished_bytes += chunk.mesh->bytes();
+    for (std::size_t wave_begin = 0; wave_begin < ranges.size();) {
+      const std::size_t wave_end = std::min(ranges.size(), wave_begin + chunks_built_at_once(chunk_triangles));
+      // Extracted one after another (a PLY file's faces are read in order), then built at once.
+      std::vector<std::unique_ptr<const TriangleMesh>> meshes;
+      for (std::size_t c = wave_begin; c < wave_end; ++c) {
+        meshes.push_back(std::make_unique<const TriangleMesh>(source.extract(ranges[c].first, ranges[c].count)));
       }
-      chunks_.push_back(std::move(chunk));
+      tbb::parallel_for(wave_begin, wave_end, [&](std::size_t c) {
+        const TriangleMesh& mesh = *meshes[c - wave_begin];
+        chunks_[c] = Chunk{ranges[c].first, ranges[c].count, mesh.bounds(), nullptr, build_chunk(mesh)};
+      });
+      // The wave's builds held their meshes, their temporaries and every chunk finished before.
+      std::size_t wave_bytes = 0;
+      for (std::size_t c = wave_begin; c < wave_end; ++c) {
+        wave_bytes += meshes[c - wave_begin]->bytes() + chunks_[c].accelerator->build().peak_bytes;
+      }
+      accounted_peak_ = std::max(accounted_peak_, finished_bytes + wave_bytes);
+      for (std::size_t c = wave_begin; c < wave_end; ++c) {
+        finished_bytes += chunks_[c].accelerator->memory().total();
+        if (keeps_mesh) {
+          chunks_[c].mesh = std::move(meshes[c - wave_begin]);
+          finished_bytes += chunks_[c].mesh->bytes();
+        }
+      }
+      wave_begin = wave_end;
     }
     build_top();
     build_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -302,24 +328,14 @@ class ChunkedAccelerator final : public Accelerator {
 std::vector<ChunkRange> plan_chunks(std::span<const std::size_t> object_starts, std::size_t triangles,
                                     std::size_t chunk_triangles) {
   std::vector<ChunkRange> chunks;
-  bool last_is_whole_objects = false;
   for (std::size_t o = 0; o < object_starts.size(); ++o) {
     const std::size_t begin = object_starts[o];
     const std::size_t end = o + 1 < object_starts.size() ? object_starts[o + 1] : triangles;
     const std::size_t size = end - begin;
-    if (size == 0) continue;
-    if (last_is_whole_objects && chunks.back().count + size <= chunk_triangles) {
-      chunks.back().count += size;
-    } else if (size <= chunk_triangles) {
-      chunks.push_back({begin, size});
-      last_is_whole_objects = true;
-    } else {
-      const std::size_t pieces = (size + chunk_triangles - 1) / chunk_triangles;
-      for (std::size_t k = 0; k < pieces; ++k) {
-        const std::size_t first = begin + size * k / pieces, next = begin + size * (k + 1) / pieces;
-        chunks.push_back({first, next - first});
-      }
-      last_is_whole_objects = false;
+    const std::size_t pieces = (size + chunk_triangles - 1) / chunk_triangles;
+    for (std::size_t k = 0; k < pieces; ++k) {
+      const std::size_t first = begin + size * k / pieces, next = begin + size * (k + 1) / pieces;
+      chunks.push_back({first, next - first});
     }
   }
   return chunks;

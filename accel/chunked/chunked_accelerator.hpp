@@ -1,6 +1,7 @@
 // A world of chunks: the scene's triangles cut into runs of at most `chunk_triangles`, each
-// built into a sub-accelerator of its own (its build temporaries freed before the next
-// chunk), joined by a top-level BVH over the chunks' boxes. The chunk is the unit of building
+// built into a sub-accelerator of its own (its build temporaries freed once it is built;
+// as many chunks built at once as there are worker threads and memory for them), joined by
+// a top-level BVH over the chunks' boxes. The chunk is the unit of building
 // and, later, of saving and paging. See ../shared/DESIGN.md, "The world at scale".
 #pragma once
 
@@ -24,9 +25,11 @@ struct ChunkRange {
   std::size_t count = 0;
 };
 
-// Cuts [0, triangles) into chunks of at most `chunk_triangles`: whole small objects share a
-// chunk, a larger object is split into equal runs, and no chunk spans two objects unless
-// both are whole in it.
+// Cuts [0, triangles) into chunks of at most `chunk_triangles`: each object (or part, such as
+// a face of a room's shell) into equal runs, and no chunk spans two. Merging small objects
+// was measured worse: a chunk holding the room's shell and the light has the room's box,
+// so every ray from inside visited it first and found the far wall before the near objects
+// (primary rays on room:8M, 1M chunks: bvh 0.88x, raystrips 0.84x of monolithic).
 std::vector<ChunkRange> plan_chunks(std::span<const std::size_t> object_starts, std::size_t triangles,
                                     std::size_t chunk_triangles);
 
