@@ -72,7 +72,7 @@ class BvhAccelerator final : public ProbedAccelerator<BvhAccelerator> {
                  query.test_leaf<kAnyHit>(leaf.first, leaf.triangle_count(), probe);
                  return kAnyHit && query.found();
                });
-      query.write(hits, i, probe);
+      query.write<!kAnyHit>(hits, i, probe);
     }
   }
 

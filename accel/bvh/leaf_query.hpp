@@ -59,14 +59,16 @@ class LeafQuery {
     }
   }
 
-  // The answer in the mesh's triangle numbering (a miss if nothing was found).
-  template <typename Probe>
+  // The answer in the mesh's triangle numbering (a miss if nothing was found); with
+  // kSurface (closest-hit queries) also the hit's point and normal.
+  template <bool kSurface, typename Probe>
   void write(HitBatch& hits, std::uint32_t i, Probe& probe) const {
     if (!found()) return write_miss(hits, i);
     if constexpr (Probe::kRecords) {
       if (const std::uint32_t* id = geometry_.input_id_address(found_)) probe.read(id, sizeof *id);
     }
     hits.set_hit(i, best_.t, geometry_.input_id(found_), best_.u, best_.v);
+    if constexpr (!kSurface) return;
     const glm::uvec3& tri = geometry_.triangles()[found_];
     const glm::vec3* positions = geometry_.positions();
     hits.set_surface(i, positions[tri.x], positions[tri.y], positions[tri.z]);

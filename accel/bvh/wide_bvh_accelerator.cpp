@@ -236,7 +236,7 @@ class WideBvhAccelerator final : public Accelerator {
         if (top == 0) break;
         current = stack[--top];
       }
-      query.write(hits, i, probe);
+      query.write<!kAnyHit>(hits, i, probe);
     }
   }
 

@@ -335,7 +335,7 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
         traverse_blocks<kAnyHit>(leaf, box_ray, sheared, tmin, tmax, best, probe);
         return kAnyHit && best.found;
       });
-      write_hit(best, hits, i, probe);
+      write_hit<!kAnyHit>(best, hits, i, probe);
     }
   }
 
@@ -443,7 +443,8 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
     }
   }
 
-  template <typename Probe>
+  // With kSurface (closest hits, whose corners test_leaf kept) also the point and normal.
+  template <bool kSurface, typename Probe>
   static void write_hit(const HmqHit& best, HitBatch& hits, std::uint32_t i, Probe& probe) {
     if (!best.found) return write_miss(hits, i);
     std::uint32_t delta[kMaxLeafTriangles], code[kMaxLeafTriangles];
@@ -452,7 +453,7 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
     const float weight[3] = {1.0f - best.u - best.v, best.u, best.v};
     hits.set_hit(i, best.t, best.header.id_base + delta[best.triangle], weight[code[best.triangle] / 3],
                  weight[code[best.triangle] % 3]);
-    set_surface_from_strip(hits, i, best.corner, code[best.triangle]);
+    if constexpr (kSurface) set_surface_from_strip(hits, i, best.corner, code[best.triangle]);
   }
 
   HmqOptions options_;

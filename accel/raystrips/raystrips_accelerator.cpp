@@ -275,7 +275,8 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
   }
 
   // The hit in the mesh's numbering: triangle id and barycentrics in its corner order.
-  template <typename Probe = NullProbe>
+  // With kSurface (closest-hit queries) also the hit's point and normal.
+  template <bool kSurface = true, typename Probe = NullProbe>
   void write_hit(const StripRay& ray, HitBatch& hits, std::uint32_t i, Probe* probe = nullptr) const {
     if (!ray.found()) return write_miss(hits, i);
     const StripView strip(ray.hit.strip);
@@ -283,6 +284,7 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
     const std::uint32_t corners = strip.corners(ray.hit.triangle);
     hits.set_hit(i, ray.hit.t, strip.triangle(ray.hit.triangle), ray.hit.weights[corners / 3],
                  ray.hit.weights[corners % 3]);
+    if constexpr (!kSurface) return;
     const glm::vec3 strip_corner[3] = {positions_[strip.vertex(ray.hit.triangle)],
                                        positions_[strip.vertex(ray.hit.triangle + 1)],
                                        positions_[strip.vertex(ray.hit.triangle + 2)]};
@@ -312,7 +314,7 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
         }
         return false;
       });
-      write_hit(ray, hits, i, &probe);
+      write_hit<!kAnyHit>(ray, hits, i, &probe);
     }
   }
 
