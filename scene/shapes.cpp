@@ -440,23 +440,5 @@ std::unique_ptr<ShapeGenerator> room_shell_shape(const glm::vec3& lower, const g
 }
 
 TriangleMesh make_quad(const glm::vec3& corner, const glm::vec3& u, const glm::vec3& v) { return quad_mesh(corner, u, v); }
-TriangleMesh make_inward_box(const glm::vec3& lower, const glm::vec3& upper) { return inward_box_mesh(lower, upper); }
-TriangleMesh make_terrain(std::size_t triangles, float size, float height, std::uint32_t seed) {
-  return generate_mesh(TerrainShape(triangles, size, height, seed));
-}
-TriangleMesh make_strands(std::size_t triangles, float radius, float length, float width, std::uint32_t seed) {
-  return generate_mesh(StrandsShape(triangles, radius, length, width, seed));
-}
-TriangleMesh make_displaced_sphere(std::size_t triangles, const glm::vec3& center, float radius, std::uint32_t seed) {
-  return generate_mesh(SphereShape(triangles, center, radius, seed));
-}
-TriangleMesh make_room_shell(const glm::vec3& lower, const glm::vec3& upper, std::size_t triangles) {
-  return generate_mesh(RoomShellShape(lower, upper, triangles));
-}
-
-TriangleMesh translated(TriangleMesh mesh, const glm::vec3& offset) {
-  tbb::parallel_for(std::size_t{0}, mesh.positions.size(), [&](std::size_t v) { mesh.positions[v] += offset; });
-  return mesh;
-}
 
 }  // namespace wavetrace

@@ -33,7 +33,7 @@ RenderOutput render(const Scene& scene, const std::vector<std::string>& settings
 
 TEST(Room, ShellIsClosedManifoldFacesInwardAndNearItsCount) {
   const glm::vec3 lower(-4, 0, -4), upper(4, 3.5, 4);
-  const TriangleMesh shell = make_room_shell(lower, upper, 20000);
+  const TriangleMesh shell = generate_mesh(*room_shell_shape(lower, upper, 20000));
   const MeshReport report = analyze_mesh(shell);
   EXPECT_TRUE(report.closed());
   EXPECT_EQ(report.connected_components, 1u);
