@@ -130,14 +130,19 @@ std::size_t parse_triangle_count(std::string_view text, std::string_view what) {
   return static_cast<std::size_t>(value * multiplier);
 }
 
-Scene make_builtin_scene(std::string_view source, bool streamed) {
+std::optional<std::size_t> requested_triangle_count(std::string_view source) {
   const std::string_view spec = source.substr(kPrefix.size());
   const std::size_t colon = spec.find(':');
-  const std::string_view name = spec.substr(0, colon);
+  if (colon == std::string_view::npos) return std::nullopt;
+  return parse_triangle_count(spec.substr(colon + 1), source);
+}
+
+Scene make_builtin_scene(std::string_view source, bool streamed) {
+  const std::string_view spec = source.substr(kPrefix.size());
+  const std::string_view name = spec.substr(0, spec.find(':'));
   const std::string label(source);
-  const auto count_or = [&](std::size_t fallback) {
-    return colon == std::string_view::npos ? fallback : parse_triangle_count(spec.substr(colon + 1), label);
-  };
+  const std::optional<std::size_t> requested = requested_triangle_count(source);
+  const auto count_or = [&](std::size_t fallback) { return requested.value_or(fallback); };
   if (name == "sphere") {
     return single_object(label, displaced_sphere_shape(count_or(1000000), glm::vec3(0.0f), 1.0f, kSeed),
                          Material{glm::vec3(0.7f)}, streamed);

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -25,6 +26,10 @@ std::vector<std::string> builtin_scene_names();
 // The triangle count is met as closely as the generator's structure allows. Streamed, the
 // scene keeps its generators (Scene::stream) and no mesh.
 Scene make_builtin_scene(std::string_view source, bool streamed = false);
+
+// The triangle count a builtin source asks for ("builtin:room:8M" -> 8000000), none when it
+// names no count; throws SceneError for a malformed count.
+std::optional<std::size_t> requested_triangle_count(std::string_view source);
 
 // Parses a count such as "8M", "250k" or "1000"; throws SceneError naming `what`.
 std::size_t parse_triangle_count(std::string_view text, std::string_view what);

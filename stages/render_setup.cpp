@@ -107,9 +107,9 @@ std::unique_ptr<Accelerator> build_world_accelerator(const Scene& scene, const A
 void check_scene_fits(const RenderPlan& plan) {
   const std::string& source = plan.scene.source;
   if (!is_builtin_scene(source) || plan.scene.subdivide > 0) return;
-  const std::size_t colon = source.find(':', std::string_view("builtin:").size());
-  if (colon == std::string::npos) return;
-  const double triangles = double(parse_triangle_count(std::string_view(source).substr(colon + 1), source));
+  const std::optional<std::size_t> requested = requested_triangle_count(source);
+  if (!requested) return;
+  const double triangles = double(*requested);
   const std::size_t available = available_memory_bytes();
   if (available == 0) return;
   // Measured on builtin:room (README, "Memory at scale"): the finished structure, the mesh

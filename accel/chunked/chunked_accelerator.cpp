@@ -99,7 +99,7 @@ class ChunkedAccelerator final : public Accelerator {
       for (std::size_t c = wave_begin; c < wave_end; ++c) {
         wave_bytes += meshes[c - wave_begin]->bytes() + chunks_[c].accelerator->build().peak_bytes;
       }
-      accounted_peak_ = std::max(accounted_peak_, finished_bytes + wave_bytes);
+      build_.peak_bytes = std::max(build_.peak_bytes, finished_bytes + wave_bytes);
       for (std::size_t c = wave_begin; c < wave_end; ++c) {
         finished_bytes += chunks_[c].accelerator->memory().total();
         if (keeps_mesh) {
@@ -111,7 +111,6 @@ class ChunkedAccelerator final : public Accelerator {
     }
     build_top();
     build_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    build_.peak_bytes = accounted_peak_;
   }
 
   std::string name() const override { return chunks_.front().accelerator->name(); }
@@ -319,7 +318,6 @@ class ChunkedAccelerator final : public Accelerator {
 
   std::vector<Chunk> chunks_;
   LargeArray<BvhNode> top_;
-  std::size_t accounted_peak_ = 0;
   BuildReport build_;
 };
 
