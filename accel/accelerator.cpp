@@ -13,4 +13,8 @@ void Accelerator::intersect_any_probed(const RayBatch&, HitBatch&, RayRange, Rec
   throw std::logic_error("accelerator '" + name() + "' cannot report its memory reads");
 }
 
+void Accelerator::save(SectionWriter&, const std::string&) const {
+  throw std::logic_error("accelerator '" + name() + "' cannot be saved");
+}
+
 }  // namespace wavetrace

@@ -15,6 +15,8 @@
 
 namespace wavetrace {
 
+class SectionWriter;
+
 // Bytes by part, as the papers split them.
 struct MemoryReport {
   std::size_t hierarchy = 0;  // nodes of the acceleration structure
@@ -68,6 +70,11 @@ class Accelerator {
   // representation (hmq snaps vertices to a grid) returns `source` with its vertices moved
   // as it decodes them, so that tests and the leak bench can ask exact questions of it.
   virtual std::optional<TriangleMesh> represented_mesh(const TriangleMesh& source) const { return std::nullopt; }
+
+  // Writes the structure as sections named PREFIX + part (its format beside its code), for
+  // load_accelerator to trace in place. The default throws std::logic_error: Embree's
+  // structure cannot be written (a world rebuilds it from the saved geometry).
+  virtual void save(SectionWriter& out, const std::string& prefix) const;
 
   // The byte ranges traversal reads, for the pager; empty where memory cannot be observed.
   virtual std::vector<std::span<const std::byte>> memory_spans() const { return {}; }

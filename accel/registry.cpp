@@ -2,6 +2,7 @@
 #include "accel/registry.hpp"
 
 #include "accel/chunked/chunked_accelerator.hpp"
+#include "accel/section_archive.hpp"
 #include "kernels/checked_narrowing.hpp"
 
 #include <stdexcept>
@@ -45,6 +46,18 @@ std::unique_ptr<Accelerator> make_world_accelerator(const TriangleSource& source
   }
   const TriangleMesh mesh = source.extract(0, source.triangle_count());
   return make_accelerator(mesh, chunk_options);
+}
+
+bool saves_structure(const std::string& type) { return type == "hmq" || type == "raystrips" || type == "bvh"; }
+
+std::unique_ptr<Accelerator> load_accelerator(SectionLoader& in) {
+  const SavedKind kind = in.file()->value<SavedKind>(in.prefix() + "kind");
+  const std::string type(kind.type, strnlen(kind.type, sizeof(kind.type)));
+  if (type == "hmq") return load_hmq_accelerator(in);
+  if (type == "raystrips") return load_raystrips_accelerator(in);
+  if (type == "bvh") return load_bvh_accelerator(in);
+  if (type == "chunked") return load_chunked_accelerator(in, [](SectionLoader& chunk) { return load_accelerator(chunk); });
+  in.fail("kind", fmt::format("names accelerator '{}', which this build cannot load", type));
 }
 
 std::unique_ptr<Accelerator> make_accelerator(const TriangleMesh& mesh, const AcceleratorOptions& options) {

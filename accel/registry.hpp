@@ -35,6 +35,14 @@ std::vector<std::string> accelerator_names();
 // Throws std::invalid_argument naming an unknown type.
 std::unique_ptr<Accelerator> make_accelerator(const TriangleMesh& mesh, const AcceleratorOptions& options);
 
+// The accelerator saved under the loader's prefix (its "kind" names the type), traced in
+// place; throws SectionFileError for a type that cannot be loaded or a damaged structure.
+class SectionLoader;
+std::unique_ptr<Accelerator> load_accelerator(SectionLoader& in);
+// Types whose built structure can be saved and traced in place from a world file; the
+// others (embree, the grids) are rebuilt from the world's saved geometry when it is loaded.
+bool saves_structure(const std::string& type);
+
 // What a type's finished structure costs per triangle on builtin:room, and what its build
 // holds beyond it per triangle built at once (a chunk, where the type builds in chunks),
 // both measured (README, "Memory at scale"): for refusing a scene that will not fit before

@@ -1,4 +1,4 @@
-// The `wavetrace` command line: render, info, bench, export.
+// The `wavetrace` command line: render, build, info, bench, export.
 #include <cstdio>
 #include <exception>
 
@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   wavetrace::add_info_command(app, exit_code);
   wavetrace::add_bench_command(app, exit_code);
   wavetrace::add_export_command(app, exit_code);
+  wavetrace::add_build_command(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {

@@ -14,6 +14,7 @@
 #include "memory/process_memory.hpp"
 #include "scene/lights.hpp"
 #include "stages/render_setup.hpp"
+#include "stages/world_file.hpp"
 
 namespace wavetrace {
 namespace {
@@ -47,9 +48,60 @@ Config build_config(const RenderArguments& args) {
   return config;
 }
 
+// Renders through the pipeline and writes the image, the report and the stats.
+int finish_render(const RenderArguments& args, const RenderPlan& plan, const Scene& scene, const World& world,
+                  const Camera& camera, RenderPhases measured) {
+  ProgressLine progress(stderr);
+  const RenderOutput output =
+      render_image(plan, world, camera, progress.enabled() ? [&](const Progress& p) { progress.update(p); }
+                                                          : std::function<void(const Progress&)>());
+  progress.finish();
+  measured.after_render_bytes = read_resident_memory().current_bytes;
+  measured.peak_rss_bytes = read_resident_memory().peak_bytes;
+
+  write_exr(args.out, plan.image.width, plan.image.height, output.image);
+  const std::string preview = preview_path_for(args.out);
+  write_png_preview(preview, plan.image.width, plan.image.height, output.image);
+
+  const RenderFacts facts{scene, world.accelerator, plan, output, args.out, world.proxy, measured};
+  fmt::print("{}: {} triangles, {} vertices{}\n", scene.name, scene.triangle_count, scene.vertex_count,
+             scene.cleanup.degenerate_dropped ? fmt::format(", {} degenerate dropped", scene.cleanup.degenerate_dropped)
+                                              : std::string());
+  fmt::print("{}", render_table(facts));
+  fmt::print("wrote {} and {}\n", args.out, preview);
+  if (!args.stats.empty()) {
+    std::ofstream file(args.stats);
+    file << render_stats_json(facts).dump(2) << "\n";
+    if (!file) throw std::runtime_error(fmt::format("{}: could not write stats", args.stats));
+  }
+  return 0;
+}
+
+// A saved world: mapped (or paged from disk under memory.budget) and traced as built.
+int render_world(const RenderArguments& args, RenderPlan plan) {
+  RenderPhases measured;
+  LoadedWorld loaded = load_world(plan.scene.source, world_paging(plan), plan.pipeline.threads);
+  measured.load_seconds = loaded.seconds;
+  measured.after_load_bytes = measured.after_build_bytes = read_resident_memory().current_bytes;
+  plan.accelerator.type = loaded.type;
+  if (plan.needs_proxy() && !loaded.proxy) {
+    throw ConfigError(fmt::format("{} was saved without a proxy, which the chain's approx_hit needs: build it with --proxy",
+                                  plan.scene.source));
+  }
+  const Camera camera = resolve_camera(plan.camera, loaded.scene);
+  const World world{loaded.scene, *loaded.accelerator, *loaded.lights, plan.needs_proxy() ? loaded.proxy.get() : nullptr,
+                    loaded.file->pager()};
+  return finish_render(args, plan, loaded.scene, world, camera, measured);
+}
+
 int run_render(const RenderArguments& args) {
   const Config config = build_config(args);
   const RenderPlan plan = plan_render(config);
+  if (is_world_file(plan.scene.source)) return render_world(args, plan);
+  if (plan.memory.file_backing) {
+    throw ConfigError(fmt::format("memory.backing = file pages a world file; {} is not one (make one with wavetrace build)",
+                                  plan.scene.source));
+  }
 
   RenderPhases measured;
   // An accelerator that holds its own geometry never needs the whole mesh: a builtin scene
@@ -68,31 +120,7 @@ int run_render(const RenderArguments& args) {
   if (holds_own_geometry(plan.accelerator.type)) scene.release_mesh();
   measured.after_build_bytes = read_resident_memory().current_bytes;
   const World world{scene, *accelerator, lights, proxy.get()};
-
-  ProgressLine progress(stderr);
-  const RenderOutput output =
-      render_image(plan, world, camera, progress.enabled() ? [&](const Progress& p) { progress.update(p); }
-                                                          : std::function<void(const Progress&)>());
-  progress.finish();
-  measured.after_render_bytes = read_resident_memory().current_bytes;
-  measured.peak_rss_bytes = read_resident_memory().peak_bytes;
-
-  write_exr(args.out, plan.image.width, plan.image.height, output.image);
-  const std::string preview = preview_path_for(args.out);
-  write_png_preview(preview, plan.image.width, plan.image.height, output.image);
-
-  const RenderFacts facts{scene, *accelerator, plan, output, args.out, proxy.get(), measured};
-  fmt::print("{}: {} triangles, {} vertices{}\n", scene.name, scene.triangle_count, scene.vertex_count,
-             scene.cleanup.degenerate_dropped ? fmt::format(", {} degenerate dropped", scene.cleanup.degenerate_dropped)
-                                              : std::string());
-  fmt::print("{}", render_table(facts));
-  fmt::print("wrote {} and {}\n", args.out, preview);
-  if (!args.stats.empty()) {
-    std::ofstream file(args.stats);
-    file << render_stats_json(facts).dump(2) << "\n";
-    if (!file) throw std::runtime_error(fmt::format("{}: could not write stats", args.stats));
-  }
-  return 0;
+  return finish_render(args, plan, scene, world, camera, measured);
 }
 
 }  // namespace
@@ -101,7 +129,7 @@ void add_render_command(CLI::App& app, int& exit_code) {
   auto args = std::make_shared<RenderArguments>();
   CLI::App* command = app.add_subcommand("render", "path-trace an image through the stage pipeline");
   command->add_option("scene,--scene", args->scene,
-                      "mesh file, scene file (.toml) or builtin:NAME[:TRIANGLES] (default builtin:default)");
+                      "mesh file, scene file (.toml), builtin:NAME[:TRIANGLES] or a saved world (.wtw) (default builtin:default)");
   command->add_option("--accel", args->accel, "accelerator (accel.type)");
   command->add_option("--spp", args->spp, "samples per pixel (render.spp)");
   command->add_option("--size", args->size, "image size as WIDTHxHEIGHT");

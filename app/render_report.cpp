@@ -40,6 +40,13 @@ std::string memory_lines(const std::vector<StageStats>& stages) {
                            double(stage.pager->budget_bytes) / (1 << 20), c.accesses, c.faults,
                            double(c.bytes_loaded) * 1e-6, c.simulated_io_seconds);
     }
+    if (stage.disk) {
+      const DiskCounters& c = stage.disk->counters;
+      lines += fmt::format("{} disk: {} KiB pages, pool {:.1f} MiB: {} real faults, {:.1f} MB read in {:.3f} s "
+                           "(O_DIRECT, in the measured time)\n",
+                           stage.name, stage.disk->page_bytes >> 10, double(stage.disk->budget_bytes) / (1 << 20),
+                           c.faults, double(c.bytes_read) * 1e-6, c.read_seconds);
+    }
     if (stage.cache) {
       const CacheGeometry& g = stage.cache->geometry;
       const CacheCounters& c = stage.cache->counters;
@@ -82,6 +89,13 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
                             {"seconds", stage.seconds},
                             {"mrays_per_s", stage.mrays_per_s()}};
     if (stage.pager) entry["pager"] = pager_json(*stage.pager);
+    if (stage.disk) {
+      entry["disk"] = {{"page_bytes", stage.disk->page_bytes},
+                       {"budget_bytes", stage.disk->budget_bytes},
+                       {"faults", stage.disk->counters.faults},
+                       {"bytes_read", stage.disk->counters.bytes_read},
+                       {"read_seconds", stage.disk->counters.read_seconds}};
+    }
     if (stage.cache) entry["cache"] = cache_json(*stage.cache);
     stages.push_back(entry);
   }

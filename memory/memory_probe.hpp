@@ -6,7 +6,11 @@
 #include <cstddef>
 #include <cstdint>
 
+#include <bit>
+#include <optional>
+
 #include "memory/cache_simulator.hpp"
+#include "memory/file_pager.hpp"
 #include "memory/pager.hpp"
 
 namespace wavetrace {
@@ -21,7 +25,8 @@ struct NullProbe {
 struct MemoryObservers {
   Pager* pager = nullptr;
   CacheBank* caches = nullptr;
-  bool any() const { return pager != nullptr || caches != nullptr; }
+  FilePager* file_pager = nullptr;  // real paging: reads keep its LRU order and load its pages
+  bool any() const { return pager != nullptr || caches != nullptr || file_pager != nullptr; }
 };
 
 // One thread's probe for one batch: lives on the stack of the stage call.
@@ -32,7 +37,13 @@ class RecordingProbe {
   RecordingProbe(const MemoryObservers& observers, std::size_t client, std::size_t thread)
       : pager_(observers.pager),
         cache_(observers.caches ? &observers.caches->for_thread(thread % observers.caches->threads()) : nullptr),
-        client_(client) {}
+        file_pager_(observers.file_pager),
+        client_(client) {
+    if (file_pager_ != nullptr) {
+      file_page_shift_ = static_cast<unsigned>(std::countr_zero(file_pager_->page_bytes()));
+      client_scope_.emplace(client);  // faults this thread takes count to this stage
+    }
+  }
   RecordingProbe(const RecordingProbe&) = delete;
   RecordingProbe& operator=(const RecordingProbe&) = delete;
   ~RecordingProbe() {
@@ -41,6 +52,14 @@ class RecordingProbe {
 
   void read(const void* address, std::size_t bytes) {
     if (cache_ != nullptr) cache_->access(address, bytes, client_);
+    if (file_pager_ != nullptr) {
+      // The page is loaded now, before the read it announces; a page change is a touch.
+      const auto first = reinterpret_cast<std::uintptr_t>(address) >> file_page_shift_;
+      const auto last = (reinterpret_cast<std::uintptr_t>(address) + bytes - 1) >> file_page_shift_;
+      if (first != last_file_page_) file_pager_->touch(address);
+      if (last != first) file_pager_->touch(static_cast<const std::byte*>(address) + bytes - 1);
+      last_file_page_ = last;
+    }
     if (pager_ == nullptr) return;
     const std::uint32_t first = pager_->page_of(address);
     const std::uint32_t last = pager_->page_of(static_cast<const std::byte*>(address) + bytes - 1);
@@ -62,7 +81,11 @@ class RecordingProbe {
 
   Pager* pager_;
   CacheSimulator* cache_;
+  FilePager* file_pager_;
   std::size_t client_;
+  unsigned file_page_shift_ = 0;
+  std::uintptr_t last_file_page_ = ~std::uintptr_t{0};
+  std::optional<FilePager::ClientScope> client_scope_;
   std::uint32_t last_page_ = Pager::kNoPage;
   std::uint64_t repeated_page_reads_ = 0;
 };

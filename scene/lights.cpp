@@ -49,6 +49,11 @@ LightSampler::LightSampler(const Scene& scene) {
   if (!cumulative_.empty()) cumulative_.back() = 1.0f;
 }
 
+LightSampler::LightSampler(std::vector<EmissiveTriangle> triangles, std::vector<float> cumulative)
+    : triangles_(std::move(triangles)), cumulative_(std::move(cumulative)) {
+  if (triangles_.size() != cumulative_.size()) throw std::invalid_argument("light sampler: one cumulative weight per light");
+}
+
 LightSample LightSampler::sample(float u_choice, float u1, float u2) const {
   const std::size_t index = std::min<std::size_t>(
       std::upper_bound(cumulative_.begin(), cumulative_.end(), u_choice) - cumulative_.begin(),

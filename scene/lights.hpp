@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -21,6 +22,20 @@ class LightSampler {
  public:
   explicit LightSampler(const Scene& scene);
 
+  // What sampling needs, precomputed per emissive triangle so a sample is arithmetic only.
+  // A saved world stores these as they are, 64 bytes each: corner, edge1, edge2, normal,
+  // emission (float x, y, z each, offsets 0, 12, 24, 36, 48), pdf_area (float, offset 60).
+  struct EmissiveTriangle {
+    glm::vec3 corner, edge1, edge2;
+    glm::vec3 normal;
+    glm::vec3 emission;
+    float pdf_area;  // choice probability / area
+  };
+  // The sampler a saved world held; throws std::invalid_argument on mismatched lengths.
+  LightSampler(std::vector<EmissiveTriangle> triangles, std::vector<float> cumulative);
+  std::span<const EmissiveTriangle> triangles() const { return triangles_; }
+  std::span<const float> cumulative() const { return cumulative_; }
+
   bool empty() const { return triangles_.empty(); }
   std::size_t count() const { return triangles_.size(); }
 
@@ -28,13 +43,6 @@ class LightSampler {
   LightSample sample(float u_choice, float u1, float u2) const;
 
  private:
-  // Everything sampling needs, precomputed per emissive triangle so a sample is arithmetic only.
-  struct EmissiveTriangle {
-    glm::vec3 corner, edge1, edge2;
-    glm::vec3 normal;
-    glm::vec3 emission;
-    float pdf_area;  // choice probability / area
-  };
   std::vector<EmissiveTriangle> triangles_;
   std::vector<float> cumulative_;  // normalized running sum of power
 };

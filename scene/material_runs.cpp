@@ -26,4 +26,15 @@ void MaterialRuns::append(std::uint64_t first, std::uint32_t material) {
   material_.push_back(material);
 }
 
+MaterialRuns MaterialRuns::from_runs(std::span<const std::uint64_t> firsts, std::span<const std::uint32_t> materials) {
+  if (firsts.size() != materials.size()) throw std::invalid_argument("material runs: as many firsts as materials needed");
+  MaterialRuns runs;
+  for (std::size_t i = 0; i < firsts.size(); ++i) {
+    if (i > 0 && firsts[i] <= firsts[i - 1]) throw std::invalid_argument("material runs: firsts must increase");
+    runs.first_.push_back(firsts[i]);
+    runs.material_.push_back(materials[i]);
+  }
+  return runs;
+}
+
 }  // namespace wavetrace

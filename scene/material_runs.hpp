@@ -14,6 +14,11 @@ class MaterialRuns {
  public:
   // Runs of a per-triangle list; an empty list is one run of material 0.
   static MaterialRuns from_triangles(std::span<const std::uint32_t> material_of_triangle, std::size_t triangles);
+  // Runs as firsts() and materials() list them (a saved world's); throws std::invalid_argument
+  // when the lists differ in length or the firsts decrease.
+  static MaterialRuns from_runs(std::span<const std::uint64_t> firsts, std::span<const std::uint32_t> materials);
+  std::span<const std::uint64_t> firsts() const { return first_; }
+  std::span<const std::uint32_t> materials() const { return material_; }
 
   // Triangles from `first` on (until the next append) use `material`; first must not
   // decrease. Extends the last run when the material is the same.

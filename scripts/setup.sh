@@ -7,7 +7,7 @@ cd "$root"
 
 packages=(build-essential cmake pkg-config libembree-dev libtbb-dev libopenmesh-dev libglm-dev
   libopenexr-dev libimath-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev libgtest-dev
-  libbenchmark-dev libpng-dev libfmt-dev python3-matplotlib libcgal-demo)
+  libbenchmark-dev libpng-dev libfmt-dev libxxhash-dev python3-matplotlib libcgal-demo)
 missing=()
 for package in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" || missing+=("$package")

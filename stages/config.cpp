@@ -244,6 +244,26 @@ void Config::set_value(std::string_view name, ConfigValue value) {
   values_.insert_or_assign(key.name, std::move(value));
 }
 
+std::string Config::assignment(std::string_view name) const {
+  const auto found = values_.find(name);
+  if (found == values_.end()) throw std::logic_error(fmt::format("config key {} has no value", name));
+  struct Text {
+    std::string operator()(bool value) const { return value ? "true" : "false"; }
+    std::string operator()(std::int64_t value) const { return fmt::format("{}", value); }
+    std::string operator()(double value) const { return fmt::format("{:.17g}", value); }
+    std::string operator()(const std::string& value) const { return "'" + value + "'"; }
+    std::string operator()(const glm::vec3& value) const {
+      return fmt::format("[{:.9g}, {:.9g}, {:.9g}]", value.x, value.y, value.z);
+    }
+    std::string operator()(const std::vector<std::string>& items) const {
+      std::string text = "[";
+      for (std::size_t i = 0; i < items.size(); ++i) text += (i ? ", '" : "'") + items[i] + "'";
+      return text + "]";
+    }
+  };
+  return found->first + "=" + std::visit(Text{}, found->second);
+}
+
 bool Config::has(std::string_view key) const { return values_.find(key) != values_.end(); }
 
 const ConfigValue& Config::value(std::string_view name, ConfigType type) const {

@@ -49,6 +49,8 @@ class Config {
   void set_value(std::string_view key, ConfigValue value);
 
   bool has(std::string_view key) const;
+  // The key's value as `set` reads it back ("section.key=value"), exactly (reals to 17 digits).
+  std::string assignment(std::string_view key) const;
   bool boolean(std::string_view key) const;
   std::int64_t integer(std::string_view key) const;
   double real(std::string_view key) const;

@@ -86,6 +86,9 @@ const std::vector<ConfigKey>& config_schema() {
        "simulated page pool: none, a share of the world (20%) or a size (512MiB, 2GB)"},
       {"memory.page_bytes", T::integer, std::int64_t{4} << 20, 4096, std::int64_t{1} << 30, {},
        "page size of the pool in bytes, a power of two (the paper: 4 MiB)"},
+      {"memory.backing", T::text, std::string("memory"), 0, 0, {"memory", "file"},
+       "where a world file's pages live: memory (mapped, the OS pages it) or file (real paging: read on demand "
+       "with O_DIRECT into a pool of memory.budget, evicted LRU)"},
       {"memory.io", T::text, std::string("disk"), 0, 0, {"disk", "nvme"},
        "simulated device per fault: disk (the paper's, 101 MB/s, 8 ms) or nvme (3.5 GB/s, 80 us)"},
       {"memory.cache", T::text, std::string("none"), 0, 0, {"none", "paper_l2", "l1d", "l2", "custom"},

@@ -21,6 +21,10 @@ MemoryPlan plan_memory(const Config& config) {
     throw ConfigError(fmt::format("memory.page_bytes = {} is not a power of two", plan.page_bytes));
   }
   plan.io = io_preset(config.text("memory.io"));
+  plan.file_backing = config.text("memory.backing") == "file";
+  if (plan.file_backing && !plan.budget) {
+    throw ConfigError("memory.backing = file pages a world file under memory.budget: set one (for example 20%)");
+  }
   const std::string cache = config.text("memory.cache");
   if (cache != "none") {
     CacheGeometry geometry = cache == "custom" ? CacheGeometry{"custom", 64, 0, 0} : cache_preset(cache);
@@ -43,12 +47,14 @@ MemoryPlan plan_memory(const Config& config) {
 std::string to_string(ObservedStage stage) { return stage == ObservedStage::trace ? "trace" : "approx_hit"; }
 
 MemoryObservation::MemoryObservation(const MemoryPlan& plan, std::vector<std::span<const std::byte>> world,
-                                     int threads) {
+                                     int threads, FilePager* file_pager)
+    : file_pager_(file_pager) {
+  if (file_pager_ != nullptr) file_pager_->reset();
   if (plan.budget) {
     pager_ = std::make_unique<Pager>(std::move(world), plan.page_bytes, *plan.budget, plan.io, kObservedStageCount);
   }
   if (plan.cache) caches_ = std::make_unique<CacheBank>(*plan.cache, std::size_t(threads), kObservedStageCount);
-  observers_ = {pager_.get(), caches_.get()};
+  observers_ = {pager_.get(), caches_.get(), file_pager_};
 }
 
 void MemoryObservation::report(std::vector<StageStats>& stages) const {
@@ -57,6 +63,7 @@ void MemoryObservation::report(std::vector<StageStats>& stages) const {
       if (stage.name != to_string(ObservedStage(client))) continue;
       if (pager_) stage.pager = PagerStats{pager_->page_bytes(), pager_->budget_bytes(), pager_->counters(client)};
       if (caches_) stage.cache = CacheStats{caches_->geometry(), caches_->total(client)};
+      if (file_pager_) stage.disk = DiskStats{file_pager_->page_bytes(), file_pager_->budget_bytes(), file_pager_->counters(client)};
     }
   }
 }

@@ -19,6 +19,7 @@ namespace wavetrace {
 
 struct MemoryPlan {
   std::optional<MemoryBudget> budget;  // no pager without one
+  bool file_backing = false;           // memory.backing = file: a world file really paged under the budget
   std::size_t page_bytes = std::size_t{4} << 20;
   IoModel io;
   std::optional<CacheGeometry> cache;  // no cache simulation without one
@@ -35,7 +36,10 @@ std::string to_string(ObservedStage stage);
 
 class MemoryObservation {
  public:
-  MemoryObservation(const MemoryPlan& plan, std::vector<std::span<const std::byte>> world, int threads);
+  // `file_pager`: the real pager of a paged world file, emptied here so each render starts
+  // cold, or null.
+  MemoryObservation(const MemoryPlan& plan, std::vector<std::span<const std::byte>> world, int threads,
+                    FilePager* file_pager = nullptr);
   const MemoryObservers& observers() const { return observers_; }
   // Fills the pager and cache objects of the observed stages in `stages`.
   void report(std::vector<StageStats>& stages) const;
@@ -43,6 +47,7 @@ class MemoryObservation {
  private:
   std::unique_ptr<Pager> pager_;
   std::unique_ptr<CacheBank> caches_;
+  FilePager* file_pager_ = nullptr;
   MemoryObservers observers_;
 };
 

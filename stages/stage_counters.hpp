@@ -7,6 +7,7 @@
 #include <string>
 
 #include "memory/cache_simulator.hpp"
+#include "memory/file_pager.hpp"
 #include "memory/pager.hpp"
 
 namespace wavetrace {
@@ -15,6 +16,12 @@ struct PagerStats {
   std::size_t page_bytes = 0;
   std::size_t budget_bytes = 0;
   PagerCounters counters;
+};
+
+struct DiskStats {
+  std::size_t page_bytes = 0;
+  std::size_t budget_bytes = 0;
+  DiskCounters counters;
 };
 
 struct CacheStats {
@@ -33,6 +40,8 @@ struct StageStats {
   // Simulated memory traffic of the stage's accelerator reads, when observed.
   std::optional<PagerStats> pager;
   std::optional<CacheStats> cache;
+  // Real paging of a world file (memory.backing = file), measured.
+  std::optional<DiskStats> disk;
 };
 
 class StageCounters {

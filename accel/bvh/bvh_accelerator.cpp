@@ -12,6 +12,7 @@
 #include "accel/bvh/node_layout.hpp"
 #include "accel/bvh/wide_bvh_accelerator.hpp"
 #include "accel/probed_accelerator.hpp"
+#include "accel/section_archive.hpp"
 #include "kernels/ray_box.hpp"
 #include "memory/cache_aligned_allocator.hpp"
 
@@ -22,20 +23,41 @@ class BvhAccelerator final : public ProbedAccelerator<BvhAccelerator> {
   friend class ProbedAccelerator<BvhAccelerator>;
 
  public:
+  explicit BvhAccelerator(SectionLoader& in) : geometry_(in) {
+    in.expect_kind("bvh", kBvhSavedVersion);
+    in.array("bvh.nodes", nodes_);
+    in.array("bvh.leaf_triangles", leaf_triangles_);
+    archive_common_state(in, triangles_, build_);
+    if (nodes_.empty()) in.fail("bvh.nodes", "is empty: no bvh was saved");
+  }
+
+  void save(SectionWriter& out, const std::string& prefix) const override {
+    out.add_value(prefix + "kind", saved_kind("bvh", kBvhSavedVersion));
+    SectionSaver saver(out, prefix);
+    geometry_.save(saver);
+    saver.array("bvh.nodes", nodes_);
+    saver.array("bvh.leaf_triangles", leaf_triangles_);
+    std::size_t triangles = geometry_.triangle_count();
+    archive_common_state(saver, triangles, build_);
+  }
+
   BvhAccelerator(const TriangleMesh& mesh, const BvhOptions& options)
       : geometry_(mesh, options.triangle_order) {
     const auto start = std::chrono::steady_clock::now();
     const BuildTree tree = build_bvh_tree(geometry_, options);
 
     // Leaf triangles are stored in node order too, so a leaf's slots follow its node's position.
-    leaf_triangles_.resize(geometry_.triangle_count());
+    LargeArray<std::uint32_t> leaf_triangles(geometry_.triangle_count());
+    LargeArray<BvhNode> nodes;
     std::uint32_t slot = 0;
-    flatten_tree(tree, node_order(tree, options.layout), nodes_, [&](const BuildNode& leaf) {
+    flatten_tree(tree, node_order(tree, options.layout), nodes, [&](const BuildNode& leaf) {
       const std::uint32_t first = slot;
-      for (std::uint32_t k = 0; k < leaf.count; ++k) leaf_triangles_[slot++] = tree.primitive_order[leaf.first + k];
+      for (std::uint32_t k = 0; k < leaf.count; ++k) leaf_triangles[slot++] = tree.primitive_order[leaf.first + k];
       return first;
     });
-    adopt_leaf_order(options, geometry_, leaf_triangles_);
+    adopt_leaf_order(options, geometry_, leaf_triangles);
+    nodes_ = StoredArray<BvhNode>(std::move(nodes));
+    leaf_triangles_ = StoredArray<std::uint32_t>(std::move(leaf_triangles));
     build_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     build_.peak_bytes = bvh_build_peak_bytes(tree, geometry_, memory().total());
   }
@@ -77,12 +99,18 @@ class BvhAccelerator final : public ProbedAccelerator<BvhAccelerator> {
   }
 
   IndexedFaceSet geometry_;
-  LargeArray<BvhNode> nodes_;
-  LargeArray<std::uint32_t> leaf_triangles_;
+  StoredArray<BvhNode> nodes_;
+  StoredArray<std::uint32_t> leaf_triangles_;
+  std::size_t triangles_ = 0;  // as loaded; the face set's count is the truth
   BuildReport build_;
 };
 
 }  // namespace
+
+std::unique_ptr<Accelerator> load_bvh_accelerator(SectionLoader& in) {
+  if (in.file()->has(in.prefix() + "bvh8.nodes")) return load_wide_bvh_accelerator(in);
+  return std::make_unique<BvhAccelerator>(in);
+}
 
 std::unique_ptr<Accelerator> make_bvh_accelerator(const TriangleMesh& mesh, const BvhOptions& options) {
   if (options.width == 8) return make_wide_bvh_accelerator(mesh, options);

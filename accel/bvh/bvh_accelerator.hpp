@@ -28,5 +28,8 @@ struct BvhOptions {
 
 // Either width; `mesh` must outlive the accelerator (with input order its buffers are read in place).
 std::unique_ptr<Accelerator> make_bvh_accelerator(const TriangleMesh& mesh, const BvhOptions& options);
+// A bvh or bvh8 saved under the loader's prefix (bvh_build.hpp), traced in place.
+class SectionLoader;
+std::unique_ptr<Accelerator> load_bvh_accelerator(SectionLoader& in);
 
 }  // namespace wavetrace

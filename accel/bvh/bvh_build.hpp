@@ -29,6 +29,12 @@ inline void adopt_leaf_order(const BvhOptions& options, IndexedFaceSet& geometry
   leaf_index = {};
 }
 
+// What a saved bvh or bvh8 keeps besides its arrays: its indexed face set (faces.*,
+// indexed_face_set.hpp), and "common" (section_archive.hpp). Arrays: "bvh.nodes" (BvhNode,
+// bvh_node.hpp) or "bvh8.nodes" (WideBvhNode, wide_bvh_node.hpp), and "bvh.leaf_triangles"
+// (uint32 per leaf slot: a face-set slot; empty in leaf order, where slot = leaf position).
+inline constexpr std::uint32_t kBvhSavedVersion = 1;
+
 // Peak build memory: the larger of the tree build's and the face-set copy's working sets,
 // held while the finished structure (`result_bytes`) already exists.
 inline std::size_t bvh_build_peak_bytes(const BuildTree& tree, const IndexedFaceSet& geometry, std::size_t result_bytes) {

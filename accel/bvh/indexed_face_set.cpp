@@ -9,6 +9,7 @@
 
 #include <glm/common.hpp>
 
+#include "accel/section_archive.hpp"
 #include "kernels/morton.hpp"
 
 namespace wavetrace {
@@ -73,12 +74,33 @@ void IndexedFaceSet::adopt_order(std::span<const std::uint32_t> order) {
   }
   build_scratch_bytes_ = std::max(build_scratch_bytes_, new_vertex.size() * sizeof(std::uint32_t) + geometry_bytes() +
                                                             input_id_.size() * sizeof(std::uint32_t));
-  owned_positions_ = std::move(positions);
-  owned_triangles_ = std::move(triangles);
-  input_id_ = std::move(input_id);
+  owned_positions_ = StoredArray<glm::vec3>(std::move(positions));
+  owned_triangles_ = StoredArray<glm::uvec3>(std::move(triangles));
+  input_id_ = StoredArray<std::uint32_t>(std::move(input_id));
   positions_ = owned_positions_.data();
   triangles_ = owned_triangles_.data();
   vertex_count_ = owned_positions_.size();
+}
+
+void IndexedFaceSet::save(SectionSaver& out) const {
+  SectionWriter& writer = out.writer();
+  // Positions keep the mesh's spare vertex of read slack: the section's padding provides it.
+  writer.add_array(out.prefix() + "faces.positions", std::span(positions_, vertex_count_));
+  writer.add_array(out.prefix() + "faces.triangles", std::span(triangles_, triangle_count_));
+  out.array("faces.input_id", input_id_);
+}
+
+IndexedFaceSet::IndexedFaceSet(SectionLoader& in) {
+  in.array("faces.positions", owned_positions_);
+  in.array("faces.triangles", owned_triangles_);
+  in.array("faces.input_id", input_id_);
+  positions_ = owned_positions_.data();
+  triangles_ = owned_triangles_.data();
+  vertex_count_ = owned_positions_.size();
+  triangle_count_ = owned_triangles_.size();
+  if (!input_id_.empty() && input_id_.size() != triangle_count_) {
+    in.fail("faces.input_id", "does not have one id per triangle");
+  }
 }
 
 LargeArray<Bounds3> IndexedFaceSet::triangle_bounds() const {

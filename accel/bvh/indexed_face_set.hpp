@@ -9,9 +9,13 @@
 #include <vector>
 
 #include "memory/cache_aligned_allocator.hpp"
+#include "memory/stored_array.hpp"
 #include "scene/triangle_mesh.hpp"
 
 namespace wavetrace {
+
+class SectionSaver;
+class SectionLoader;
 
 // input: the mesh's arrays, leaves reach triangles through a 4-byte index per triangle.
 // morton: a copy sorted along a Morton curve, leaves still index it.
@@ -25,6 +29,11 @@ class IndexedFaceSet {
   // `mesh` must outlive this object when order is input or leaf (leaf starts as input
   // until adopt_leaf_order is called).
   IndexedFaceSet(const TriangleMesh& mesh, TriangleOrder order);
+  // Saved as "faces.positions" (float x, y, z per vertex), "faces.triangles" (uint32 x3 per
+  // triangle) and "faces.input_id" (uint32 per triangle, empty in input order), and read
+  // back in place; whatever order it was built in, a loaded face set owns its arrays.
+  void save(SectionSaver& out) const;
+  explicit IndexedFaceSet(SectionLoader& in);
 
   // Re-stores the triangles so that slot i holds what slot order[i] held before (a copy,
   // vertices renumbered by first use); input ids follow.
@@ -49,9 +58,9 @@ class IndexedFaceSet {
   std::vector<std::span<const std::byte>> spans() const;
 
  private:
-  LargeArray<glm::vec3> owned_positions_;
-  LargeArray<glm::uvec3> owned_triangles_;
-  LargeArray<std::uint32_t> input_id_;  // empty for input order
+  StoredArray<glm::vec3> owned_positions_;
+  StoredArray<glm::uvec3> owned_triangles_;
+  StoredArray<std::uint32_t> input_id_;  // empty for input order
   const glm::vec3* positions_ = nullptr;
   const glm::uvec3* triangles_ = nullptr;
   std::size_t vertex_count_ = 0;

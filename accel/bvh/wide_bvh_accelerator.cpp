@@ -13,6 +13,7 @@
 #endif
 
 #include "accel/bvh/bvh_build.hpp"
+#include "accel/section_archive.hpp"
 #include "accel/bvh/indexed_face_set.hpp"
 #include "accel/bvh/wide_bvh_node.hpp"
 #include "kernels/ray_box.hpp"
@@ -86,13 +87,34 @@ struct WideRay {
 
 class WideBvhAccelerator final : public Accelerator {
  public:
+  explicit WideBvhAccelerator(SectionLoader& in) : geometry_(in) {
+    in.expect_kind("bvh", kBvhSavedVersion);
+    in.array("bvh8.nodes", nodes_);
+    in.array("bvh.leaf_triangles", leaf_triangles_);
+    std::size_t triangles = 0;
+    archive_common_state(in, triangles, build_);
+    if (nodes_.empty()) in.fail("bvh8.nodes", "is empty: no bvh8 was saved");
+  }
+
+  void save(SectionWriter& out, const std::string& prefix) const override {
+    out.add_value(prefix + "kind", saved_kind("bvh", kBvhSavedVersion));
+    SectionSaver saver(out, prefix);
+    geometry_.save(saver);
+    saver.array("bvh8.nodes", nodes_);
+    saver.array("bvh.leaf_triangles", leaf_triangles_);
+    std::size_t triangles = geometry_.triangle_count();
+    archive_common_state(saver, triangles, build_);
+  }
+
   WideBvhAccelerator(const TriangleMesh& mesh, const BvhOptions& options) : geometry_(mesh, options.triangle_order) {
     const auto start = std::chrono::steady_clock::now();
     const BuildTree tree = build_bvh_tree(geometry_, options);
-    leaf_triangles_.reserve(geometry_.triangle_count());
-    nodes_.reserve(tree.nodes.size() / 4 + 1);
+    build_leaf_triangles_.reserve(geometry_.triangle_count());
+    build_nodes_.reserve(tree.nodes.size() / 4 + 1);
     collapse(tree, 0);
-    adopt_leaf_order(options, geometry_, leaf_triangles_);
+    adopt_leaf_order(options, geometry_, build_leaf_triangles_);
+    nodes_ = StoredArray<WideBvhNode>(std::move(build_nodes_));
+    leaf_triangles_ = StoredArray<std::uint32_t>(std::move(build_leaf_triangles_));
     build_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     build_.peak_bytes = bvh_build_peak_bytes(tree, geometry_, memory().total());
   }
@@ -151,8 +173,8 @@ class WideBvhAccelerator final : public Accelerator {
         lanes.push_back(opened.right);
       }
     }
-    const auto index = static_cast<std::uint32_t>(nodes_.size());
-    nodes_.emplace_back();
+    const auto index = static_cast<std::uint32_t>(build_nodes_.size());
+    build_nodes_.emplace_back();
     WideBvhNode node{};
     for (int k = 0; k < kWidth; ++k) {
       node.lower_x[k] = node.lower_y[k] = node.lower_z[k] = kInfinity;
@@ -163,15 +185,15 @@ class WideBvhAccelerator final : public Accelerator {
       node.lower_x[k] = child.bounds.lower.x, node.lower_y[k] = child.bounds.lower.y, node.lower_z[k] = child.bounds.lower.z;
       node.upper_x[k] = child.bounds.upper.x, node.upper_y[k] = child.bounds.upper.y, node.upper_z[k] = child.bounds.upper.z;
       if (child.leaf()) {
-        node.child[k] = static_cast<std::uint32_t>(leaf_triangles_.size());
+        node.child[k] = static_cast<std::uint32_t>(build_leaf_triangles_.size());
         node.count[k] = static_cast<std::uint8_t>(child.count);
-        for (std::uint32_t i = 0; i < child.count; ++i) leaf_triangles_.push_back(tree.primitive_order[child.first + i]);
+        for (std::uint32_t i = 0; i < child.count; ++i) build_leaf_triangles_.push_back(tree.primitive_order[child.first + i]);
       } else {
         node.child[k] = collapse(tree, lanes[k]);
         node.count[k] = 0;
       }
     }
-    nodes_[index] = node;
+    build_nodes_[index] = node;
     return index;
   }
 
@@ -241,12 +263,18 @@ class WideBvhAccelerator final : public Accelerator {
   }
 
   IndexedFaceSet geometry_;
-  LargeArray<WideBvhNode> nodes_;
-  LargeArray<std::uint32_t> leaf_triangles_;
+  StoredArray<WideBvhNode> nodes_;
+  StoredArray<std::uint32_t> leaf_triangles_;
+  LargeArray<WideBvhNode> build_nodes_;              // while collapsing; empty once built
+  LargeArray<std::uint32_t> build_leaf_triangles_;
   BuildReport build_;
 };
 
 }  // namespace
+
+std::unique_ptr<Accelerator> load_wide_bvh_accelerator(SectionLoader& in) {
+  return std::make_unique<WideBvhAccelerator>(in);
+}
 
 std::unique_ptr<Accelerator> make_wide_bvh_accelerator(const TriangleMesh& mesh, const BvhOptions& options) {
   return std::make_unique<WideBvhAccelerator>(mesh, options);

@@ -8,5 +8,8 @@
 namespace wavetrace {
 
 std::unique_ptr<Accelerator> make_wide_bvh_accelerator(const TriangleMesh& mesh, const BvhOptions& options);
+// A bvh or bvh8 saved under the loader's prefix (bvh_build.hpp), traced in place.
+class SectionLoader;
+std::unique_ptr<Accelerator> load_wide_bvh_accelerator(SectionLoader& in);
 
 }  // namespace wavetrace

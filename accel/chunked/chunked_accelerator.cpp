@@ -18,6 +18,7 @@
 #include "accel/bvh/bvh_walk.hpp"
 #include "accel/bvh/node_layout.hpp"
 #include "accel/bvh/sah_builder.hpp"
+#include "accel/section_archive.hpp"
 #include "kernels/ray_box.hpp"
 #include "memory/process_memory.hpp"
 
@@ -67,8 +68,57 @@ std::size_t chunks_built_at_once(std::size_t chunk_triangles) {
   return std::clamp<std::size_t>(affordable, 1, threads);
 }
 
+// A saved chunked world, under `PREFIX`: "kind" ("chunked", version 1), "common"
+// (section_archive.hpp), "chunked.top" (BvhNode, bvh_node.hpp; a leaf's first is a chunk's
+// index, its count 0x80000001), "chunked.chunks" (40 bytes a chunk:
+//   offset  size  field
+//        0     8  first: the source's id of the chunk's triangle 0, uint64
+//        8     8  count of triangles, uint64
+//       16    24  box: float lower x, y, z, upper x, y, z)
+// and each chunk's own accelerator under PREFIX + "chunk.N/" (N from 0, in decimal).
+struct SavedChunk {
+  std::uint64_t first, count;
+  Bounds3 bounds;
+};
+static_assert(sizeof(SavedChunk) == 40);
+constexpr std::uint32_t kChunkedSavedVersion = 1;
+
 class ChunkedAccelerator final : public Accelerator {
  public:
+  ChunkedAccelerator(SectionLoader& in, const ChunkLoader& load_chunk) {
+    in.expect_kind("chunked", kChunkedSavedVersion);
+    StoredArray<SavedChunk> saved;
+    in.array("chunked.chunks", saved);
+    in.array("chunked.top", top_);
+    std::size_t triangles = 0;
+    archive_common_state(in, triangles, build_);
+    if (saved.empty() || top_.empty()) in.fail("chunked.chunks", "is empty: no chunk was saved");
+    for (const BvhNode& node : top_) {
+      if (node.leaf() ? node.first >= saved.size() : (node.left() >= top_.size() || node.right() >= top_.size())) {
+        in.fail("chunked.top", "names a node or chunk that does not exist");
+      }
+    }
+    chunks_.resize(saved.size());
+    for (std::size_t c = 0; c < saved.size(); ++c) {
+      SectionLoader chunk_in(in.file(), in.prefix() + fmt::format("chunk.{}/", c));
+      chunks_[c] = Chunk{saved[c].first, saved[c].count, saved[c].bounds, nullptr, load_chunk(chunk_in)};
+    }
+  }
+
+  void save(SectionWriter& out, const std::string& prefix) const override {
+    out.add_value(prefix + "kind", saved_kind("chunked", kChunkedSavedVersion));
+    LargeArray<SavedChunk> saved;
+    for (const Chunk& chunk : chunks_) saved.push_back({chunk.first, chunk.count, chunk.bounds});
+    SectionSaver saver(out, prefix);
+    saver.array("chunked.chunks", StoredArray<SavedChunk>(std::move(saved)));
+    saver.array("chunked.top", top_);
+    std::size_t triangles = this->triangles();
+    archive_common_state(saver, triangles, build_);
+    for (std::size_t c = 0; c < chunks_.size(); ++c) {
+      chunks_[c].accelerator->save(out, prefix + fmt::format("chunk.{}/", c));
+    }
+  }
+
   ChunkedAccelerator(const TriangleSource& source, std::size_t chunk_triangles, const ChunkBuilder& build_chunk,
                      bool keeps_mesh) {
     if (chunk_triangles < kMinChunkTriangles || chunk_triangles > kMaxChunkTriangles) {
@@ -191,7 +241,7 @@ class ChunkedAccelerator final : public Accelerator {
   }
 
   std::vector<std::span<const std::byte>> memory_spans() const override {
-    std::vector<std::span<const std::byte>> spans = {std::as_bytes(std::span(top_))};
+    std::vector<std::span<const std::byte>> spans = {top_.bytes()};
     for (const Chunk& chunk : chunks_) {
       for (const auto& span : chunk.accelerator->memory_spans()) spans.push_back(span);
     }
@@ -211,8 +261,10 @@ class ChunkedAccelerator final : public Accelerator {
     SahOptions sah;
     sah.max_leaf_size = 1;
     const BuildTree tree = build_sah_tree(boxes, sah);
-    flatten_tree(tree, node_order(tree, NodeLayout::depth_first), top_,
+    LargeArray<BvhNode> top;
+    flatten_tree(tree, node_order(tree, NodeLayout::depth_first), top,
                  [&](const BuildNode& leaf) { return tree.primitive_order[leaf.first]; });
+    top_ = StoredArray<BvhNode>(std::move(top));
   }
 
   // The chunks ray i enters within [tmin, tmax], nearest first, appended to `visits`.
@@ -317,7 +369,7 @@ class ChunkedAccelerator final : public Accelerator {
   }
 
   std::vector<Chunk> chunks_;
-  LargeArray<BvhNode> top_;
+  StoredArray<BvhNode> top_;
   BuildReport build_;
 };
 
@@ -337,6 +389,10 @@ std::vector<ChunkRange> plan_chunks(std::span<const std::size_t> object_starts, 
     }
   }
   return chunks;
+}
+
+std::unique_ptr<Accelerator> load_chunked_accelerator(SectionLoader& in, const ChunkLoader& load_chunk) {
+  return std::make_unique<ChunkedAccelerator>(in, load_chunk);
 }
 
 std::unique_ptr<Accelerator> make_chunked_accelerator(const TriangleSource& source, std::size_t chunk_triangles,

@@ -43,4 +43,10 @@ using ChunkBuilder = std::function<std::unique_ptr<Accelerator>(const TriangleMe
 std::unique_ptr<Accelerator> make_chunked_accelerator(const TriangleSource& source, std::size_t chunk_triangles,
                                                       const ChunkBuilder& build_chunk, bool keeps_mesh);
 
+// A chunked world saved under the loader's prefix (format in chunked_accelerator.cpp), each
+// chunk's accelerator loaded by `load_chunk` from its own prefix.
+class SectionLoader;
+using ChunkLoader = std::function<std::unique_ptr<Accelerator>(SectionLoader&)>;
+std::unique_ptr<Accelerator> load_chunked_accelerator(SectionLoader& in, const ChunkLoader& load_chunk);
+
 }  // namespace wavetrace

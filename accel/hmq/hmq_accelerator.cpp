@@ -21,6 +21,7 @@
 #include "accel/hmq/hmq_format.hpp"
 #include "accel/hmq/leaf_codec.hpp"
 #include "accel/probed_accelerator.hpp"
+#include "accel/section_archive.hpp"
 #include "kernels/checked_narrowing.hpp"
 #include "kernels/ray_box.hpp"
 #include "kernels/triangle_intersect.hpp"
@@ -190,11 +191,63 @@ struct HmqHit {
   bool found = false;
 };
 
+// What an hmq world saves besides its arrays, `PREFIX` + "hmq.state" (88 bytes):
+//   offset  size  field
+//        0    12  grid origin, float x, y, z
+//       12    12  grid cell size, float x, y, z
+//       24    12  1 / cell size, float x, y, z (as the build computed it: decoding re-snaps with it)
+//       36    12  grid bits, uint32 x, y, z
+//       48     8  max vertex error, double
+//       56     8  hierarchy bytes of the blocks (node slots, forward slots, leaf offsets, padding)
+//       64     8  geometry bytes of the leaf records (vertices and connectivity)
+//       72     8  other bytes of the leaf records (triangle ids and corners)
+//       80     4  BVH nodes, uint32
+//       84     4  BVH leaves, uint32
+// and the triangle count and build report in the common sections (save_common_state).
+// Arrays: "hmq.top" (BvhNode, bvh_node.hpp; a leaf's first is a block's word offset, its
+// count 1 or 2 roots) and "hmq.blocks" (bytes, hmq_format.hpp, 8 bytes of read slack at the end).
+struct HmqSavedState {
+  GlobalGrid grid;
+  std::uint64_t hierarchy_bytes, geometry_bytes, other_bytes;
+  std::uint32_t nodes, leaves;
+};
+static_assert(sizeof(GlobalGrid) == 56 && sizeof(HmqSavedState) == 88);
+constexpr std::uint32_t kHmqSavedVersion = 1;
+
 class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
   friend class ProbedAccelerator<HmqAccelerator>;
 
  public:
-  HmqAccelerator(const TriangleMesh& mesh, const HmqOptions& options) : options_(options) {
+  explicit HmqAccelerator(const SectionLoader& loader) {
+    loader.expect_kind("hmq", kHmqSavedVersion);
+    SectionLoader in = loader;
+    archive(*this, in);
+  }
+
+  template <typename Archive>
+  static void archive(auto& self, Archive& a) {
+    HmqSavedState state{self.grid_, self.parts_.hierarchy, self.parts_.geometry, self.parts_.other,
+                        static_cast<std::uint32_t>(self.nodes_), static_cast<std::uint32_t>(self.leaves_)};
+    a.value("hmq.state", state);
+    a.array("hmq.top", self.top_);
+    a.array("hmq.blocks", self.blocks_);
+    archive_common_state(a, self.triangles_, self.build_);
+    if constexpr (Archive::kLoading) {
+      self.grid_ = state.grid;
+      self.parts_ = {state.hierarchy_bytes, state.geometry_bytes, state.other_bytes};
+      self.nodes_ = state.nodes;
+      self.leaves_ = state.leaves;
+      if (self.top_.empty() || self.blocks_.size() < 8) a.fail("hmq.top", "is empty: no hmq structure was saved");
+    }
+  }
+
+  void save(SectionWriter& out, const std::string& prefix) const override {
+    out.add_value(prefix + "kind", saved_kind("hmq", kHmqSavedVersion));
+    SectionSaver saver(out, prefix);
+    archive(*this, saver);
+  }
+
+  HmqAccelerator(const TriangleMesh& mesh, const HmqOptions& options) {
     check_options(options);
     if (mesh.triangle_count() == 0) throw std::invalid_argument("hmq: the mesh has no triangles");
     const auto start = Clock::now();
@@ -268,12 +321,10 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
       top[slot].first = block;
       top[slot].count = BvhNode::kLeafFlag | static_cast<std::uint32_t>(roots.size());
     }
-    top_.resize(top.size());
-    std::copy(top.begin(), top.end(), top_.data());
+    top_ = StoredArray<BvhNode>(LargeArray<BvhNode>(top.begin(), top.end()));
     blocks.resize(blocks.size() + 8, std::byte{0});  // read slack for unaligned 8-byte stream loads
     parts.hierarchy += 8;
-    blocks_.resize(blocks.size());
-    std::memcpy(blocks_.data(), blocks.data(), blocks.size());
+    blocks_ = StoredArray<std::byte>(LargeArray<std::byte>(blocks.begin(), blocks.end()));
     parts_ = parts;
     leaves_ = 0;
     for (const BuildNode& node : tree.nodes) leaves_ += node.leaf();
@@ -305,7 +356,7 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
   }
 
   std::vector<std::span<const std::byte>> memory_spans() const override {
-    return {std::as_bytes(std::span(top_)), std::span<const std::byte>(blocks_.data(), blocks_.size())};
+    return {top_.bytes(), blocks_.bytes()};
   }
 
   std::optional<TriangleMesh> represented_mesh(const TriangleMesh& source) const override {
@@ -456,10 +507,9 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
     if constexpr (kSurface) set_surface_from_strip(hits, i, best.corner, code[best.triangle]);
   }
 
-  HmqOptions options_;
   GlobalGrid grid_;
-  LargeArray<BvhNode> top_;
-  LargeArray<std::byte> blocks_;
+  StoredArray<BvhNode> top_;
+  StoredArray<std::byte> blocks_;
   PartBytes parts_;
   std::size_t nodes_ = 0, leaves_ = 0, triangles_ = 0;
   BuildReport build_;
@@ -469,6 +519,10 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
 
 std::unique_ptr<Accelerator> make_hmq_accelerator(const TriangleMesh& mesh, const HmqOptions& options) {
   return std::make_unique<HmqAccelerator>(mesh, options);
+}
+
+std::unique_ptr<Accelerator> load_hmq_accelerator(const SectionLoader& loader) {
+  return std::make_unique<HmqAccelerator>(loader);
 }
 
 }  // namespace wavetrace

@@ -31,5 +31,8 @@ struct HmqOptions {
 
 // Throws std::invalid_argument for options outside their ranges or set together.
 std::unique_ptr<Accelerator> make_hmq_accelerator(const TriangleMesh& mesh, const HmqOptions& options);
+// The hmq structure saved under the loader's prefix, traced in place (format in hmq_accelerator.cpp).
+class SectionLoader;
+std::unique_ptr<Accelerator> load_hmq_accelerator(const SectionLoader& loader);
 
 }  // namespace wavetrace

@@ -141,4 +141,13 @@ Proxy::Proxy(const TriangleMesh& mesh, const ProxyOptions& options, const Accele
   }
 }
 
+Proxy::Proxy(TriangleMesh simplified, const Bounds3& scene_bounds, float surface_tolerance, const ProxyReport& report,
+             const AcceleratorOptions& accelerator)
+    : mesh_(std::move(simplified)), scene_bounds_(scene_bounds), report_(report), surface_tolerance_(surface_tolerance) {
+  if (mesh_.triangles.empty()) throw SceneError("the saved proxy has no triangles");
+  const auto build_start = std::chrono::steady_clock::now();
+  accelerator_ = make_accelerator(mesh_, accelerator);
+  report_.build_seconds = seconds_since(build_start);
+}
+
 }  // namespace wavetrace

@@ -50,6 +50,10 @@ class Proxy {
   // `scene_accelerator` answers for the full mesh; it judges quality. Throws SceneError
   // when the share is outside (0, 1].
   Proxy(const TriangleMesh& mesh, const ProxyOptions& options, const Accelerator& scene_accelerator);
+  // A proxy simplified before (a saved world's): its accelerator is rebuilt from `simplified`,
+  // everything else is as it was.
+  Proxy(TriangleMesh simplified, const Bounds3& scene_bounds, float surface_tolerance, const ProxyReport& report,
+        const AcceleratorOptions& accelerator);
 
   const Accelerator& accelerator() const { return *accelerator_; }
   const Bounds3& scene_bounds() const { return scene_bounds_; }

@@ -18,6 +18,7 @@
 #include "accel/bvh/node_layout.hpp"
 #include "accel/bvh/sah_builder.hpp"
 #include "accel/probed_accelerator.hpp"
+#include "accel/section_archive.hpp"
 #include "accel/raystrips/strip_encode.hpp"
 #include "accel/raystrips/strip_packet.hpp"
 #include "accel/raystrips/strip_traversal.hpp"
@@ -89,13 +90,76 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> cut_submeshes(const BuildTr
   return submeshes;
 }
 
+// What a raystrips world saves besides its arrays, `PREFIX` + "raystrips.state" (144 bytes):
+//   offset  size  field
+//        0     4  run_triangles, uint32 (traversal's span size)
+//        4     4  packet_min_active, uint32
+//        8     4  packets, uint32 (0 or 1)
+//       12     4  stripifier, uint32 (0: ours, 1: openmesh; build notes only)
+//       16     4  submesh_triangles, uint32 (build notes only)
+//       20     4  strips_per_leaf, uint32 (build notes only)
+//       24   120  the build's statistics, 15 fields of 8 bytes in RayStripStats' order: strips
+//                 (uint64), 10 doubles (mean triangles .. encode seconds), 4 byte counts (uint64)
+// and the triangle count and build report in "common" (section_archive.hpp). Arrays:
+// "raystrips.nodes" (BvhNode, bvh_node.hpp; a leaf's first is a word offset into the strips),
+// "raystrips.strips" (bytes, ray_strip_format.hpp), "raystrips.positions" (float x, y, z).
+struct RayStripsSavedOptions {
+  std::uint32_t run_triangles, packet_min_active, packets, stripifier, submesh_triangles, strips_per_leaf;
+};
+constexpr std::uint32_t kRayStripsSavedVersion = 1;
+
 class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator> {
   friend class ProbedAccelerator<RayStripsAccelerator>;
 
  public:
+  explicit RayStripsAccelerator(const SectionLoader& loader) {
+    loader.expect_kind("raystrips", kRayStripsSavedVersion);
+    SectionLoader in = loader;
+    archive(*this, in);
+  }
+
+  template <typename Archive>
+  static void archive(auto& self, Archive& a) {
+    struct State {
+      RayStripsSavedOptions options;
+      RayStripStats stats;
+    };
+    static_assert(sizeof(State) == 144);
+    State state{{self.options_.run_triangles, self.options_.packet_min_active, self.options_.packets ? 1u : 0u,
+                 static_cast<std::uint32_t>(self.options_.stripifier), self.options_.submesh_triangles,
+                 self.options_.strips_per_leaf},
+                self.stats_};
+    a.value("raystrips.state", state);
+    a.array("raystrips.nodes", self.nodes_);
+    a.array("raystrips.strips", self.strip_bytes_);
+    a.array("raystrips.positions", self.positions_);
+    archive_common_state(a, self.triangles_, self.build_);
+    if constexpr (Archive::kLoading) {
+      self.options_.run_triangles = state.options.run_triangles;
+      self.options_.packet_min_active = state.options.packet_min_active;
+      self.options_.packets = state.options.packets != 0;
+      self.options_.stripifier = static_cast<StripifierKind>(state.options.stripifier);
+      self.options_.submesh_triangles = state.options.submesh_triangles;
+      self.options_.strips_per_leaf = state.options.strips_per_leaf;
+      self.stats_ = state.stats;
+      if (self.nodes_.empty()) a.fail("raystrips.nodes", "is empty: no raystrips structure was saved");
+      if (state.options.run_triangles < 2 || state.options.run_triangles > 64 || state.options.packet_min_active < 1 ||
+          state.options.packet_min_active > kPacketRays) {
+        a.fail("raystrips.state", "holds traversal settings out of range");
+      }
+    }
+  }
+
+  void save(SectionWriter& out, const std::string& prefix) const override {
+    out.add_value(prefix + "kind", saved_kind("raystrips", kRayStripsSavedVersion));
+    SectionSaver saver(out, prefix);
+    archive(*this, saver);
+  }
+
   RayStripsAccelerator(const TriangleMesh& mesh, const RayStripsOptions& options) : options_(options) {
     check_options(options);
     if (mesh.triangle_count() == 0) throw std::invalid_argument("raystrips: the mesh has no triangles");
+    triangles_ = mesh.triangle_count();
     const auto start = Clock::now();
 
     // 1. SAH cut into sub-meshes.
@@ -159,9 +223,9 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
         }
       }
     }
-    positions_.resize(next_vertex);
+    LargeArray<glm::vec3> positions(next_vertex);
     for (std::uint32_t v = 0; v < mesh.vertex_count(); ++v) {
-      if (vertex_id[v] != kNoTriangle) positions_[vertex_id[v]] = mesh.positions[v];
+      if (vertex_id[v] != kNoTriangle) positions[vertex_id[v]] = mesh.positions[v];
     }
 
     std::vector<StripEncoding> encodings(strips.size());
@@ -174,19 +238,23 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
     if (offset.back() / 4 >= BvhNode::kLeafFlag) {
       throw std::length_error("raystrips: the strips need more than 8 GiB, beyond the top BVH's 31-bit word offsets");
     }
-    strip_bytes_.resize(offset.back());
+    LargeArray<std::byte> strip_bytes(offset.back());
     tbb::parallel_for(std::size_t{0}, strip_order.size(), [&](std::size_t i) {
-      encode_strip(strips[strip_order[i]], encodings[i], vertex_id, positions_, mesh, strip_bytes_.data() + offset[i]);
+      encode_strip(strips[strip_order[i]], encodings[i], vertex_id, positions, mesh, strip_bytes.data() + offset[i]);
     });
 
     // Flatten the top BVH: a leaf's `first` is the word offset of its first strip.
     std::size_t next_strip = 0;
-    flatten_tree(top, node_order_list, nodes_, [&](const BuildNode& leaf) {
+    LargeArray<BvhNode> nodes;
+    flatten_tree(top, node_order_list, nodes, [&](const BuildNode& leaf) {
       const std::uint32_t first = checked_uint32(
           offset[next_strip] / 4, "raystrips strip offset in 4-byte words; build in smaller chunks (build.chunk_triangles)");
       next_strip += leaf.count;
       return first;
     });
+    nodes_ = StoredArray<BvhNode>(std::move(nodes));
+    strip_bytes_ = StoredArray<std::byte>(std::move(strip_bytes));
+    positions_ = StoredArray<glm::vec3>(std::move(positions));
     stats_.encode_seconds = seconds_since(encode_start);
     collect_stats(strips, encodings, strip_order);
     build_.seconds = seconds_since(start);
@@ -227,8 +295,7 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
   }
 
   std::vector<std::span<const std::byte>> memory_spans() const override {
-    return {std::as_bytes(std::span(nodes_)), std::span<const std::byte>(strip_bytes_.data(), strip_bytes_.size()),
-            std::as_bytes(std::span(positions_))};
+    return {nodes_.bytes(), strip_bytes_.bytes(), positions_.bytes()};
   }
 
  private:
@@ -319,10 +386,11 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
   }
 
   RayStripsOptions options_;
-  LargeArray<BvhNode> nodes_;
-  LargeArray<std::byte> strip_bytes_;
-  LargeArray<glm::vec3> positions_;
+  StoredArray<BvhNode> nodes_;
+  StoredArray<std::byte> strip_bytes_;
+  StoredArray<glm::vec3> positions_;
   RayStripStats stats_;
+  std::size_t triangles_ = 0;
   BuildReport build_;
 };
 
@@ -330,6 +398,10 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
 
 std::unique_ptr<Accelerator> make_raystrips_accelerator(const TriangleMesh& mesh, const RayStripsOptions& options) {
   return std::make_unique<RayStripsAccelerator>(mesh, options);
+}
+
+std::unique_ptr<Accelerator> load_raystrips_accelerator(const SectionLoader& loader) {
+  return std::make_unique<RayStripsAccelerator>(loader);
 }
 
 }  // namespace wavetrace

@@ -39,4 +39,9 @@ struct RayStripsOptions {
 // the accelerator only while it builds; the strips keep their own vertex copy.
 std::unique_ptr<Accelerator> make_raystrips_accelerator(const TriangleMesh& mesh, const RayStripsOptions& options);
 
+// The raystrips structure saved under the loader's prefix, traced in place (format in
+// raystrips_accelerator.cpp).
+class SectionLoader;
+std::unique_ptr<Accelerator> load_raystrips_accelerator(const SectionLoader& loader);
+
 }  // namespace wavetrace

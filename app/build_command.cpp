@@ -1,0 +1,120 @@
+// `wavetrace build`: a scene built once into a world file (.wtw) that render, info and the
+// benchmarks map and trace without rebuilding.
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "accel/registry.hpp"
+#include "app/commands.hpp"
+#include "memory/process_memory.hpp"
+#include "scene/lights.hpp"
+#include "stages/render_setup.hpp"
+#include "stages/world_file.hpp"
+
+namespace wavetrace {
+namespace {
+
+struct BuildArguments {
+  std::string scene;
+  std::string accel;
+  int threads = -1;
+  std::string config_file;
+  std::vector<std::string> assignments;
+  bool proxy = false;
+  std::string out;
+  std::string stats;
+};
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+int run_build(const BuildArguments& args) {
+  Config config;
+  if (!args.config_file.empty()) config.load_file(args.config_file);
+  if (!args.scene.empty()) config.set_value("scene.source", args.scene);
+  if (!args.accel.empty()) config.set_value("accel.type", args.accel);
+  if (args.threads >= 0) config.set_value("render.threads", std::int64_t{args.threads});
+  for (const std::string& assignment : args.assignments) config.set(assignment);
+  if (!is_world_file(args.out)) throw ConfigError(fmt::format("--out {}: a world file is named *.wtw", args.out));
+  RenderPlan plan = plan_render(config);
+  if (is_world_file(plan.scene.source)) throw ConfigError(fmt::format("{} is already a world", plan.scene.source));
+  const std::string& type = plan.accelerator.type;
+  const bool with_proxy = args.proxy || plan.needs_proxy();
+
+  // As render does: an accelerator holding its own geometry is built from a streamed scene
+  // (never whole) unless the proxy, simplified from the whole mesh, is wanted.
+  plan.scene.streamed = holds_own_geometry(type) && !with_proxy;
+  check_scene_fits(plan);
+  const auto load_start = std::chrono::steady_clock::now();
+  Scene scene = load_scene(plan.scene);
+  WorldBuildInfo info;
+  info.scene_seconds = seconds_since(load_start);
+  const auto build_start = std::chrono::steady_clock::now();
+  const std::unique_ptr<Accelerator> accelerator = build_world_accelerator(scene, plan.accelerator);
+  const LightSampler lights(scene);
+  std::unique_ptr<Proxy> proxy;
+  if (with_proxy) proxy = std::make_unique<Proxy>(scene.mesh, plan.proxy, *accelerator);
+  // A type traced in place no longer needs the mesh (bvh's face sets have their own copy
+  // or keep the mesh they point into; rebuilt types save it).
+  if (holds_own_geometry(type)) scene.release_mesh();
+  info.build_seconds = seconds_since(build_start);
+
+  const auto save_start = std::chrono::steady_clock::now();
+  info.peak_rss_bytes = read_resident_memory().peak_bytes;
+  save_world(args.out, scene, lights, *accelerator, type, proxy.get(), config, info);
+  const double save_seconds = seconds_since(save_start);
+  const std::uintmax_t file_bytes = std::filesystem::file_size(args.out);
+  const std::size_t peak = read_resident_memory().peak_bytes;
+
+  const double triangles = double(std::max<std::size_t>(scene.triangle_count, 1));
+  fmt::print("{}: {} triangles; {} ({})\n", scene.name, scene.triangle_count, type,
+             saves_structure(type) ? "saved in place" : "rebuilt from the saved geometry when loaded");
+  fmt::print("scene {:.2f} s, build {:.2f} s, save {:.2f} s; peak resident {:.2f} GB\n", info.scene_seconds,
+             info.build_seconds, save_seconds, double(peak) * 1e-9);
+  fmt::print("wrote {}: {:.3f} GB, {:.2f} bytes/triangle (in memory: {:.2f}){}\n", args.out, double(file_bytes) * 1e-9,
+             double(file_bytes) / triangles, double(accelerator->memory().total()) / triangles,
+             proxy ? fmt::format("; proxy of {} triangles", proxy->report().triangles) : std::string());
+  if (!args.stats.empty()) {
+    const nlohmann::json stats = {{"scene", {{"source", plan.scene.source}, {"name", scene.name},
+                                             {"triangles", scene.triangle_count}}},
+                                  {"accel", type},
+                                  {"scene_seconds", info.scene_seconds},
+                                  {"build_seconds", info.build_seconds},
+                                  {"save_seconds", save_seconds},
+                                  {"peak_rss_bytes", peak},
+                                  {"file_bytes", file_bytes},
+                                  {"file_bytes_per_triangle", double(file_bytes) / triangles},
+                                  {"memory_bytes", accelerator->memory().total()},
+                                  {"proxy_triangles", proxy ? proxy->report().triangles : 0}};
+    std::ofstream file(args.stats);
+    file << stats.dump(2) << "\n";
+    if (!file) throw std::runtime_error(fmt::format("{}: could not write stats", args.stats));
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_build_command(CLI::App& app, int& exit_code) {
+  auto args = std::make_shared<BuildArguments>();
+  CLI::App* command = app.add_subcommand("build", "build a scene's world once and save it to a world file (.wtw)");
+  command->add_option("scene,--scene", args->scene, "mesh file, scene file (.toml) or builtin:NAME[:TRIANGLES]");
+  command->add_option("--accel", args->accel, "accelerator (accel.type)");
+  command->add_option("--threads", args->threads, "worker threads, 0 = all cores (render.threads)");
+  command->add_option("--config", args->config_file, "TOML config file");
+  command->add_option("--set", args->assignments, "override a config key: section.key=value")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  command->add_flag("--proxy", args->proxy,
+                    "also simplify and save the proxy that hit-point reordering needs (always when reorder.heuristic needs it)");
+  command->add_option("--out", args->out, "the world file to write (*.wtw)")->required();
+  command->add_option("--stats", args->stats, "write the build's figures as JSON");
+  command->callback([args, &exit_code] { exit_code = run_build(*args); });
+}
+
+}  // namespace wavetrace
