@@ -1,0 +1,319 @@
+// Saved worlds: the section container's checks, images from a world file bit-identical to a
+// fresh build for every accelerator (Embree and the grids rebuilt from saved geometry), real
+// paging that changes no pixel, and damaged files refused with the file and problem named.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include <xxhash.h>
+
+#include "accel/registry.hpp"
+#include "accel/section_archive.hpp"
+#include "memory/section_file.hpp"
+#include "memory/section_writer.hpp"
+#include "scene/builtin_scenes.hpp"
+#include "scene/lights.hpp"
+#include "stages/render_setup.hpp"
+#include "stages/world_file.hpp"
+#include "test_support.hpp"
+
+namespace wavetrace {
+namespace {
+
+namespace fs = std::filesystem;
+using section_file::Header;
+using section_file::TableEntry;
+
+std::string temp_path(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / "wavetrace_tests";
+  fs::create_directories(dir);
+  return (dir / (std::to_string(::getpid()) + "_" + name)).string();
+}
+
+std::string read_all(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+void write_all(const std::string& path, const std::string& bytes) { std::ofstream(path, std::ios::binary) << bytes; }
+
+// Replaces a section's bytes in place (same size) and recomputes every checksum, so that a
+// test reaches the check behind them (a wrong version, an offset out of bounds).
+struct Resealer {
+  std::string bytes;
+  Header header{};
+  std::vector<TableEntry> table;
+  explicit Resealer(const std::string& path) : bytes(read_all(path)) {
+    std::memcpy(&header, bytes.data(), sizeof(header));
+    table.resize(header.section_count);
+    std::memcpy(table.data(), bytes.data() + header.table_offset, table.size() * sizeof(TableEntry));
+  }
+  TableEntry& entry(const std::string& name) {
+    for (TableEntry& e : table) {
+      if (name == e.name) return e;
+    }
+    throw std::logic_error("no section " + name);
+  }
+  char* data(const std::string& name) { return bytes.data() + entry(name).offset; }
+  void seal(const std::string& path) {
+    for (TableEntry& e : table) {
+      if (e.offset + e.size <= bytes.size()) e.checksum = XXH3_64bits(bytes.data() + e.offset, e.size);
+    }
+    std::memcpy(bytes.data() + header.table_offset, table.data(), table.size() * sizeof(TableEntry));
+    header.table_checksum = XXH3_64bits(table.data(), table.size() * sizeof(TableEntry));
+    header.header_checksum = XXH3_64bits(&header, section_file::kHeaderChecksummedBytes);
+    std::memcpy(bytes.data(), &header, sizeof(header));
+    write_all(path, bytes);
+  }
+};
+
+std::string open_error(const std::string& path) {
+  try {
+    load_world(path);
+  } catch (const SectionFileError& error) {
+    return error.what();
+  }
+  return "(no error)";
+}
+
+TEST(SectionFile, ArraysComeBackInPlaceAndChecked) {
+  const std::string path = temp_path("sections.bin");
+  const std::vector<std::uint32_t> numbers = {1, 2, 3, 5, 8, 13};
+  const std::vector<double> reals = {0.5, -2.25};
+  {
+    SectionWriter out(path);
+    out.add_array("b/numbers", std::span<const std::uint32_t>(numbers));
+    out.add_array("a/reals", std::span<const double>(reals));
+    out.add_value("c/one", std::uint64_t{42});
+    out.finish();
+  }
+  EXPECT_EQ(fs::file_size(path) % 4096, 0u);
+  const auto file = SectionFile::open(path);
+  const std::span<const std::uint32_t> back = file->array<std::uint32_t>("b/numbers");
+  EXPECT_EQ(std::vector<std::uint32_t>(back.begin(), back.end()), numbers);
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(back.data()) % 4096, 0u);  // aligned for use in place
+  EXPECT_EQ(file->value<std::uint64_t>("c/one"), 42u);
+  EXPECT_THROW(file->array<std::uint64_t>("b/numbers"), SectionFileError);  // 4-byte elements
+  EXPECT_THROW(file->value<double>("a/reals"), SectionFileError);          // two values, not one
+  try {
+    file->bytes("d/missing");
+    FAIL();
+  } catch (const SectionFileError& error) {
+    EXPECT_NE(std::string(error.what()).find(path), std::string::npos);
+    EXPECT_NE(std::string(error.what()).find("'d/missing' is missing"), std::string::npos);
+  }
+}
+
+Config small_render(const std::vector<std::string>& settings) {
+  Config config;
+  config.set("render.width=32");
+  config.set("render.height=24");
+  config.set("render.spp=1");
+  config.set("render.threads=2");
+  for (const std::string& s : settings) config.set(s);
+  return config;
+}
+
+std::vector<float> render_with(const Config& config, const World& world) {
+  const RenderPlan plan = plan_render(config);
+  return render_image(plan, world, resolve_camera(plan.camera, world.scene)).image;
+}
+
+const Scene& room() {
+  static const Scene scene = make_builtin_scene("builtin:room:20k");
+  return scene;
+}
+
+// Builds `settings` over the room, saves it, and returns the fresh build's image.
+std::vector<float> build_and_save(const std::vector<std::string>& settings, const std::string& path, bool proxy = false) {
+  const Config config = small_render(settings);
+  const RenderPlan plan = plan_render(config);
+  const Scene& scene = room();
+  const auto accelerator = build_world_accelerator(scene, plan.accelerator);
+  const LightSampler lights(scene);
+  std::unique_ptr<Proxy> simplified;
+  if (proxy) simplified = std::make_unique<Proxy>(scene.mesh, plan.proxy, *accelerator);
+  save_world(path, scene, lights, *accelerator, plan.accelerator.type, simplified.get(), config, {});
+  return render_with(config, World{scene, *accelerator, lights, simplified.get()});
+}
+
+std::vector<float> render_loaded(const std::vector<std::string>& settings, const std::string& path) {
+  const Config config = small_render(settings);
+  const RenderPlan plan = plan_render(config);
+  const LoadedWorld loaded = load_world(path, world_paging(plan), 2);
+  return render_with(config, World{loaded.scene, *loaded.accelerator, *loaded.lights,
+                                   plan.needs_proxy() ? loaded.proxy.get() : nullptr, loaded.file->pager()});
+}
+
+class WorldRoundTrip : public ::testing::TestWithParam<std::vector<std::string>> {};
+
+TEST_P(WorldRoundTrip, ImageIsBitIdenticalToTheFreshBuild) {
+  const std::string path = temp_path("roundtrip.wtw");
+  const std::vector<float> fresh = build_and_save(GetParam(), path);
+  const std::vector<float> loaded = render_loaded(GetParam(), path);
+  ASSERT_EQ(loaded.size(), fresh.size());
+  EXPECT_TRUE(loaded == fresh);
+  const LoadedWorld world = load_world(path);
+  EXPECT_EQ(world.scene.triangle_count, room().triangle_count);
+  EXPECT_EQ(world.rebuilt, !saves_structure(world.type)) << world.type;
+  EXPECT_GT(world.accelerator->memory().total(), 0u);
+  fs::remove(path);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    EveryAccelerator, WorldRoundTrip,
+    ::testing::Values(std::vector<std::string>{"accel.type=hmq"}, std::vector<std::string>{"accel.type=raystrips"},
+                      std::vector<std::string>{"accel.type=bvh"},
+                      std::vector<std::string>{"accel.type=bvh", "accel.bvh.width=8", "accel.bvh.triangle_order=leaf"},
+                      std::vector<std::string>{"accel.type=bvh", "accel.bvh.triangle_order=morton"},
+                      std::vector<std::string>{"accel.type=embree"}, std::vector<std::string>{"accel.type=grid"},
+                      std::vector<std::string>{"accel.type=mlgrid"}, std::vector<std::string>{"accel.type=arraygrid"},
+                      std::vector<std::string>{"accel.type=hmq", "build.chunk_triangles=4096"},
+                      std::vector<std::string>{"accel.type=raystrips", "build.chunk_triangles=4096"},
+                      std::vector<std::string>{"accel.type=bvh", "build.chunk_triangles=4096"}));
+
+TEST(WorldFile, RealPagingChangesNoPixelAndCountsItsReads) {
+  const std::string path = temp_path("paged.wtw");
+  const std::vector<std::string> build = {"accel.type=hmq", "build.chunk_triangles=4096"};
+  const std::vector<float> fresh = build_and_save(build, path);
+  std::vector<std::string> paged = build;
+  for (const char* s : {"memory.backing=file", "memory.budget=5%", "memory.page_bytes=4096"}) paged.emplace_back(s);
+  const Config config = small_render(paged);
+  const RenderPlan plan = plan_render(config);
+  const LoadedWorld loaded = load_world(path, world_paging(plan), 2);
+  ASSERT_NE(loaded.file->pager(), nullptr);
+  EXPECT_LT(loaded.file->pager()->budget_bytes(), loaded.file->file_bytes() / 10);
+  const RenderOutput output = render_image(plan, World{loaded.scene, *loaded.accelerator, *loaded.lights, nullptr,
+                                                       loaded.file->pager()},
+                                           resolve_camera(plan.camera, loaded.scene));
+  EXPECT_TRUE(output.image == fresh);
+  bool counted = false;
+  for (const StageStats& stage : output.run.stages) {
+    if (stage.name != "trace") continue;
+    ASSERT_TRUE(stage.disk.has_value());
+    ASSERT_TRUE(stage.pager.has_value());
+    EXPECT_GT(stage.disk->counters.faults, 0u);
+    EXPECT_EQ(stage.disk->counters.bytes_read, stage.disk->counters.faults * 4096);
+    EXPECT_GT(stage.disk->counters.read_seconds, 0.0);
+    counted = true;
+  }
+  EXPECT_TRUE(counted);
+  fs::remove(path);
+}
+
+TEST(WorldFile, SavedProxyOrdersRaysAsTheFreshOneDoes) {
+  const std::string path = temp_path("proxy.wtw");
+  const std::vector<std::string> settings = {"accel.type=hmq", "reorder.heuristic=hph"};
+  const std::vector<float> fresh = build_and_save(settings, path, true);
+  EXPECT_TRUE(render_loaded(settings, path) == fresh);
+  fs::remove(path);
+}
+
+class DamagedWorld : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    path_ = temp_path("damaged.wtw");
+    good_ = temp_path("good.wtw");
+    build_and_save({"accel.type=hmq", "build.chunk_triangles=8192"}, good_);
+    bytes_ = read_all(good_);
+  }
+  void TearDown() override {
+    fs::remove(path_);
+    fs::remove(good_);
+  }
+  std::string path_, good_, bytes_;
+};
+
+TEST_F(DamagedWorld, EachProblemIsNamedWithTheFile) {
+  const auto expect_error = [&](const std::string& contents, const std::string& problem) {
+    write_all(path_, contents);
+    const std::string error = open_error(path_);
+    EXPECT_NE(error.find(path_), std::string::npos) << error;
+    EXPECT_NE(error.find(problem), std::string::npos) << "expected '" << problem << "' in: " << error;
+  };
+  expect_error(bytes_.substr(0, 40), "truncated");
+  expect_error(bytes_.substr(0, bytes_.size() - 4096), "truncated");
+  expect_error(std::string(bytes_.size(), '\0'), "incomplete");
+  std::string magic = bytes_;
+  magic[0] = 'X';
+  expect_error(magic, "not a wavetrace world file");
+  std::string data = bytes_;
+  Resealer probe(good_);
+  data[probe.entry("accel/chunk.0/hmq.blocks").offset + 100] ^= 0x10;
+  expect_error(data, "'accel/chunk.0/hmq.blocks' checksum mismatch");
+  std::string table = bytes_;
+  table[probe.header.table_offset + 70] ^= 0x01;
+  expect_error(table, "table checksum mismatch");
+
+  Resealer version(good_);
+  version.header.version = 7;
+  version.seal(path_);
+  EXPECT_NE(open_error(path_).find("container version 7"), std::string::npos) << open_error(path_);
+
+  Resealer accel_version(good_);
+  SavedKind kind{};
+  std::memcpy(&kind, accel_version.data("accel/chunk.0/kind"), sizeof(kind));
+  kind.version = 99;
+  std::memcpy(accel_version.data("accel/chunk.0/kind"), &kind, sizeof(kind));
+  accel_version.seal(path_);
+  EXPECT_NE(open_error(path_).find("'hmq' format version 99"), std::string::npos) << open_error(path_);
+
+  Resealer outside(good_);
+  outside.entry("accel/chunk.0/hmq.blocks").size = std::uint64_t{1} << 40;
+  outside.seal(path_);
+  EXPECT_NE(open_error(path_).find("lies outside the file"), std::string::npos) << open_error(path_);
+}
+
+TEST_F(DamagedWorld, FlippedBytesAnywhereAreRefusedOrHarmless) {
+  const std::vector<float> expected = render_loaded({"accel.type=hmq"}, good_);
+  std::mt19937_64 random(20261201);
+  std::size_t refused = 0, harmless = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    std::string damaged = bytes_;
+    const std::size_t at = random() % damaged.size();
+    damaged[at] = static_cast<char>(damaged[at] ^ static_cast<char>(1 + random() % 255));
+    write_all(path_, damaged);
+    try {
+      // A flip in the zero padding between sections touches no checked byte: the world
+      // must then load and render exactly as before.
+      EXPECT_TRUE(render_loaded({"accel.type=hmq"}, path_) == expected) << "flip at byte " << at;
+      ++harmless;
+    } catch (const SectionFileError& error) {
+      EXPECT_NE(std::string(error.what()).find(path_), std::string::npos);
+      ++refused;
+    }
+  }
+  EXPECT_GT(refused, 0u);
+  EXPECT_EQ(refused + harmless, 300u);
+}
+
+TEST(WorldFileCli, BuildRenderAndInfo) {
+  const std::string world = temp_path("cli.wtw");
+  const auto built = testing::run_wavetrace("build builtin:room:20k --accel raystrips --out " + world);
+  ASSERT_EQ(built.exit_code, 0) << built.output;
+  EXPECT_NE(built.output.find("bytes/triangle"), std::string::npos) << built.output;
+  const std::string stats = temp_path("cli_stats.json");
+  const auto rendered = testing::run_wavetrace("render " + world + " --size 32x24 --spp 1 --out " +
+                                               temp_path("cli.exr") + " --set memory.backing=file --set memory.budget=10% "
+                                               "--set memory.page_bytes=4096 --stats " + stats);
+  ASSERT_EQ(rendered.exit_code, 0) << rendered.output;
+  EXPECT_NE(rendered.output.find("real faults"), std::string::npos) << rendered.output;
+  EXPECT_NE(read_all(stats).find("\"disk\""), std::string::npos);
+  const auto info = testing::run_wavetrace("info " + world);
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  EXPECT_NE(info.output.find("raystrips"), std::string::npos) << info.output;
+  write_all(world, read_all(world).substr(0, 10000));
+  const auto broken = testing::run_wavetrace("render " + world + " --size 32x24 --out " + temp_path("x.exr"));
+  EXPECT_EQ(broken.exit_code, 1);
+  EXPECT_NE(broken.output.find(world + ": truncated"), std::string::npos) << broken.output;
+  const auto not_world = testing::run_wavetrace("render builtin:room:20k --size 8x8 --set memory.backing=file "
+                                                "--set memory.budget=10% --out " + temp_path("y.exr"));
+  EXPECT_EQ(not_world.exit_code, 1);
+  EXPECT_NE(not_world.output.find("is not one"), std::string::npos) << not_world.output;
+}
+
+}  // namespace
+}  // namespace wavetrace
