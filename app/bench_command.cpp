@@ -11,6 +11,7 @@
 #include "bench/leak_bench.hpp"
 #include "bench/reorder_bench.hpp"
 #include "stages/render_setup.hpp"
+#include "stages/world_file.hpp"
 
 namespace wavetrace {
 namespace {
@@ -40,8 +41,11 @@ std::vector<std::string> split_commas(const std::string& text) {
 
 struct BenchSetup {
   Config config;
-  Scene scene;
+  Scene loaded_scene;
   std::vector<AcceleratorSpec> accelerators;
+  std::unique_ptr<LoadedWorld> world;  // --scene FILE.wtw: the saved world
+  // The world's own scene object: a rebuilt Embree refers to that very mesh.
+  const Scene& scene() const { return world ? world->scene : loaded_scene; }
 };
 
 BenchSetup prepare(const BenchArguments& args) {
@@ -52,7 +56,11 @@ BenchSetup prepare(const BenchArguments& args) {
   if (args.count == 0) throw ConfigError("--count must be at least 1");
   for (const std::string& spec : split_commas(args.accel)) setup.accelerators.push_back(parse_accelerator_spec(spec, setup.config));
   if (setup.accelerators.empty()) throw ConfigError("--accel names no accelerator");
-  setup.scene = load_scene(plan_render(setup.config).scene);
+  if (is_world_file(args.scene)) {
+    setup.world = load_world(args.scene, std::nullopt, args.threads);
+    return setup;
+  }
+  setup.loaded_scene = load_scene(plan_render(setup.config).scene);
   return setup;
 }
 
@@ -87,7 +95,13 @@ int run_accel(const BenchArguments& args) {
     }
   }
   if (args.repeat < 1) throw ConfigError("--repeat must be at least 1");
-  const AccelBenchReport report = run_accel_bench(setup.scene, request);
+  if (setup.world) {
+    request.world = setup.world->accelerator.get();
+    request.world_lights = setup.world->lights.get();
+    request.world_label = fmt::format("{} (world file{})", setup.world->type, setup.world->rebuilt ? ", rebuilt" : "");
+    request.world_load_seconds = setup.world->seconds;
+  }
+  const AccelBenchReport report = run_accel_bench(setup.scene(), request);
   fmt::print("{}", to_table(report));
   if (!args.json.empty()) {
     write_text(args.json, to_json(report).dump(2) + "\n");
@@ -97,8 +111,9 @@ int run_accel(const BenchArguments& args) {
 }
 
 int run_leak(const BenchArguments& args) {
+  if (is_world_file(args.scene)) throw ConfigError("bench leak builds each accelerator from a scene: give a scene, not a world file");
   BenchSetup setup = prepare(args);
-  const LeakReport report = run_leak_bench(setup.scene, setup.accelerators, args.count, args.threads);
+  const LeakReport report = run_leak_bench(setup.scene(), setup.accelerators, args.count, args.threads);
   fmt::print("{}", to_table(report));
   if (!args.json.empty()) write_text(args.json, to_json(report).dump(2) + "\n");
   return 0;

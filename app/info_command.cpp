@@ -22,7 +22,8 @@ struct InfoArguments {
 
 // A saved world: what it holds and what it costs, from its sections (checked, not traced).
 int run_world_info(const InfoArguments& args) {
-  const LoadedWorld world = load_world(args.scene);
+  const std::unique_ptr<LoadedWorld> loaded = load_world(args.scene);
+  const LoadedWorld& world = *loaded;
   const double triangles = double(std::max<std::size_t>(world.scene.triangle_count, 1));
   const MemoryReport memory = world.accelerator->memory();
   nlohmann::json sections = nlohmann::json::array();

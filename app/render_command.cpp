@@ -80,7 +80,8 @@ int finish_render(const RenderArguments& args, const RenderPlan& plan, const Sce
 // A saved world: mapped (or paged from disk under memory.budget) and traced as built.
 int render_world(const RenderArguments& args, RenderPlan plan) {
   RenderPhases measured;
-  LoadedWorld loaded = load_world(plan.scene.source, world_paging(plan), plan.pipeline.threads);
+  const std::unique_ptr<LoadedWorld> world_file = load_world(plan.scene.source, world_paging(plan), plan.pipeline.threads);
+  LoadedWorld& loaded = *world_file;
   measured.load_seconds = loaded.seconds;
   measured.after_load_bytes = measured.after_build_bytes = read_resident_memory().current_bytes;
   plan.accelerator.type = loaded.type;

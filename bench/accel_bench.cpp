@@ -126,18 +126,23 @@ AccelBenchReport run_accel_bench(const Scene& scene, const AccelBenchRequest& re
   TracingArena arena(request.threads);
   AccelBenchReport report;
   report.scene = scene.name;
-  report.triangles = scene.mesh.triangle_count();
+  report.triangles = scene.triangle_count;
   report.rays = to_string(request.rays);
   report.reference = request.reference.label;
   report.threads = arena.threads();
   report.repeats = request.repeats;
   report.packets = request.packets && request.rays == RaySetKind::primary;
   report.memory_observed = request.memory.enabled() || !request.budgets.empty();
-  const float diagonal = scene.mesh.bounds().diagonal();
+  const float diagonal = scene.bounds.diagonal();
+  const bool has_mesh = !scene.mesh.triangles.empty();
+  if (request.world != nullptr && !has_mesh) report.reference = "the world itself (it holds no mesh)";
 
   arena.execute([&] {
-    const auto reference = make_accelerator(scene.mesh, request.reference.options);
-    const RaySet rays = make_ray_set(request.rays, scene, *reference, request.count);
+    const std::unique_ptr<Accelerator> built_reference =
+        has_mesh ? make_accelerator(scene.mesh, request.reference.options) : nullptr;
+    const Accelerator* reference = built_reference ? built_reference.get() : request.world;
+    const RaySet rays = make_ray_set(request.rays, scene, *reference, request.count, kDefaultBatchCapacity,
+                                     request.world_lights);
     report.ray_count = rays.count();
     const auto reference_hits = trace_ray_set(*reference, rays);
     std::size_t reference_hit_count = 0;
@@ -146,19 +151,29 @@ AccelBenchReport run_accel_bench(const Scene& scene, const AccelBenchRequest& re
     }
     report.reference_hit_rate = double(reference_hit_count) / double(std::max<std::size_t>(1, report.ray_count));
 
-    for (const AcceleratorSpec& spec : request.accelerators) {
+    const std::size_t subjects = request.world != nullptr ? 1 : request.accelerators.size();
+    for (std::size_t subject = 0; subject < subjects; ++subject) {
       AccelBenchResult result;
-      result.label = spec.label;
-      // The build's peak resident memory, from the OS: the peak window starts here, so it
-      // holds what the process already had (scene, rays, reference) plus the build's own.
-      const bool windowed = reset_peak_resident_memory();
-      const std::size_t resident_before = read_resident_memory().current_bytes;
-      const auto accelerator = build_world_accelerator(scene, spec.options);
-      const std::size_t peak = read_resident_memory().peak_bytes;
-      if (windowed) result.build_peak_rss_above_start_bytes = peak > resident_before ? peak - resident_before : 0;
+      std::unique_ptr<Accelerator> built;
+      if (request.world != nullptr) {
+        result.label = request.world_label;
+        result.build = request.world->build();
+        result.build.seconds = request.world_load_seconds;  // the world's load stands for its build
+      } else {
+        const AcceleratorSpec& spec = request.accelerators[subject];
+        result.label = spec.label;
+        // The build's peak resident memory, from the OS: the peak window starts here, so it
+        // holds what the process already had (scene, rays, reference) plus the build's own.
+        const bool windowed = reset_peak_resident_memory();
+        const std::size_t resident_before = read_resident_memory().current_bytes;
+        built = build_world_accelerator(scene, spec.options);
+        const std::size_t peak = read_resident_memory().peak_bytes;
+        if (windowed) result.build_peak_rss_above_start_bytes = peak > resident_before ? peak - resident_before : 0;
+        result.build = built->build();
+      }
+      const Accelerator* accelerator = built ? built.get() : request.world;
       result.memory = accelerator->memory();
-      result.bytes_per_triangle = double(result.memory.total()) / double(scene.mesh.triangle_count());
-      result.build = accelerator->build();
+      result.bytes_per_triangle = double(result.memory.total()) / double(scene.triangle_count);
       result.build_notes = accelerator->build_notes();
       std::vector<std::unique_ptr<HitBatch>> hits;
       for (int run = 0; run < std::max(1, request.repeats); ++run) {
@@ -169,7 +184,7 @@ AccelBenchReport run_accel_bench(const Scene& scene, const AccelBenchRequest& re
       }
       result.mrays_per_s = median(result.mrays_per_s_runs);
       compare(rays, hits, reference_hits, diagonal, result);
-      if (!rays.any_hit()) measure_surface_error(scene.mesh, *accelerator, rays, hits, result);
+      if (!rays.any_hit() && has_mesh) measure_surface_error(scene.mesh, *accelerator, rays, hits, result);
       result.probed = accelerator->probed();
       if (report.memory_observed && result.probed) {
         result.memory_runs = memory_runs(*accelerator, rays, request, report.threads);

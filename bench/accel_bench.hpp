@@ -83,6 +83,13 @@ struct AccelBenchRequest {
   // Pager settings and cache; `budgets` (e.g. "100%", "20%") replace memory.budget when given.
   MemoryPlan memory;
   std::vector<std::string> budgets;
+  // A saved world (bench accel --scene FILE.wtw): measured instead of `accelerators`, with
+  // its load in place of a build; the reference is built from its geometry when it has some,
+  // else the world answers for itself (accuracy then compares it with itself).
+  const Accelerator* world = nullptr;
+  const LightSampler* world_lights = nullptr;
+  std::string world_label;
+  double world_load_seconds = 0.0;
 };
 
 AccelBenchReport run_accel_bench(const Scene& scene, const AccelBenchRequest& request);

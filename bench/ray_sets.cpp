@@ -1,6 +1,8 @@
 // Ray set generation, deterministic (keyed randomness), and tracing a set in parallel.
 #include "bench/ray_sets.hpp"
 
+#include <optional>
+
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -77,12 +79,12 @@ std::vector<SurfacePoint> primary_surface_points(const Scene& scene, const Accel
       const RayBatch& rays = *primary.batches[b];
       for (std::size_t i = 0; i < rays.count && points.size() < count; ++i) {
         if (!hits[b]->is_hit(i)) continue;
-        const glm::uvec3& tri = scene.mesh.triangles[hits[b]->primitive[i]];
-        const glm::vec3 a = scene.mesh.positions[tri.x], e1 = scene.mesh.positions[tri.y] - a,
-                        e2 = scene.mesh.positions[tri.z] - a;
-        const glm::vec3 point = a + e1 * hits[b]->u[i] + e2 * hits[b]->v[i];
+        // The hit's own surface (every accelerator records it for closest hits): no mesh needed,
+        // so a saved world's ray sets are the ones its fresh build would get.
+        const HitBatch& hit = *hits[b];
+        const glm::vec3 point(hit.point_x[i], hit.point_y[i], hit.point_z[i]);
         const glm::vec3 direction(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]);
-        glm::vec3 normal = glm::normalize(glm::cross(e1, e2));
+        glm::vec3 normal = glm::normalize(glm::vec3(hit.normal_x[i], hit.normal_y[i], hit.normal_z[i]));
         if (glm::dot(normal, direction) > 0.0f) normal = -normal;
         points.push_back({offset_ray_origin(point, normal), normal, static_cast<std::uint32_t>(points.size())});
       }
@@ -119,10 +121,10 @@ std::size_t RaySet::count() const {
 }
 
 RaySet make_ray_set(RaySetKind kind, const Scene& scene, const Accelerator& reference, std::size_t count,
-                    std::size_t batch_size) {
+                    std::size_t batch_size, const LightSampler* scene_lights) {
   RaySet set{kind, {}};
   RayWriter writer{set, batch_size};
-  const Bounds3 bounds = scene.mesh.bounds();
+  const Bounds3 bounds = scene.bounds;
   switch (kind) {
     case RaySetKind::primary: add_primary(writer, resolve_camera(CameraOverride{}, scene), count, 0); break;
     case RaySetKind::diffuse: {
@@ -133,7 +135,9 @@ RaySet make_ray_set(RaySetKind kind, const Scene& scene, const Accelerator& refe
       break;
     }
     case RaySetKind::shadow: {
-      const LightSampler lights(scene);
+      const std::optional<LightSampler> own_lights =
+          scene_lights == nullptr ? std::optional<LightSampler>(std::in_place, scene) : std::nullopt;
+      const LightSampler& lights = scene_lights != nullptr ? *scene_lights : *own_lights;
       // Without lights: a square light a half diagonal above the scene, facing down.
       const float size = 0.5f * bounds.diagonal();
       const glm::vec3 virtual_corner(bounds.center().x - 0.5f * size, bounds.upper.y + size, bounds.center().z - 0.5f * size);

@@ -10,6 +10,7 @@
 
 #include "accel/accelerator.hpp"
 #include "memory/ray_batch.hpp"
+#include "scene/lights.hpp"
 #include "scene/scene.hpp"
 
 namespace wavetrace {
@@ -27,9 +28,10 @@ struct RaySet {
 
 // `reference` supplies the primary hits that diffuse and shadow rays start from. A scene
 // without emissive triangles gets shadow rays toward a virtual square light above it.
-// Throws std::runtime_error if no primary ray hits the scene (diffuse, shadow).
+// Throws std::runtime_error if no primary ray hits the scene (diffuse, shadow). Shadow rays
+// aim at `scene_lights`, or at the scene's own when null (which needs its mesh or stream).
 RaySet make_ray_set(RaySetKind kind, const Scene& scene, const Accelerator& reference, std::size_t count,
-                    std::size_t batch_size = kDefaultBatchCapacity);
+                    std::size_t batch_size = kDefaultBatchCapacity, const LightSampler* scene_lights = nullptr);
 
 // Every ray of the set traced by `accelerator` into one HitBatch per ray batch. With
 // `coherent`, primary rays go through intersect_coherent (packets where there are any).

@@ -6,6 +6,7 @@
 #include "accel/registry.hpp"
 #include "scene/lights.hpp"
 #include "stages/render_setup.hpp"
+#include "stages/world_file.hpp"
 
 namespace wavetrace {
 namespace {
@@ -26,19 +27,38 @@ ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<Reo
     throw ConfigError(fmt::format("render.max_depth = {}: the reorder benchmark path traces to depth 3 or more",
                                   base.rules.max_depth));
   }
-  Scene scene = load_scene(base.scene);
-  const Camera camera = resolve_camera(base.camera, scene);
-  const auto accelerator = build_world_accelerator(scene, base.accelerator);
-  const LightSampler lights(scene);
-  std::unique_ptr<Proxy> proxy;
-  for (ReorderHeuristic heuristic : heuristics) {
-    if (uses_hit_points(heuristic) && !proxy) proxy = std::make_unique<Proxy>(scene.mesh, base.proxy, *accelerator);
+  bool hit_points = false;
+  for (ReorderHeuristic heuristic : heuristics) hit_points = hit_points || uses_hit_points(heuristic);
+  // A scene is loaded and built here; a saved world is mapped, or paged from its file.
+  std::unique_ptr<LoadedWorld> saved;
+  Scene built_scene;
+  std::unique_ptr<Accelerator> built_accelerator;
+  std::unique_ptr<LightSampler> built_lights;
+  std::unique_ptr<Proxy> built_proxy;
+  if (is_world_file(base.scene.source)) {
+    saved = load_world(base.scene.source, world_paging(base), base.pipeline.threads);
+    if (hit_points && !saved->proxy) {
+      throw ConfigError(fmt::format("{} was saved without a proxy, which hit-point heuristics need: build it with --proxy",
+                                    base.scene.source));
+    }
+  } else {
+    if (base.memory.file_backing) throw ConfigError("memory.backing = file pages a world file: give one (wavetrace build)");
+    built_scene = load_scene(base.scene);
+    built_accelerator = build_world_accelerator(built_scene, base.accelerator);
+    built_lights = std::make_unique<LightSampler>(built_scene);
+    if (hit_points) built_proxy = std::make_unique<Proxy>(built_scene.mesh, base.proxy, *built_accelerator);
   }
-  const World world{scene, *accelerator, lights, proxy.get()};
+  const Scene& scene = saved ? saved->scene : built_scene;
+  const Accelerator* accelerator = saved ? saved->accelerator.get() : built_accelerator.get();
+  const Proxy* proxy = saved ? saved->proxy.get() : built_proxy.get();
+  FilePager* file_pager = saved ? saved->file->pager() : nullptr;
+  const Camera camera = resolve_camera(base.camera, scene);
+  const World world{scene, *accelerator, saved ? *saved->lights : *built_lights, proxy, file_pager};
 
   ReorderBenchReport report;
   report.scene = scene.name;
-  report.triangles = scene.mesh.triangle_count();
+  report.triangles = scene.triangle_count;
+  if (saved) report.world_bytes = saved->file->file_bytes();
   report.accel = accelerator->name();
   report.curve = to_string(base.reorder.curve);
   report.image = fmt::format("{}x{}, {} spp, depth {}", base.image.width, base.image.height,
@@ -50,8 +70,15 @@ ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<Reo
                                proxy->accelerator().name(), 100.0 * p.quality.hit_overlap);
   }
   report.memory = "off";
-  if (base.memory.budget) report.memory = "pager " + config.text("memory.budget") + " of " +
-                                          std::to_string(base.memory.page_bytes >> 10) + " KiB pages";
+  if (base.memory.budget) {
+    report.memory = "pager " + config.text("memory.budget") + " of " + std::to_string(base.memory.page_bytes >> 10) +
+                    " KiB pages";
+    if (file_pager != nullptr) {
+      report.memory += fmt::format(" (simulated, and real: {} of {} pages read with O_DIRECT into a {:.1f} MiB pool)",
+                                   base.scene.source, file_pager->page_count(), double(file_pager->budget_bytes()) / (1 << 20));
+      report.page_count = file_pager->page_count();
+    }
+  }
   if (base.memory.cache) report.memory += (base.memory.budget ? ", cache " : "cache ") + base.memory.cache->name;
 
   std::vector<float> first_image;
@@ -78,6 +105,11 @@ ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<Reo
         result.simulated_io_seconds = trace->pager->counters.simulated_io_seconds;
       }
       if (trace->cache) result.cache_misses = trace->cache->counters.misses;
+      if (trace->disk) {
+        result.disk_faults = trace->disk->counters.faults;
+        result.disk_bytes_read = trace->disk->counters.bytes_read;
+        result.disk_read_seconds = trace->disk->counters.read_seconds;
+      }
     }
     if (const StageStats* approx = find_stage(output.run, "approx_hit")) {
       result.approx_hit_seconds = approx->seconds;
@@ -118,6 +150,9 @@ nlohmann::json to_json(const ReorderBenchReport& report) {
                        {"bytes_loaded", optional(r.bytes_loaded)},
                        {"simulated_io_seconds", optional(r.simulated_io_seconds)},
                        {"cache_misses", optional(r.cache_misses)},
+                       {"disk_faults", optional(r.disk_faults)},
+                       {"disk_bytes_read", optional(r.disk_bytes_read)},
+                       {"disk_read_seconds", optional(r.disk_read_seconds)},
                        {"image_identical", r.image_identical}});
   }
   return {{"scene", {{"source", report.scene}, {"triangles", report.triangles}}},
@@ -127,6 +162,8 @@ nlohmann::json to_json(const ReorderBenchReport& report) {
           {"threads", report.threads},
           {"proxy", optional(report.proxy)},
           {"memory", report.memory},
+          {"world_bytes", report.world_bytes},
+          {"page_count", report.page_count},
           {"results", results}};
 }
 
@@ -134,28 +171,43 @@ std::string to_table(const ReorderBenchReport& report) {
   std::string table = fmt::format("{}: {} triangles; {} on {}; {} curve; {} threads; memory {}\n", report.scene,
                                   report.triangles, report.image, report.accel, report.curve, report.threads, report.memory);
   if (report.proxy) table += "proxy: " + *report.proxy + "\n";
-  table += fmt::format("{:<11} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>8} {:>9} {:>10} {:>9} {:>11} {:>11} {:>9} {:>10}\n",
+  const bool disk = !report.results.empty() && report.results.front().disk_faults.has_value();
+  table += fmt::format("{:<11} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>8} {:>9} {:>10} {:>9} {:>11} {:>11} {:>9} {:>10}",
                        "heuristic", "render s", "trace s", "Mr/s/thr", "closest", "shadow", "approx s", "sort s",
                        "overhead", "faults", "sim I/O s", "misses", "vs first", "speedup", "identical");
+  table += disk ? fmt::format(" {:>11} {:>9} {:>9} {:>9} {:>10}\n", "disk faults", "disk MB", "read s", "disk vs 1st",
+                              "rays/page")
+                : "\n";
   const ReorderBenchResult* first = report.results.empty() ? nullptr : &report.results.front();
   const auto optional = [](const auto& value, const char* format) {
     return value ? fmt::format(fmt::runtime(format), *value) : std::string("-");
   };
+  const auto ratio = [](const std::optional<std::uint64_t>& base, const std::optional<std::uint64_t>& value) {
+    return base && value && *value > 0 ? fmt::format("{:.2f}x", double(*base) / double(*value)) : std::string("-");
+  };
   for (const ReorderBenchResult& r : report.results) {
-    const std::string fault_ratio =
-        r.page_faults && first->page_faults && *r.page_faults > 0
-            ? fmt::format("{:.2f}x", double(*first->page_faults) / double(*r.page_faults))
-            : std::string("-");
     table += fmt::format("{:<11} {:>9.3f} {:>9.3f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.3f} {:>8.3f} {:>8.1f}% {:>10} {:>9} {:>11} {:>11} "
-                         "{:>8.2f}x {:>10}\n",
+                         "{:>8.2f}x {:>10}",
                          r.heuristic, r.render_seconds, r.trace_seconds, r.trace_mrays_per_s, r.closest_mrays_per_s,
                          r.shadow_mrays_per_s, r.approx_hit_seconds,
                          r.sort_seconds, 100.0 * r.overhead_share, optional(r.page_faults, "{}"),
-                         optional(r.simulated_io_seconds, "{:.1f}"), optional(r.cache_misses, "{}"), fault_ratio,
-                         first->render_seconds / r.render_seconds, r.image_identical ? "yes" : "NO");
+                         optional(r.simulated_io_seconds, "{:.1f}"), optional(r.cache_misses, "{}"),
+                         ratio(first->page_faults, r.page_faults), first->render_seconds / r.render_seconds,
+                         r.image_identical ? "yes" : "NO");
+    if (disk) {
+      table += fmt::format(" {:>11} {:>9.1f} {:>9.2f} {:>9} {:>10.0f}", optional(r.disk_faults, "{}"),
+                           double(r.disk_bytes_read.value_or(0)) * 1e-6, r.disk_read_seconds.value_or(0.0),
+                           ratio(first->disk_faults, r.disk_faults),
+                           double(r.rays_traced) / double(std::max<std::size_t>(report.page_count, 1)));
+    }
+    table += "\n";
   }
   table += "Mr/s/thr: trace's rays per busy thread-second (closest: camera and bounce rays; shadow: any-hit rays)\n"
            "vs first: the first heuristic's page faults over this one's; speedup: its render seconds over this one's\n";
+  if (disk) {
+    table += "disk: real faults of trace (pages read from the world file with O_DIRECT), their bytes and measured read\n"
+             "seconds (inside render s); rays/page: rays traced per page of the world file\n";
+  }
   return table;
 }
 

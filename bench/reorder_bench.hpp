@@ -31,6 +31,10 @@ struct ReorderBenchResult {
   std::optional<std::uint64_t> bytes_loaded;
   std::optional<double> simulated_io_seconds;
   std::optional<std::uint64_t> cache_misses;
+  // Real paging of a world file (memory.backing = file): pages read from disk, measured.
+  std::optional<std::uint64_t> disk_faults;
+  std::optional<std::uint64_t> disk_bytes_read;
+  std::optional<double> disk_read_seconds;
   bool image_identical = false;  // to the first heuristic's image (none, when listed first)
 };
 
@@ -43,6 +47,8 @@ struct ReorderBenchReport {
   int threads = 0;
   std::optional<std::string> proxy;  // method, triangles, quality
   std::string memory;                // pager and cache settings, or "off"
+  std::uint64_t world_bytes = 0;     // the world file's size, when the scene is one
+  std::size_t page_count = 0;        // the world's pages, when paged (real or simulated)
   std::vector<ReorderBenchResult> results;
 };
 

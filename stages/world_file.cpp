@@ -159,9 +159,10 @@ void save_world(const std::string& path, const Scene& scene, const LightSampler&
   out.finish();
 }
 
-LoadedWorld load_world(const std::string& path, const std::optional<PagingRequest>& paging, int threads) {
+std::unique_ptr<LoadedWorld> load_world(const std::string& path, const std::optional<PagingRequest>& paging, int threads) {
   const auto start = std::chrono::steady_clock::now();
-  LoadedWorld world;
+  auto loaded = std::make_unique<LoadedWorld>();
+  LoadedWorld& world = *loaded;
   world.file = SectionFile::open(path, paging);
   const SectionFile& file = *world.file;
   SectionLoader(world.file, "world.").expect_kind("world", kWorldFileVersion);
@@ -239,7 +240,7 @@ LoadedWorld load_world(const std::string& path, const std::optional<PagingReques
                                           proxy_options);
   }
   world.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return world;
+  return loaded;
 }
 
 }  // namespace wavetrace

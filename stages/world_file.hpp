@@ -53,7 +53,12 @@ struct WorldBuildInfo {
 void save_world(const std::string& path, const Scene& scene, const LightSampler& lights, const Accelerator& accelerator,
                 const std::string& type, const Proxy* proxy, const Config& settings, const WorldBuildInfo& info);
 
+// Held by pointer: a rebuilt Embree refers to `scene.mesh` where it lies.
 struct LoadedWorld {
+  LoadedWorld() = default;
+  LoadedWorld(const LoadedWorld&) = delete;
+  LoadedWorld& operator=(const LoadedWorld&) = delete;
+
   std::shared_ptr<const SectionFile> file;
   Scene scene;  // described; its mesh only where the accelerator was rebuilt from it
   std::unique_ptr<LightSampler> lights;
@@ -75,7 +80,7 @@ std::optional<PagingRequest> world_paging(const RenderPlan& plan);
 
 // Maps `path` (or pages it under `paging`) and loads the world in place. `threads` is for
 // a rebuilt Embree. Throws SectionFileError naming the file and its problem.
-LoadedWorld load_world(const std::string& path, const std::optional<PagingRequest>& paging = std::nullopt,
+std::unique_ptr<LoadedWorld> load_world(const std::string& path, const std::optional<PagingRequest>& paging = std::nullopt,
                        int threads = 0);
 
 }  // namespace wavetrace

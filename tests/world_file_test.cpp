@@ -143,7 +143,8 @@ std::vector<float> build_and_save(const std::vector<std::string>& settings, cons
 std::vector<float> render_loaded(const std::vector<std::string>& settings, const std::string& path) {
   const Config config = small_render(settings);
   const RenderPlan plan = plan_render(config);
-  const LoadedWorld loaded = load_world(path, world_paging(plan), 2);
+  const std::unique_ptr<LoadedWorld> world = load_world(path, world_paging(plan), 2);
+  const LoadedWorld& loaded = *world;
   return render_with(config, World{loaded.scene, *loaded.accelerator, *loaded.lights,
                                    plan.needs_proxy() ? loaded.proxy.get() : nullptr, loaded.file->pager()});
 }
@@ -156,7 +157,8 @@ TEST_P(WorldRoundTrip, ImageIsBitIdenticalToTheFreshBuild) {
   const std::vector<float> loaded = render_loaded(GetParam(), path);
   ASSERT_EQ(loaded.size(), fresh.size());
   EXPECT_TRUE(loaded == fresh);
-  const LoadedWorld world = load_world(path);
+  const std::unique_ptr<LoadedWorld> held = load_world(path);
+  const LoadedWorld& world = *held;
   EXPECT_EQ(world.scene.triangle_count, room().triangle_count);
   EXPECT_EQ(world.rebuilt, !saves_structure(world.type)) << world.type;
   EXPECT_GT(world.accelerator->memory().total(), 0u);
@@ -183,7 +185,8 @@ TEST(WorldFile, RealPagingChangesNoPixelAndCountsItsReads) {
   for (const char* s : {"memory.backing=file", "memory.budget=5%", "memory.page_bytes=4096"}) paged.emplace_back(s);
   const Config config = small_render(paged);
   const RenderPlan plan = plan_render(config);
-  const LoadedWorld loaded = load_world(path, world_paging(plan), 2);
+  const std::unique_ptr<LoadedWorld> world = load_world(path, world_paging(plan), 2);
+  const LoadedWorld& loaded = *world;
   ASSERT_NE(loaded.file->pager(), nullptr);
   EXPECT_LT(loaded.file->pager()->budget_bytes(), loaded.file->file_bytes() / 10);
   const RenderOutput output = render_image(plan, World{loaded.scene, *loaded.accelerator, *loaded.lights, nullptr,
@@ -302,6 +305,9 @@ TEST(WorldFileCli, BuildRenderAndInfo) {
   ASSERT_EQ(rendered.exit_code, 0) << rendered.output;
   EXPECT_NE(rendered.output.find("real faults"), std::string::npos) << rendered.output;
   EXPECT_NE(read_all(stats).find("\"disk\""), std::string::npos);
+  const auto bench = testing::run_wavetrace("bench accel --scene " + world + " --rays diffuse --count 2000 --repeat 1");
+  ASSERT_EQ(bench.exit_code, 0) << bench.output;
+  EXPECT_NE(bench.output.find("raystrips (world file)"), std::string::npos) << bench.output;
   const auto info = testing::run_wavetrace("info " + world);
   ASSERT_EQ(info.exit_code, 0) << info.output;
   EXPECT_NE(info.output.find("raystrips"), std::string::npos) << info.output;
