@@ -199,7 +199,9 @@ std::string FilePager::load_locked(std::uint32_t page) {
     written += std::size_t(put);
   }
   void* at = base_ + (std::size_t(page) << page_shift_);
-  if (::mmap(at, page_bytes_, PROT_READ, MAP_SHARED | MAP_FIXED, pool_fd_, off_t(std::size_t(slot) * page_bytes_)) == MAP_FAILED) {
+  // MAP_POPULATE maps every 4 KiB of the page now: one call instead of a minor fault each.
+  if (::mmap(at, page_bytes_, PROT_READ, MAP_SHARED | MAP_FIXED | MAP_POPULATE, pool_fd_,
+             off_t(std::size_t(slot) * page_bytes_)) == MAP_FAILED) {
     return fmt::format("{}: mapping page {} failed: {}", path_, page, std::strerror(errno));
   }
   free_slots_.pop_back();
