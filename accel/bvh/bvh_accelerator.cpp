@@ -23,22 +23,10 @@ class BvhAccelerator final : public ProbedAccelerator<BvhAccelerator> {
   friend class ProbedAccelerator<BvhAccelerator>;
 
  public:
-  explicit BvhAccelerator(SectionLoader& in) : geometry_(in) {
-    in.expect_kind("bvh", kBvhSavedVersion);
-    in.array("bvh.nodes", nodes_);
-    in.array("bvh.leaf_triangles", leaf_triangles_);
-    archive_common_state(in, triangles_, build_);
-    if (nodes_.empty()) in.fail("bvh.nodes", "is empty: no bvh was saved");
-  }
+  explicit BvhAccelerator(SectionLoader& in) : geometry_(in) { load_bvh(in, "bvh.nodes", nodes_, leaf_triangles_, build_); }
 
   void save(SectionWriter& out, const std::string& prefix) const override {
-    out.add_value(prefix + "kind", saved_kind("bvh", kBvhSavedVersion));
-    SectionSaver saver(out, prefix);
-    geometry_.save(saver);
-    saver.array("bvh.nodes", nodes_);
-    saver.array("bvh.leaf_triangles", leaf_triangles_);
-    std::size_t triangles = geometry_.triangle_count();
-    archive_common_state(saver, triangles, build_);
+    save_bvh(out, prefix, geometry_, "bvh.nodes", nodes_, leaf_triangles_, build_);
   }
 
   BvhAccelerator(const TriangleMesh& mesh, const BvhOptions& options)
@@ -101,7 +89,6 @@ class BvhAccelerator final : public ProbedAccelerator<BvhAccelerator> {
   IndexedFaceSet geometry_;
   StoredArray<BvhNode> nodes_;
   StoredArray<std::uint32_t> leaf_triangles_;
-  std::size_t triangles_ = 0;  // as loaded; the face set's count is the truth
   BuildReport build_;
 };
 

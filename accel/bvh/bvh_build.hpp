@@ -8,6 +8,7 @@
 #include "accel/bvh/bvh_accelerator.hpp"
 #include "accel/bvh/indexed_face_set.hpp"
 #include "accel/bvh/sah_builder.hpp"
+#include "accel/section_archive.hpp"
 
 namespace wavetrace {
 
@@ -34,6 +35,31 @@ inline void adopt_leaf_order(const BvhOptions& options, IndexedFaceSet& geometry
 // bvh_node.hpp) or "bvh8.nodes" (WideBvhNode, wide_bvh_node.hpp), and "bvh.leaf_triangles"
 // (uint32 per leaf slot: a face-set slot; empty in leaf order, where slot = leaf position).
 inline constexpr std::uint32_t kBvhSavedVersion = 1;
+
+template <typename Node>
+void save_bvh(SectionWriter& out, const std::string& prefix, const IndexedFaceSet& geometry, std::string_view nodes_section,
+              const StoredArray<Node>& nodes, const StoredArray<std::uint32_t>& leaf_triangles, const BuildReport& build) {
+  out.add_value(prefix + "kind", saved_kind("bvh", kBvhSavedVersion));
+  SectionSaver saver(out, prefix);
+  geometry.save(saver);
+  saver.array(nodes_section, nodes);
+  saver.array("bvh.leaf_triangles", leaf_triangles);
+  std::size_t triangles = geometry.triangle_count();
+  BuildReport report = build;
+  archive_common_state(saver, triangles, report);
+}
+
+// The face set is loaded by the accelerator's constructor (a member); this reads the rest.
+template <typename Node>
+void load_bvh(SectionLoader& in, std::string_view nodes_section, StoredArray<Node>& nodes,
+              StoredArray<std::uint32_t>& leaf_triangles, BuildReport& build) {
+  in.expect_kind("bvh", kBvhSavedVersion);
+  in.array(nodes_section, nodes);
+  in.array("bvh.leaf_triangles", leaf_triangles);
+  std::size_t triangles = 0;
+  archive_common_state(in, triangles, build);
+  if (nodes.empty()) in.fail(nodes_section, "is empty: no bvh was saved");
+}
 
 // Peak build memory: the larger of the tree build's and the face-set copy's working sets,
 // held while the finished structure (`result_bytes`) already exists.

@@ -88,22 +88,11 @@ struct WideRay {
 class WideBvhAccelerator final : public Accelerator {
  public:
   explicit WideBvhAccelerator(SectionLoader& in) : geometry_(in) {
-    in.expect_kind("bvh", kBvhSavedVersion);
-    in.array("bvh8.nodes", nodes_);
-    in.array("bvh.leaf_triangles", leaf_triangles_);
-    std::size_t triangles = 0;
-    archive_common_state(in, triangles, build_);
-    if (nodes_.empty()) in.fail("bvh8.nodes", "is empty: no bvh8 was saved");
+    load_bvh(in, "bvh8.nodes", nodes_, leaf_triangles_, build_);
   }
 
   void save(SectionWriter& out, const std::string& prefix) const override {
-    out.add_value(prefix + "kind", saved_kind("bvh", kBvhSavedVersion));
-    SectionSaver saver(out, prefix);
-    geometry_.save(saver);
-    saver.array("bvh8.nodes", nodes_);
-    saver.array("bvh.leaf_triangles", leaf_triangles_);
-    std::size_t triangles = geometry_.triangle_count();
-    archive_common_state(saver, triangles, build_);
+    save_bvh(out, prefix, geometry_, "bvh8.nodes", nodes_, leaf_triangles_, build_);
   }
 
   WideBvhAccelerator(const TriangleMesh& mesh, const BvhOptions& options) : geometry_(mesh, options.triangle_order) {
