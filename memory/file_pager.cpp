@@ -63,12 +63,12 @@ void install_handler() {
 constexpr std::size_t kNoClient = ~std::size_t{0};
 thread_local std::size_t current_client = kNoClient;
 
-}  // namespace
-
 // Replaces a range with fresh PROT_NONE address space (no memory behind it).
-static bool reserve_range(void* address, std::size_t bytes) {
+bool reserve_range(void* address, std::size_t bytes) {
   return ::mmap(address, bytes, PROT_NONE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE | MAP_FIXED, -1, 0) != MAP_FAILED;
 }
+
+}  // namespace
 
 FilePager::ClientScope::ClientScope(std::size_t client) : previous_(current_client) { current_client = client; }
 FilePager::ClientScope::~ClientScope() { current_client = previous_; }
