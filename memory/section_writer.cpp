@@ -86,7 +86,6 @@ void SectionWriter::finish() {
   write_at(0, &header, sizeof(header));
   if (::close(fd_) != 0) throw std::runtime_error(fmt::format("{}: close failed: {}", path_, std::strerror(errno)));
   fd_ = -1;
-  position_ = header.file_size;
 }
 
 }  // namespace wavetrace

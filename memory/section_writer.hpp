@@ -38,7 +38,6 @@ class SectionWriter {
   // Writes the table and header and closes the file; until then the file is not valid
   // (its header is zero), so an interrupted save is refused when read.
   void finish();
-  std::uint64_t bytes_written() const { return position_; }
 
  private:
   void write_at(std::uint64_t offset, const void* data, std::size_t bytes);

@@ -47,7 +47,6 @@ class StoredArray {
   std::span<const T> span() const { return view_; }
   operator std::span<const T>() const { return view_; }
   std::span<const std::byte> bytes() const { return std::as_bytes(view_); }
-  bool mapped() const { return keep_alive_ != nullptr; }
 
  private:
   LargeArray<T> owned_;

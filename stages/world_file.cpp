@@ -95,12 +95,10 @@ TriangleMesh read_mesh(const SectionFile& file, const std::string& prefix) {
 
 }  // namespace
 
-std::optional<PagingRequest> world_paging(const MemoryPlan& memory) {
-  if (!memory.file_backing) return std::nullopt;
-  return PagingRequest{memory.page_bytes, *memory.budget, kObservedStageCount};
+std::optional<PagingRequest> world_paging(const RenderPlan& plan) {
+  if (!plan.memory.file_backing) return std::nullopt;
+  return PagingRequest{plan.memory.page_bytes, *plan.memory.budget, kObservedStageCount};
 }
-
-std::optional<PagingRequest> world_paging(const RenderPlan& plan) { return world_paging(plan.memory); }
 
 bool is_world_file(const std::string& path) { return path.size() > 4 && path.compare(path.size() - 4, 4, ".wtw") == 0; }
 

@@ -73,8 +73,6 @@ struct LoadedWorld {
 };
 
 // The paging a plan asks for: real paging under memory.budget when memory.backing = file.
-struct MemoryPlan;
-std::optional<PagingRequest> world_paging(const MemoryPlan& memory);
 struct RenderPlan;
 std::optional<PagingRequest> world_paging(const RenderPlan& plan);
 
