@@ -54,6 +54,7 @@ std::unique_ptr<Accelerator> load_accelerator(SectionLoader& in) {
   const SavedKind kind = in.file()->value<SavedKind>(in.prefix() + "kind");
   const std::string type(kind.type, strnlen(kind.type, sizeof(kind.type)));
   if (type == "hmq") return load_hmq_accelerator(in);
+  if (type == "hmq8") return load_wide_hmq_accelerator(in);
   if (type == "raystrips") return load_raystrips_accelerator(in);
   if (type == "bvh") return load_bvh_accelerator(in);
   if (type == "chunked") return load_chunked_accelerator(in, [](SectionLoader& chunk) { return load_accelerator(chunk); });

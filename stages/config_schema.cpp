@@ -76,7 +76,10 @@ const std::vector<ConfigKey>& config_schema() {
       {"accel.hmq.epsilon", T::real, 0.0, 0.0, 1e30, {},
        "error bound in scene units instead of bits (0: unset); the grid is the coarsest that keeps every vertex within it"},
       {"accel.hmq.leaf_size", T::integer, std::int64_t{8}, 1, 14, {}, "most triangles per leaf (the paper: 4, 8, 12)"},
-      {"accel.hmq.top_fraction", T::real, 0.05, 0.0, 1.0, {}, "share of the BVH's nodes kept uncompressed at the top"},
+      {"accel.hmq.top_fraction", T::real, 0.05, 0.0, 1.0, {},
+       "share of the BVH's nodes kept uncompressed at the top (width 2 only)"},
+      {"accel.hmq.width", T::integer, std::int64_t{2}, 2, 8, {},
+       "2: the paper's binary 4-byte nodes in blocks; 8: 64-byte nodes of 8 children, 8-bit planes, AVX2"},
       {"accel.bvh.width", T::integer, std::int64_t{2}, 2, 8, {}, "2: binary 32-byte nodes; 8: AVX2 8-wide nodes"},
 
       {"build.chunk_triangles", T::integer, std::int64_t{1} << 22, std::int64_t{1024}, std::int64_t{1} << 30, {},

@@ -83,6 +83,7 @@ AcceleratorOptions accelerator_options(const Config& config) {
   options.hmq.epsilon = config.real("accel.hmq.epsilon");
   options.hmq.leaf_size = static_cast<std::uint32_t>(config.integer("accel.hmq.leaf_size"));
   options.hmq.top_fraction = config.real("accel.hmq.top_fraction");
+  options.hmq.width = static_cast<std::uint32_t>(config.integer("accel.hmq.width"));
   options.hmq.bins = options.bvh.bins;
   if (options.hmq.epsilon > 0.0 && options.hmq.bits != 16) {
     throw ConfigError(fmt::format("accel.hmq.bits = {} and accel.hmq.epsilon = {}: set one of them",
@@ -94,6 +95,9 @@ AcceleratorOptions accelerator_options(const Config& config) {
   options.mlgrid.macrocell_factor = static_cast<std::uint32_t>(config.integer("accel.mlgrid.macrocell_factor"));
   if (options.bvh.width != 2 && options.bvh.width != 8) {
     throw ConfigError(fmt::format("accel.bvh.width = {}: must be 2 or 8", options.bvh.width));
+  }
+  if (options.hmq.width != 2 && options.hmq.width != 8) {
+    throw ConfigError(fmt::format("accel.hmq.width = {}: must be 2 or 8", options.hmq.width));
   }
   return options;
 }

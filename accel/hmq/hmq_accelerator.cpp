@@ -20,6 +20,8 @@
 #include "accel/hmq/global_grid.hpp"
 #include "accel/hmq/hmq_format.hpp"
 #include "accel/hmq/leaf_codec.hpp"
+#include "accel/hmq/leaf_hit.hpp"
+#include "accel/hmq/snapped_tree.hpp"
 #include "accel/probed_accelerator.hpp"
 #include "accel/section_archive.hpp"
 #include "kernels/checked_narrowing.hpp"
@@ -33,22 +35,6 @@ namespace {
 using namespace hmq;
 using Clock = std::chrono::steady_clock;
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
-
-void check_options(const HmqOptions& options) {
-  auto require = [](bool ok, const std::string& message) {
-    if (!ok) throw std::invalid_argument("hmq: " + message);
-  };
-  require(options.epsilon >= 0.0 && std::isfinite(options.epsilon),
-          fmt::format("epsilon = {}: must be a positive distance (0: unset)", options.epsilon));
-  require(options.epsilon == 0.0 || options.bits == 16,
-          fmt::format("bits = {} and epsilon = {} are both set; the grid comes from one of them", options.bits,
-                      options.epsilon));
-  require(options.bits >= 1 && options.bits <= 24, fmt::format("bits = {}: must be 1 .. 24", options.bits));
-  require(options.leaf_size >= 1 && options.leaf_size <= kMaxLeafTriangles,
-          fmt::format("leaf_size = {}: must be 1 .. {} (the strip table's limit)", options.leaf_size, kMaxLeafTriangles));
-  require(options.top_fraction >= 0.0 && options.top_fraction <= 1.0,
-          fmt::format("top_fraction = {}: must be 0 .. 1", options.top_fraction));
-}
 
 Box box_of(const Bounds3& bounds) { return {bounds.lower, bounds.upper}; }
 
@@ -179,18 +165,6 @@ class BlockEncoder {
   PartBytes& parts_;
 };
 
-// The nearest hit of one ray, kept in leaf terms until written.
-struct HmqHit {
-  float t = kInfinity;
-  float u = 0.0f, v = 0.0f;  // weights of the strip triangle's second and third corner
-  LeafHeader header{};
-  const std::byte* ids = nullptr;
-  const std::byte* corners = nullptr;
-  std::uint32_t triangle = 0;
-  glm::vec3 corner[3];  // the strip triangle's decoded corners, for the hit's point and normal
-  bool found = false;
-};
-
 // What an hmq world saves besides its arrays, `PREFIX` + "hmq.state" (88 bytes):
 //   offset  size  field
 //        0    12  grid origin, float x, y, z
@@ -248,31 +222,12 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
   }
 
   HmqAccelerator(const TriangleMesh& mesh, const HmqOptions& options) {
-    check_options(options);
-    if (mesh.triangle_count() == 0) throw std::invalid_argument("hmq: the mesh has no triangles");
     const auto start = Clock::now();
-    const Bounds3 grid_box = options.grid_bounds.value_or(mesh.bounds());
-    grid_ = options.epsilon > 0.0 ? grid_from_epsilon(grid_box, options.epsilon) : grid_from_bits(grid_box, options.bits);
-    QuantizedMesh quantized{&mesh, std::vector<glm::ivec3>(mesh.vertex_count())};
-    tbb::parallel_for(std::size_t{0}, mesh.vertex_count(),
-                      [&](std::size_t v) { quantized.lines[v] = grid_.snap(mesh.positions[v]); });
-    LargeArray<Bounds3> bounds(mesh.triangle_count());
-    tbb::parallel_for(std::size_t{0}, mesh.triangle_count(), [&](std::size_t t) {
-      Bounds3 box;
-      for (int k = 0; k < 3; ++k) box.extend(grid_.point(quantized.lines[mesh.triangles[t][k]]));
-      bounds[t] = box;
-    });
-    SahOptions sah;
-    sah.max_leaf_size = options.leaf_size;
-    sah.bins = options.bins;
-    // A leaf record has a fixed cost (header, id base, byte-aligned streams) that makes small
-    // leaves expensive in bytes; a traversal step priced at half a full leaf keeps leaves
-    // near full, as in the paper's Table 2 (about 3.3, 6.2 and 9.2 triangles per leaf for
-    // leaf sizes 4, 8, 12 on Lucy).
-    sah.traversal_cost = 0.5f * float(options.leaf_size);
-    const BuildTree tree = build_sah_tree(bounds, sah);
-    const std::size_t tree_peak = tree.peak_bytes + bounds.size() * sizeof(Bounds3);
-    bounds = {};
+    SnappedTree snapped = build_snapped_tree(mesh, options);
+    grid_ = snapped.grid;
+    const BuildTree& tree = snapped.tree;
+    const QuantizedMesh& quantized = snapped.quantized;
+    const std::size_t tree_peak = snapped.peak_bytes;
 
     // The uncompressed top: the first inner nodes in breadth-first order, as many as make the
     // top tree (those nodes and the leaves under them, one more) `top_fraction` of all nodes.
@@ -381,12 +336,12 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
       const WatertightRay sheared = make_watertight_ray(origin, direction);
       const float tmin = rays.tmin[i];
       float tmax = rays.tmax[i];
-      HmqHit best;
+      LeafHit best;
       walk_bvh(top_.data(), box_ray, tmin, tmax, probe, [&](const BvhNode& leaf) {
         traverse_blocks<kAnyHit>(leaf, box_ray, sheared, tmin, tmax, best, probe);
         return kAnyHit && best.found;
       });
-      write_hit<!kAnyHit>(best, hits, i, probe);
+      write_leaf_hit<!kAnyHit>(best, hits, i);
     }
   }
 
@@ -394,7 +349,7 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
   // the nearer child visited next and the farther one stacked, as in walk_bvh.
   template <bool kAnyHit, typename Probe>
   void traverse_blocks(const BvhNode& top_leaf, const BoxRay& box_ray, const WatertightRay& sheared, float tmin,
-                       float& tmax, HmqHit& best, Probe& probe) const {
+                       float& tmax, LeafHit& best, Probe& probe) const {
     struct Node {
       const std::byte* block;
       std::uint32_t word;  // its slot
@@ -468,43 +423,14 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
 
   template <bool kAnyHit, typename Probe>
   void test_leaf(const std::byte* block, std::uint32_t leaf, const Box& box, const WatertightRay& sheared, float tmin,
-                 float& tmax, HmqHit& best, Probe& probe) const {
+                 float& tmax, LeafHit& best, Probe& probe) const {
     const std::uint32_t node_slots = static_cast<std::uint8_t>(block[0]);
     const std::uint32_t forward_slots = static_cast<std::uint8_t>(block[1]);
     std::uint16_t offset;
     const std::byte* offset_at = block + kBlockHeaderBytes + 4 * (node_slots + forward_slots) + 2 * leaf;
     probe.read(offset_at, 2);
     std::memcpy(&offset, offset_at, 2);
-    const std::byte* record = block + offset;
-    if constexpr (Probe::kRecords) probe.read(record, leaf_record_bytes(record));
-    DecodedLeaf decoded;
-    decode_leaf(record, grid_, snap_outward(grid_, box), decoded);
-    const StripLayoutEntry& layout = *decoded.layout;
-    for (std::uint32_t k = 0; k < layout.triangles; ++k) {
-      const glm::vec3* corner = decoded.slot_position + layout.first_slot[k];
-      TriangleHit hit;
-      if (intersect_watertight(sheared, corner[0], corner[1], corner[2], tmin, tmax, hit)) {
-        tmax = hit.t;
-        best = {hit.t, hit.u, hit.v, decoded.header, decoded.ids, decoded.corners, k, {}, true};
-        if constexpr (kAnyHit) return;
-        best.corner[0] = corner[0];
-        best.corner[1] = corner[1];
-        best.corner[2] = corner[2];
-      }
-    }
-  }
-
-  // With kSurface (closest hits, whose corners test_leaf kept) also the point and normal.
-  template <bool kSurface, typename Probe>
-  static void write_hit(const HmqHit& best, HitBatch& hits, std::uint32_t i, Probe& probe) {
-    if (!best.found) return write_miss(hits, i);
-    std::uint32_t delta[kMaxLeafTriangles], code[kMaxLeafTriangles];
-    read_stream(best.ids, best.header.id_bits, best.triangle + 1, delta);
-    read_stream(best.corners, 3, best.triangle + 1, code);
-    const float weight[3] = {1.0f - best.u - best.v, best.u, best.v};
-    hits.set_hit(i, best.t, best.header.id_base + delta[best.triangle], weight[code[best.triangle] / 3],
-                 weight[code[best.triangle] % 3]);
-    if constexpr (kSurface) set_surface_from_strip(hits, i, best.corner, code[best.triangle]);
+    test_leaf_record<kAnyHit>(block + offset, grid_, box, sheared, tmin, tmax, best, probe);
   }
 
   GlobalGrid grid_;
@@ -518,6 +444,7 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
 }  // namespace
 
 std::unique_ptr<Accelerator> make_hmq_accelerator(const TriangleMesh& mesh, const HmqOptions& options) {
+  if (options.width == 8) return make_wide_hmq_accelerator(mesh, options);
   return std::make_unique<HmqAccelerator>(mesh, options);
 }
 

@@ -23,6 +23,10 @@ struct HmqOptions {
   double epsilon = 0.0;
   std::uint32_t leaf_size = 8;   // most triangles per leaf, 1 .. 14 (the paper's table: 4, 8, 12)
   double top_fraction = 0.05;    // share of the BVH's nodes kept uncompressed at its top, 0 .. 1
+                                 // (binary layout only: the 8-wide one quantizes every node)
+  // 2: the paper's binary tree of 4-byte nodes in blocks; 8: 64-byte nodes of eight children
+  // quantized to 8 bits per plane, tested in AVX2 lanes (wide_hmq_node.hpp). Same leaves.
+  std::uint32_t width = 2;
   std::uint32_t bins = 16;       // SAH bins
   // The box the global grid spans: the whole scene's when a chunk is built, so that every
   // chunk snaps to the same grid and shared vertices decode alike; unset: the mesh's box.
@@ -34,5 +38,8 @@ std::unique_ptr<Accelerator> make_hmq_accelerator(const TriangleMesh& mesh, cons
 // The hmq structure saved under the loader's prefix, traced in place (format in hmq_accelerator.cpp).
 class SectionLoader;
 std::unique_ptr<Accelerator> load_hmq_accelerator(const SectionLoader& loader);
+// The 8-wide layout's (wide_hmq_accelerator.cpp); make_hmq_accelerator calls it for width 8.
+std::unique_ptr<Accelerator> make_wide_hmq_accelerator(const TriangleMesh& mesh, const HmqOptions& options);
+std::unique_ptr<Accelerator> load_wide_hmq_accelerator(const SectionLoader& loader);
 
 }  // namespace wavetrace

@@ -1,0 +1,71 @@
+// The 8-wide layout of HMQ (`hmq:width=8`): the paper's leaves and global grid under 64-byte
+// nodes of eight children, each child box quantized to 8 bits per plane against the node's
+// own box as its parent decoded it (the frame), as compressed wide BVHs (Ylitie, Karras and
+// Laine 2017) and Embree's quantized nodes do, but with no float frame stored: the frame
+// travels down the traversal stack, as HMQ's 4-bit binary nodes do.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+#include "accel/hmq/hmq_format.hpp"
+
+namespace wavetrace::hmq {
+
+// WideHmqNode, 64 bytes, 64-byte aligned (one cache line). Children sit in slots 0..7; with
+// F = the frame (the node's decoded box) and step = (F.upper - F.lower) * (1.0f / 255.0f) per
+// axis, in floats, child k's box is
+//   lower = fma(q_lower[k], step, F.lower)      upper = fma(-q_upper[k], step, F.upper)
+// (fused multiply-adds, one rounding each; the encoder rounds q outward through this very
+// arithmetic, so the decoded box always holds the child's triangles).
+//
+//   offset  size  field
+//        0     8  lower_x[8]   uint8  q_lower of each slot's x
+//        8     8  upper_x[8]   uint8  q_upper of each slot's x
+//       16    16  lower_y, upper_y    the same for y
+//       32    16  lower_z, upper_z    the same for z
+//       48     4  child_base   uint32 node index of the first inner child; the node's inner
+//                                     children are nodes child_base, child_base + 1, ... in
+//                                     slot order
+//       52     4  leaf_base    uint32 word (4-byte) offset in the leaf array of the first leaf
+//                                     child's record; the others follow in slot order
+//       56     8  meta[8]      uint8  0: empty slot; 0x80: inner child; 1 .. 127: leaf child
+//                                     whose record takes that many words
+// A leaf record (hmq_format.hpp, unchanged) starts 4-byte aligned and is zero-padded to a
+// whole word; its grid box is its decoded box snapped outward, as in the binary layout.
+//
+// Slot order (Ylitie et al. 2017, §3.2): slot s holds the child that rays whose direction has
+// the signs of s (bit 0: x < 0, bit 1: y < 0, bit 2: z < 0) meet first, so a ray of octant o
+// visits slots o ^ 0, o ^ 1, ..., o ^ 7 in that order, near first without sorting.
+struct alignas(64) WideHmqNode {
+  static constexpr int kWidth = 8;
+  static constexpr std::uint8_t kInnerMeta = 0x80;
+  static constexpr std::uint32_t kMaxLeafWords = 127;
+  std::uint8_t lower_x[kWidth], upper_x[kWidth];
+  std::uint8_t lower_y[kWidth], upper_y[kWidth];
+  std::uint8_t lower_z[kWidth], upper_z[kWidth];
+  std::uint32_t child_base;
+  std::uint32_t leaf_base;
+  std::uint8_t meta[kWidth];
+
+  const std::uint8_t* lower(int axis) const { return reinterpret_cast<const std::uint8_t*>(this) + 16 * axis; }
+  const std::uint8_t* upper(int axis) const { return reinterpret_cast<const std::uint8_t*>(this) + 16 * axis + 8; }
+  std::uint8_t* lower(int axis) { return reinterpret_cast<std::uint8_t*>(this) + 16 * axis; }
+  std::uint8_t* upper(int axis) { return reinterpret_cast<std::uint8_t*>(this) + 16 * axis + 8; }
+};
+static_assert(sizeof(WideHmqNode) == 64, "the wide HMQ node is one cache line");
+
+inline float frame_step(const Box& frame, int axis) { return (frame.upper[axis] - frame.lower[axis]) * (1.0f / 255.0f); }
+
+// Slot `slot`'s box, one lane of what traversal computes for all eight (bit-identical).
+inline Box decode_wide_child(const WideHmqNode& node, int slot, const Box& frame) {
+  Box child;
+  for (int axis = 0; axis < 3; ++axis) {
+    const float step = frame_step(frame, axis);
+    child.lower[axis] = std::fma(float(node.lower(axis)[slot]), step, frame.lower[axis]);
+    child.upper[axis] = std::fma(-float(node.upper(axis)[slot]), step, frame.upper[axis]);
+  }
+  return child;
+}
+
+}  // namespace wavetrace::hmq
