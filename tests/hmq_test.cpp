@@ -194,10 +194,10 @@ TEST(HmqLeaf, RecordDecodesToTheSnappedVerticesIdsAndCorners) {
       const std::uint32_t id = leaf.triangle_id(k);
       ids.insert(id);
       const glm::uvec3& corners = scene.mesh.triangles[id];
-      const glm::vec3* slot = leaf.slot_position + leaf.layout->first_slot[k];
+      const std::uint32_t first = leaf.layout->first_slot[k];
       const std::uint32_t code = leaf.corner_code(k);
-      EXPECT_EQ(slot[code / 3], grid.point(quantized.lines[corners.y])) << "triangle " << k;
-      EXPECT_EQ(slot[code % 3], grid.point(quantized.lines[corners.z])) << "triangle " << k;
+      EXPECT_EQ(leaf.slot_position(first + code / 3), grid.point(quantized.lines[corners.y])) << "triangle " << k;
+      EXPECT_EQ(leaf.slot_position(first + code % 3), grid.point(quantized.lines[corners.z])) << "triangle " << k;
     }
     EXPECT_EQ(ids, std::multiset<std::uint32_t>(triangles.begin(), triangles.end()));
   }

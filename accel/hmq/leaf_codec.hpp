@@ -37,14 +37,21 @@ inline GridBox snap_outward(const GlobalGrid& grid, const Box& box) {
 void encode_leaf(const QuantizedMesh& quantized, std::span<const std::uint32_t> triangles, const GridBox& box,
                  std::vector<std::byte>& out);
 
-// A decoded leaf: vertex positions per slot, ready for triangle tests.
+// A decoded leaf: vertex positions in columns (SoA, ready to gather into triangle lanes)
+// and which vertex each strip slot holds.
 struct DecodedLeaf {
   LeafHeader header;
   const StripLayoutEntry* layout;
-  glm::vec3 slot_position[64];
+  alignas(32) float position[3][64];  // per axis, per vertex
+  alignas(32) std::uint32_t slot_vertex[64];  // indexed strips: the vertex of each slot; else unused
   const std::byte* ids;      // the id stream
   const std::byte* corners;  // the corner stream
 
+  std::uint32_t vertex_of_slot(std::uint32_t slot) const { return header.indexed ? slot_vertex[slot] : slot; }
+  glm::vec3 slot_position(std::uint32_t slot) const {
+    const std::uint32_t v = vertex_of_slot(slot);
+    return {position[0][v], position[1][v], position[2][v]};
+  }
   std::uint32_t triangle_id(std::uint32_t k) const {
     std::uint32_t delta[kMaxLeafTriangles];
     read_stream(ids, header.id_bits, k + 1, delta);
@@ -57,35 +64,32 @@ struct DecodedLeaf {
   }
 };
 
+// Vertex v's grid line on an axis is the leaf box's plane its offset counts from (the
+// min-max trick), and its position the grid point of that line: origin + line * cell, the
+// float operations of GlobalGrid::point. A plain loop over the vertices, which GCC vectorizes.
 inline void decode_leaf(const std::byte* record, const GlobalGrid& grid, const GridBox& box, DecodedLeaf& leaf) {
   leaf.header = read_leaf_header(record);
   leaf.layout = &StripTable::instance().entry(leaf.header.entry);
   const std::uint32_t vertices = leaf.header.vertex_count;
   const std::byte* data = record + kLeafHeaderBytes;
-  std::uint32_t values[3][64];
   for (int axis = 0; axis < 3; ++axis) {
     const std::uint32_t bits = leaf.header.axis_bits[axis] + 1;
-    read_stream(data, bits, vertices, values[axis]);
+    alignas(32) std::uint32_t values[64];
+    read_stream(data, bits, vertices, values);
     data += stream_bytes(bits, vertices);
-  }
-  glm::vec3 vertex[64];
-  for (std::uint32_t i = 0; i < vertices; ++i) {
-    glm::ivec3 line;
-    for (int axis = 0; axis < 3; ++axis) {
-      const std::uint32_t value = values[axis][i];
-      const int offset = static_cast<int>(value >> 1);
-      line[axis] = (value & 1u) ? box.upper[axis] - offset : box.lower[axis] + offset;
+    const int lower = box.lower[axis], upper = box.upper[axis];
+    const float origin = grid.origin[axis], cell = grid.cell[axis];
+    float* position = leaf.position[axis];
+    for (std::uint32_t i = 0; i < vertices; ++i) {
+      const int offset = static_cast<int>(values[i] >> 1);
+      const int line = (values[i] & 1u) ? upper - offset : lower + offset;
+      position[i] = origin + float(line) * cell;
     }
-    vertex[i] = grid.point(line);
   }
   const std::uint32_t slots = leaf.layout->slots;
   if (leaf.header.indexed) {
-    std::uint32_t index[64];
-    read_stream(data, leaf.header.index_bits, slots, index);
+    read_stream(data, leaf.header.index_bits, slots, leaf.slot_vertex);
     data += stream_bytes(leaf.header.index_bits, slots);
-    for (std::uint32_t s = 0; s < slots; ++s) leaf.slot_position[s] = vertex[index[s]];
-  } else {
-    for (std::uint32_t s = 0; s < slots; ++s) leaf.slot_position[s] = vertex[s];
   }
   const std::uint32_t triangles = leaf.layout->triangles;
   leaf.ids = data;

@@ -21,7 +21,8 @@ struct StripLayoutEntry {
   std::array<std::uint8_t, kMaxLeafTriangles> strip_length{};  // longest first
   // Triangle k has the corners (slot[k], slot[k] + 1, slot[k] + 2); `flipped` is set for the
   // odd triangles of a strip, whose winding the strip reverses.
-  std::array<std::uint8_t, kMaxLeafTriangles> first_slot{};
+  // 16 entries, the last two always zero, so two 8-byte loads cover every triangle.
+  std::array<std::uint8_t, 16> first_slot{};
   std::array<bool, kMaxLeafTriangles> flipped{};
 };
 

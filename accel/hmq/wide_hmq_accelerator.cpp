@@ -1,7 +1,7 @@
 // `hmq:width=8`: HMQ's global grid and leaf records under 8-wide nodes quantized against
 // their frames (wide_hmq_node.hpp). Build: the binary SAH tree collapsed to eight children
-// a node, children placed in octant slots; traversal: one ray at a time, the eight child
-// boxes decoded and tested in AVX2 lanes, the entered ones pushed nearest-last in one pass.
+// a node, the cut chosen by surface area; traversal: one ray at a time, the eight child
+// boxes decoded and tested in AVX2 lanes, the entered ones sorted by distance onto the stack.
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -26,6 +26,7 @@
 #include <immintrin.h>
 #endif
 
+
 namespace wavetrace {
 
 #if defined(__AVX2__) && defined(__FMA__)
@@ -33,8 +34,9 @@ namespace {
 
 using namespace hmq;
 constexpr int kWidth = WideHmqNode::kWidth;
+constexpr std::size_t kUnit = WideHmqNode::kLeafUnitBytes;
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
-// A stack or child reference: a node index, or with this bit a leaf record's word offset.
+// A stack or child reference: a node index, or with this bit a leaf record's offset in units.
 constexpr std::uint32_t kLeafRef = 0x8000'0000u;
 
 float half_area(const Bounds3& b) {
@@ -55,35 +57,6 @@ std::uint8_t quantize_upper(float frame_upper, float step, float upper) {
   float q = std::clamp(std::floor((frame_upper - upper) / step), 0.0f, 255.0f);
   while (q > 0.0f && std::fma(-q, step, frame_upper) < upper) q -= 1.0f;
   return static_cast<std::uint8_t>(q);
-}
-
-// The slot of each child (Ylitie et al. 2017): slot s goes to the child that lies furthest
-// against the direction of octant s, so rays of that octant meet it first. Greedy over all
-// (child, slot) pairs by that cost, which the paper finds as good as an optimal assignment.
-std::array<int, kWidth> assign_slots(const std::vector<Bounds3>& children, const Bounds3& parent) {
-  struct Pair {
-    float cost;
-    int child, slot;
-  };
-  std::vector<Pair> pairs;
-  const glm::vec3 centre = parent.lower + parent.upper;
-  for (int c = 0; c < int(children.size()); ++c) {
-    const glm::vec3 offset = children[c].lower + children[c].upper - centre;
-    for (int s = 0; s < kWidth; ++s) {
-      const glm::vec3 octant((s & 1) ? -1.0f : 1.0f, (s & 2) ? -1.0f : 1.0f, (s & 4) ? -1.0f : 1.0f);
-      pairs.push_back({offset.x * octant.x + offset.y * octant.y + offset.z * octant.z, c, s});
-    }
-  }
-  std::stable_sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) { return a.cost < b.cost; });
-  std::array<int, kWidth> child_in_slot;
-  child_in_slot.fill(-1);
-  std::vector<bool> placed(children.size(), false);
-  for (const Pair& pair : pairs) {
-    if (placed[pair.child] || child_in_slot[pair.slot] >= 0) continue;
-    placed[pair.child] = true;
-    child_in_slot[pair.slot] = pair.child;
-  }
-  return child_in_slot;
 }
 
 // Which binary nodes become wide nodes (Ylitie et al. 2017, §3.1, without their leaf
@@ -174,15 +147,10 @@ class WideEncoder {
   // allocates its inner children next to each other, and fills them depth first.
   void encode(std::uint32_t root, std::uint32_t index, const Box& frame) {
     const std::vector<std::uint32_t> children = collapse(root);
-    std::vector<Bounds3> child_bounds;
-    for (const std::uint32_t child : children) child_bounds.push_back(tree_.nodes[child].bounds);
-    const std::array<int, kWidth> child_in_slot = assign_slots(child_bounds, tree_.nodes[root].bounds);
-
     WideHmqNode node{};
     Box child_box[kWidth];
-    for (int slot = 0; slot < kWidth; ++slot) {
-      if (child_in_slot[slot] < 0) continue;
-      const Bounds3& bounds = child_bounds[child_in_slot[slot]];
+    for (int slot = 0; slot < int(children.size()); ++slot) {
+      const Bounds3& bounds = tree_.nodes[children[slot]].bounds;
       for (int axis = 0; axis < 3; ++axis) {
         const float step = frame_step(frame, axis);
         node.lower(axis)[slot] = quantize_lower(frame.lower[axis], step, bounds.lower[axis]);
@@ -191,11 +159,10 @@ class WideEncoder {
       child_box[slot] = decode_wide_child(node, slot, frame);
     }
 
-    node.leaf_base = checked_uint32(leaves_.size() / 4, "hmq:width=8 leaf words");
+    node.leaf_base = checked_uint32(leaves_.size() / kUnit, "hmq:width=8 leaf offset");
     std::uint32_t inner_count = 0;
-    for (int slot = 0; slot < kWidth; ++slot) {
-      if (child_in_slot[slot] < 0) continue;
-      const BuildNode& child = tree_.nodes[children[child_in_slot[slot]]];
+    for (int slot = 0; slot < int(children.size()); ++slot) {
+      const BuildNode& child = tree_.nodes[children[slot]];
       if (!child.leaf()) {
         node.meta[slot] = WideHmqNode::kInnerMeta;
         ++inner_count;
@@ -203,8 +170,8 @@ class WideEncoder {
       }
       node.meta[slot] = static_cast<std::uint8_t>(encode_leaf_record(child, child_box[slot]));
     }
-    if (leaves_.size() / 4 >= kLeafRef) {
-      throw std::length_error("hmq:width=8: the leaf records pass 8 GiB; build in smaller chunks (build.chunk_triangles)");
+    if (leaves_.size() / kUnit >= kLeafRef) {
+      throw std::length_error("hmq:width=8: the leaf records pass 4 GiB; build in smaller chunks (build.chunk_triangles)");
     }
     node.child_base = checked_uint32(nodes_.size(), "hmq:width=8 nodes");
     nodes_.resize(nodes_.size() + inner_count);
@@ -212,7 +179,7 @@ class WideEncoder {
     parts_.hierarchy += sizeof(WideHmqNode);
     std::uint32_t next = node.child_base;
     for (int slot = 0; slot < kWidth; ++slot) {
-      if (node.meta[slot] == WideHmqNode::kInnerMeta) encode(children[child_in_slot[slot]], next++, child_box[slot]);
+      if (node.meta[slot] == WideHmqNode::kInnerMeta) encode(children[slot], next++, child_box[slot]);
     }
   }
 
@@ -228,7 +195,7 @@ class WideEncoder {
     return children;
   }
 
-  // Appends the leaf's record, zero-padded to whole words; returns its words.
+  // Appends the leaf's record, zero-padded to whole 2-byte units; returns its units.
   std::uint32_t encode_leaf_record(const BuildNode& leaf, const Box& box) {
     const std::size_t start = leaves_.size();
     encode_leaf(quantized_, std::span(tree_.primitive_order.data() + leaf.first, leaf.count), snap_outward(grid_, box),
@@ -236,13 +203,13 @@ class WideEncoder {
     const LeafHeader header = read_leaf_header(leaves_.data() + start);
     const std::size_t identity = stream_bytes(header.id_bits, leaf.count) + stream_bytes(3, leaf.count);
     const std::size_t record = leaves_.size() - start;
-    leaves_.resize(start + (record + 3) / 4 * 4, std::byte{0});
+    leaves_.resize(start + (record + kUnit - 1) / kUnit * kUnit, std::byte{0});
     parts_.other += identity;
     parts_.geometry += record - identity;
     parts_.hierarchy += leaves_.size() - start - record;
-    const std::size_t words = (leaves_.size() - start) / 4;
-    if (words > WideHmqNode::kMaxLeafWords) throw std::logic_error("hmq:width=8: a leaf record over 127 words");
-    return static_cast<std::uint32_t>(words);
+    const std::size_t units = (leaves_.size() - start) / kUnit;
+    if (units > WideHmqNode::kMaxLeafUnits) throw std::logic_error("hmq:width=8: a leaf record over 508 bytes");
+    return static_cast<std::uint32_t>(units);
   }
 
   const BuildTree& tree_;
@@ -254,38 +221,52 @@ class WideEncoder {
   PartBytes& parts_;
 };
 
-// Lane indices of the set bits of an 8-bit mask, lowest first, as eight bytes: the
-// permutation that packs the entered children to the front of a vector.
-constexpr std::array<std::uint64_t, 256> kCompressLanes = [] {
-  std::array<std::uint64_t, 256> table{};
-  for (unsigned mask = 0; mask < 256; ++mask) {
-    std::uint64_t lanes = 0;
-    int out = 0;
-    for (int lane = 0; lane < 8; ++lane) {
-      if (mask & (1u << lane)) lanes |= std::uint64_t(lane) << (8 * out++);
+// Bitonic network over eight int32 lanes, descending: per stage, lane i meets lane i ^ j and
+// keeps the larger when `kTakeMax` says so.
+struct SortStage {
+  int partner[8];
+  int take_max[8];
+};
+constexpr std::array<SortStage, 6> kDescendingStages = [] {
+  std::array<SortStage, 6> stages{};
+  int n = 0;
+  for (int k = 2; k <= 8; k *= 2) {
+    for (int j = k / 2; j >= 1; j /= 2, ++n) {
+      for (int i = 0; i < 8; ++i) {
+        stages[n].partner[i] = i ^ j;
+        const bool upper = (i & j) != 0, descending_block = (i & k) != 0;
+        stages[n].take_max[i] = (upper != descending_block) ? 0 : -1;  // descending overall
+      }
     }
-    table[mask] = lanes;
   }
-  return table;
+  return stages;
 }();
 
+[[gnu::always_inline]] inline __m256i sort_descending(__m256i keys) {
+  for (const SortStage& stage : kDescendingStages) {
+    const __m256i other = _mm256_permutevar8x32_epi32(keys, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(stage.partner)));
+    keys = _mm256_blendv_epi8(_mm256_min_epi32(keys, other), _mm256_max_epi32(keys, other),
+                              _mm256_loadu_si256(reinterpret_cast<const __m256i*>(stage.take_max)));
+  }
+  return keys;
+}
+
 // Each child's reference: inner children number from child_base in slot order, leaf
-// records from leaf_base by the words of the leaf slots before them (exclusive prefix sums
-// over the meta bytes, in 16-bit lanes: leaf words in bits 0-9, inner count in bits 10-13).
+// records from leaf_base by the units of the leaf slots before them (exclusive prefix sums
+// over the meta bytes, in 16-bit lanes: leaf units in bits 0-10, inner count in bits 11-14).
 [[gnu::always_inline]] inline __m256i child_references(const WideHmqNode& node) {
   const __m128i meta = _mm_cvtepu8_epi16(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(node.meta)));
-  const __m128i inner = _mm_srli_epi16(meta, 7);
-  const __m128i counts = _mm_or_si128(_mm_and_si128(meta, _mm_set1_epi16(0x7f)), _mm_slli_epi16(inner, 10));
+  const __m128i inner = _mm_cmpeq_epi16(meta, _mm_set1_epi16(WideHmqNode::kInnerMeta));
+  const __m128i counts = _mm_or_si128(_mm_andnot_si128(inner, meta), _mm_and_si128(inner, _mm_set1_epi16(1 << 11)));
   __m128i sums = _mm_add_epi16(counts, _mm_slli_si128(counts, 2));
   sums = _mm_add_epi16(sums, _mm_slli_si128(sums, 4));
   sums = _mm_add_epi16(sums, _mm_slli_si128(sums, 8));
   const __m256i before = _mm256_cvtepu16_epi32(_mm_sub_epi16(sums, counts));
   const __m256i leaf = _mm256_or_si256(_mm256_add_epi32(_mm256_set1_epi32(int(node.leaf_base)),
-                                                        _mm256_and_si256(before, _mm256_set1_epi32(1023))),
+                                                        _mm256_and_si256(before, _mm256_set1_epi32(2047))),
                                        _mm256_set1_epi32(int(kLeafRef)));
-  const __m256i child = _mm256_add_epi32(_mm256_set1_epi32(int(node.child_base)), _mm256_srli_epi32(before, 10));
-  const __m256i is_inner = _mm256_cmpeq_epi32(_mm256_cvtepu16_epi32(inner), _mm256_set1_epi32(1));
-  return _mm256_blendv_epi8(leaf, child, is_inner);
+  const __m256i child = _mm256_add_epi32(_mm256_set1_epi32(int(node.child_base)), _mm256_srli_epi32(before, 11));
+  return _mm256_blendv_epi8(leaf, child, _mm256_cvtepi16_epi32(inner));
 }
 
 // What an hmq:width=8 world saves besides its arrays, `PREFIX` + "hmq8.state" (112 bytes):
@@ -422,10 +403,6 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
       const __m256 origin_lanes[3] = {_mm256_set1_ps(origin.x), _mm256_set1_ps(origin.y), _mm256_set1_ps(origin.z)};
       const __m256 inverse_lanes[3] = {_mm256_set1_ps(1.0f / direction.x), _mm256_set1_ps(1.0f / direction.y),
                                        _mm256_set1_ps(1.0f / direction.z)};
-      const int octant = std::signbit(direction.x) | std::signbit(direction.y) << 1 | std::signbit(direction.z) << 2;
-      // Lane j of a pushed vector is slot j ^ 7 ^ octant: the nearest-first order reversed,
-      // so the nearest child ends on top of the stack.
-      const __m256i push_order = _mm256_xor_si256(lane_index, _mm256_set1_epi32(7 ^ octant));
       const float tmin = rays.tmin[i];
       float tmax = rays.tmax[i];
       LeafHit best;
@@ -456,18 +433,34 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
           const __m256i empty = _mm256_cvtepi8_epi32(
               _mm_cmpeq_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(node.meta)), _mm_setzero_si128()));
           const __m256 entered = _mm256_andnot_ps(_mm256_castsi256_ps(empty), _mm256_cmp_ps(near, far, _CMP_LE_OQ));
-          const auto pushed = static_cast<unsigned>(_mm256_movemask_ps(_mm256_permutevar8x32_ps(entered, push_order)));
-          if (pushed != 0) {
-            const __m256i order = _mm256_permutevar8x32_epi32(
-                push_order, _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(static_cast<long long>(kCompressLanes[pushed]))));
+          const auto entered_mask = static_cast<unsigned>(_mm256_movemask_ps(entered));
+          if (std::has_single_bit(entered_mask)) {  // one child: go down, nothing to order or stack
+            const int lane = std::countr_zero(entered_mask);
+            alignas(32) std::uint32_t reference[kWidth];
+            alignas(32) float lanes[6][kWidth];
+            _mm256_store_si256(reinterpret_cast<__m256i*>(reference), child_references(node));
+            for (int b = 0; b < 6; ++b) _mm256_store_ps(lanes[b], bound[b]);
+            current = reference[lane];
+            frame = {{lanes[0][lane], lanes[1][lane], lanes[2][lane]}, {lanes[3][lane], lanes[4][lane], lanes[5][lane]}};
+            continue;
+          }
+          if (entered_mask != 0) {
+            // Nearest first, by sorting: keys are the entry distance's bits (>= 0, so they order
+            // as integers) with the lane in the low three, lanes not entered -1, sorted
+            // descending so that the nearest child lands on top of the stack.
+            const __m256i keys = _mm256_blendv_epi8(
+                _mm256_set1_epi32(-1),
+                _mm256_or_si256(_mm256_and_si256(_mm256_castps_si256(near), _mm256_set1_epi32(~7)), lane_index),
+                _mm256_castps_si256(entered));
+            const __m256i order = _mm256_and_si256(sort_descending(keys), _mm256_set1_epi32(7));
             _mm256_storeu_si256(reinterpret_cast<__m256i*>(stack.reference + top),
                                 _mm256_permutevar8x32_epi32(child_references(node), order));
             _mm256_storeu_ps(stack.distance + top, _mm256_permutevar8x32_ps(near, order));
             for (int b = 0; b < 6; ++b) _mm256_storeu_ps(stack.bound[b] + top, _mm256_permutevar8x32_ps(bound[b], order));
-            top += static_cast<std::uint32_t>(std::popcount(pushed));
+            top += static_cast<std::uint32_t>(std::popcount(entered_mask));
           }
         } else {
-          test_leaf_record<kAnyHit>(leaves + std::size_t(current & ~kLeafRef) * 4, grid_, frame, sheared, tmin, tmax,
+          test_leaf_record<kAnyHit>(leaves + std::size_t(current & ~kLeafRef) * kUnit, grid_, frame, sheared, tmin, tmax,
                                     best, probe);
           if (kAnyHit && best.found) break;
         }

@@ -1,0 +1,124 @@
+// hmq:width=8: the very hits of the binary layout (the same snapped triangles, and node boxes
+// that never lose one), on the scenes where methods fail too; closed meshes do not leak;
+// memory, the collapse, and bad options.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "accel/hmq/hmq_accelerator.hpp"
+#include "accel/hmq/wide_hmq_node.hpp"
+#include "accel/registry.hpp"
+#include "accel_agreement.hpp"
+#include "bench/accel_bench.hpp"
+#include "bench/leak_bench.hpp"
+#include "scene/builtin_scenes.hpp"
+#include "scene/scene.hpp"
+#include "stages/render_setup.hpp"
+#include "test_support.hpp"
+
+namespace wavetrace {
+namespace {
+
+using namespace hmq;
+
+HmqOptions hmq_options(std::uint32_t width, std::uint32_t leaf_size, std::uint32_t bits) {
+  HmqOptions options;
+  options.width = width;
+  options.leaf_size = leaf_size;
+  options.bits = bits;
+  return options;
+}
+
+std::string scene_label(const ::testing::TestParamInfo<std::string>& info) {
+  static const std::vector<std::string> names = {"sphere", "soup", "terrain", "stadium", "fur", "bunny"};
+  return names[info.index];
+}
+
+class WideHmqMatchesBinary : public ::testing::TestWithParam<std::string> {};
+
+// Both layouts hold the same leaves over the same grid, so every ray must find the same
+// nearest surface. A child box quantized too tightly would lose hits here; one decoded
+// differently from the encoder, too. Distances agree to float rounding: where snapping makes
+// two triangles coincide (stadium, fur, bits = 10), the layouts' different visiting orders
+// may meet either one first, at distances a few ulps apart.
+TEST_P(WideHmqMatchesBinary, SameHitsAndDistancesOnEveryRayKind) {
+  const Scene scene = load_scene({GetParam(), 0});
+  const float tolerance = 1e-6f * scene.mesh.bounds().diagonal();
+  for (const std::uint32_t leaf_size : {1u, 8u, 14u}) {
+    for (const std::uint32_t bits : {10u, 16u}) {
+      const auto binary = make_hmq_accelerator(scene.mesh, hmq_options(2, leaf_size, bits));
+      const auto wide = make_hmq_accelerator(scene.mesh, hmq_options(8, leaf_size, bits));
+      ASSERT_EQ(wide->name(), "hmq8");
+      for (const RaySetKind kind : {RaySetKind::primary, RaySetKind::diffuse, RaySetKind::shadow, RaySetKind::random}) {
+        const testing::Agreement result = testing::compare_on_rays(scene, *binary, *wide, kind, 4000, tolerance, 1e-4f);
+        const std::string label = to_string(kind) + " leaf_size " + std::to_string(leaf_size) + " bits " + std::to_string(bits);
+        EXPECT_EQ(result.hit_differs, 0u) << label;
+        EXPECT_EQ(result.far_t, 0u) << label;
+        EXPECT_EQ(result.far_uv, 0u) << label;
+      }
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, WideHmqMatchesBinary,
+                         ::testing::Values("builtin:sphere:50k", "builtin:soup:20k", "builtin:terrain:30k",
+                                           "builtin:stadium:2000", "builtin:fur:30k",
+                                           std::string(WAVETRACE_DATA_DIR) + "/bunny00.off"),
+                         scene_label);
+
+TEST(WideHmq, NoRayEscapesClosedMeshes) {
+  for (const char* source : {"builtin:sphere:100k", "builtin:room:50k"}) {
+    const Scene scene = make_builtin_scene(source);
+    const LeakReport report = run_leak_bench(scene,
+                                             {parse_accelerator_spec("hmq:width=8:bits=8", Config{}),
+                                              parse_accelerator_spec("hmq:width=8", Config{}),
+                                              parse_accelerator_spec("hmq:width=8:leaf_size=2", Config{})},
+                                             100000, 0);
+    ASSERT_EQ(report.results.size(), 3u);
+    for (const LeakResult& result : report.results) EXPECT_EQ(result.escaped, 0u) << source << " " << result.label;
+  }
+}
+
+TEST(WideHmq, FewerBytesThanBinaryHmqAndFullNodes) {
+  const Scene scene = make_builtin_scene("builtin:room:100k");
+  const auto binary = make_hmq_accelerator(scene.mesh, hmq_options(2, 8, 16));
+  const auto wide = make_hmq_accelerator(scene.mesh, hmq_options(8, 8, 16));
+  std::size_t span_bytes = 0;
+  for (const auto& span : wide->memory_spans()) span_bytes += span.size();
+  EXPECT_EQ(wide->memory().total(), span_bytes);
+  EXPECT_LT(wide->memory().total(), binary->memory().total());
+  // The surface-area cut fills nodes (greedy collapsing left 4.0 children a node on room:1M).
+  const std::string notes = wide->build_notes();
+  const auto at = notes.find("children each");
+  ASSERT_NE(at, std::string::npos) << notes;
+  const double children = std::stod(notes.substr(notes.rfind('(', at) + 1));
+  EXPECT_GT(children, 5.5) << notes;
+  EXPECT_LE(children, 8.0) << notes;
+}
+
+TEST(WideHmq, DecodedChildOfAFullStepIsTheFrame) {
+  WideHmqNode node{};
+  const Box frame{{-1.0f, 2.0f, 0.0f}, {3.0f, 2.0f, 1e-3f}};  // one flat axis
+  node.upper(0)[3] = 255;
+  node.lower(2)[3] = 255;
+  const Box child = decode_wide_child(node, 3, frame);
+  EXPECT_EQ(child.lower.x, -1.0f);
+  EXPECT_NEAR(child.upper.x, -1.0f, 1e-6f);
+  EXPECT_EQ(child.lower.y, 2.0f);
+  EXPECT_EQ(child.upper.y, 2.0f);
+  EXPECT_NEAR(child.lower.z, 1e-3f, 1e-9f);
+  EXPECT_EQ(child.upper.z, 1e-3f);
+}
+
+TEST(WideHmq, BadWidthIsAClearError) {
+  const Scene scene = make_builtin_scene("builtin:sphere:2000");
+  EXPECT_THROW(make_hmq_accelerator(scene.mesh, hmq_options(4, 8, 16)), std::invalid_argument);
+  Config config;
+  config.set("accel.hmq.width=4");
+  EXPECT_THROW(accelerator_options(config), ConfigError);
+  EXPECT_THROW(parse_accelerator_spec("hmq:width=16", Config{}), ConfigError);
+}
+
+}  // namespace
+}  // namespace wavetrace
