@@ -1,5 +1,6 @@
 // Build (bounds, optional Morton reorder, SAH tree, flatten in the chosen node order) and
 // single-ray ordered traversal with a short stack of (node, entry distance) pairs.
+#include "accel/ray_loop.hpp"
 #include "accel/bvh/bvh_accelerator.hpp"
 
 #include <chrono>
@@ -69,21 +70,14 @@ class BvhAccelerator final : public ProbedAccelerator<BvhAccelerator> {
  private:
   template <bool kAnyHit, typename Probe>
   void traverse(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
-    for (std::uint32_t i = range.begin; i < range.end; ++i) {
-      if (!(rays.flags[i] & ray_flags::alive)) {
-        write_miss(hits, i);
-        continue;
-      }
-      const glm::vec3 origin(rays.origin_x[i], rays.origin_y[i], rays.origin_z[i]);
-      const glm::vec3 direction(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]);
-      LeafQuery query(geometry_, leaf_triangles_, origin, direction, rays.tmin[i], rays.tmax[i]);
-      walk_bvh(nodes_.data(), make_box_ray(origin, direction), query.tmin, query.tmax, probe,
-               [&](const BvhNode& leaf) {
-                 query.test_leaf<kAnyHit>(leaf.first, leaf.triangle_count(), probe);
-                 return kAnyHit && query.found();
-               });
+    for_each_ray(rays, hits, range, [&](const SingleRay& ray, std::uint32_t i) {
+      LeafQuery query(geometry_, leaf_triangles_, ray);
+      walk_bvh(nodes_.data(), ray.box, query.tmin, query.tmax, probe, [&](const BvhNode& leaf) {
+        query.test_leaf<kAnyHit>(leaf.first, leaf.triangle_count(), probe);
+        return kAnyHit && query.found();
+      });
       query.write<!kAnyHit>(hits, i, probe);
-    }
+    });
   }
 
   IndexedFaceSet geometry_;

@@ -8,27 +8,21 @@
 #include <vector>
 
 #include "accel/bvh/indexed_face_set.hpp"
+#include "accel/ray_loop.hpp"
 #include "kernels/triangle_intersect.hpp"
 #include "memory/ray_batch.hpp"
 
 namespace wavetrace {
 
-inline void write_miss(HitBatch& hits, std::uint32_t i) {
-  hits.t[i] = std::numeric_limits<float>::infinity();
-  hits.primitive[i] = kInvalidPrimitive;
-  hits.u[i] = hits.v[i] = 0.0f;
-}
-
 class LeafQuery {
  public:
   // `leaf_index` maps leaf slots to face-set slots; empty when the face set is in leaf order.
-  LeafQuery(const IndexedFaceSet& geometry, std::span<const std::uint32_t> leaf_index, const glm::vec3& origin,
-            const glm::vec3& direction, float tmin, float tmax)
-      : tmin(tmin),
-        tmax(tmax),
+  LeafQuery(const IndexedFaceSet& geometry, std::span<const std::uint32_t> leaf_index, const SingleRay& ray)
+      : tmin(ray.tmin),
+        tmax(ray.tmax),
         geometry_(geometry),
         leaf_index_(leaf_index.empty() ? nullptr : leaf_index.data()),
-        ray_(make_watertight_ray(origin, direction)) {}
+        ray_(ray.sheared) {}
 
   float tmin;
   float tmax;  // shrinks to the nearest hit found
@@ -63,7 +57,7 @@ class LeafQuery {
   // kSurface (closest-hit queries) also the hit's point and normal.
   template <bool kSurface, typename Probe>
   void write(HitBatch& hits, std::uint32_t i, Probe& probe) const {
-    if (!found()) return write_miss(hits, i);
+    if (!found()) return hits.set_miss(i);
     if constexpr (Probe::kRecords) {
       if (const std::uint32_t* id = geometry_.input_id_address(found_)) probe.read(id, sizeof *id);
     }

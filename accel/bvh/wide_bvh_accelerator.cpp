@@ -1,6 +1,7 @@
 // The 8-wide BVH: the binary SAH tree collapsed (each node adopts the largest-area inner
 // child's children until it has eight), traversed one ray at a time with all eight child
 // boxes tested in one AVX2 pass, nearest child first.
+#include "accel/ray_loop.hpp"
 #include "accel/bvh/wide_bvh_accelerator.hpp"
 
 #include <algorithm>
@@ -196,16 +197,11 @@ class WideBvhAccelerator final : public Accelerator {
     // Each level pushes at most seven siblings.
     StackEntry stack[kMaxTreeDepth * (kWidth - 1) + kWidth];
     const WideBvhNode* nodes = nodes_.data();
-    for (std::uint32_t i = range.begin; i < range.end; ++i) {
-      if (!(rays.flags[i] & ray_flags::alive)) {
-        write_miss(hits, i);
-        continue;
-      }
-      const glm::vec3 origin(rays.origin_x[i], rays.origin_y[i], rays.origin_z[i]);
-      const glm::vec3 direction(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]);
-      const WideRay box_ray{origin, 1.0f / direction,
+    for_each_ray(rays, hits, range, [&](const SingleRay& ray, std::uint32_t i) {
+      const glm::vec3& direction = ray.direction;
+      const WideRay box_ray{ray.origin, ray.box.inverse_direction,
                             (direction.x == 0.0f) | (direction.y == 0.0f) << 1 | (direction.z == 0.0f) << 2};
-      LeafQuery query(geometry_, leaf_triangles_, origin, direction, rays.tmin[i], rays.tmax[i]);
+      LeafQuery query(geometry_, leaf_triangles_, ray);
       const float tmin = query.tmin;
       float& tmax = query.tmax;
 
@@ -248,7 +244,7 @@ class WideBvhAccelerator final : public Accelerator {
         current = stack[--top];
       }
       query.write<!kAnyHit>(hits, i, probe);
-    }
+    });
   }
 
   IndexedFaceSet geometry_;

@@ -1,5 +1,6 @@
 // Embree 3 wrapper: one triangle geometry with shared buffers, rtcIntersect1/rtcOccluded1
 // per ray (the configuration the papers and PLATFORM.md measure).
+#include "accel/ray_loop.hpp"
 #include "accel/embree/embree_accelerator.hpp"
 #include "accel/hit_surface.hpp"
 
@@ -85,37 +86,32 @@ class EmbreeAccelerator final : public Accelerator {
   void intersect_closest(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
-    for (std::uint32_t i = range.begin; i < range.end; ++i) {
-      if (!(rays.flags[i] & ray_flags::alive)) {
-        mark_miss(hits, i);
-        continue;
-      }
+    for_each_ray(rays, hits, range, [&](const SingleRay& ray, std::uint32_t i) {
       RTCRayHit query;
-      fill_ray(rays, i, query.ray);
+      fill_ray(ray, i, query.ray);
       query.hit.geomID = RTC_INVALID_GEOMETRY_ID;
       query.hit.primID = RTC_INVALID_GEOMETRY_ID;
       rtcIntersect1(scene_, &context, &query);
       if (query.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
-        mark_miss(hits, i);
+        hits.set_miss(i);
       } else {
         hits.set_hit(i, query.ray.tfar, query.hit.primID, query.hit.u, query.hit.v);
         set_surface_from_mesh(hits, i, mesh_, query.hit.primID);
       }
-    }
+    });
   }
 
   void intersect_any(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
-    for (std::uint32_t i = range.begin; i < range.end; ++i) {
-      mark_miss(hits, i);
-      if (!(rays.flags[i] & ray_flags::alive)) continue;
+    for_each_ray(rays, hits, range, [&](const SingleRay& ray, std::uint32_t i) {
+      hits.set_miss(i);
       RTCRay query;
-      fill_ray(rays, i, query);
+      fill_ray(ray, i, query);
       rtcOccluded1(scene_, &context, &query);
       // Embree says which ray was blocked, not by what: report primitive 0 as "occluded".
       if (query.tfar == -std::numeric_limits<float>::infinity()) hits.primitive[i] = 0;
-    }
+    });
   }
 
   MemoryReport memory() const override {
@@ -128,22 +124,15 @@ class EmbreeAccelerator final : public Accelerator {
   BuildReport build() const override { return build_; }
 
  private:
-  static void mark_miss(HitBatch& hits, std::uint32_t i) {
-    hits.t[i] = std::numeric_limits<float>::infinity();
-    hits.primitive[i] = kInvalidPrimitive;
-    hits.u[i] = 0.0f;
-    hits.v[i] = 0.0f;
-  }
-
-  static void fill_ray(const RayBatch& rays, std::uint32_t i, RTCRay& ray) {
-    ray.org_x = rays.origin_x[i];
-    ray.org_y = rays.origin_y[i];
-    ray.org_z = rays.origin_z[i];
-    ray.dir_x = rays.direction_x[i];
-    ray.dir_y = rays.direction_y[i];
-    ray.dir_z = rays.direction_z[i];
-    ray.tnear = rays.tmin[i];
-    ray.tfar = rays.tmax[i];
+  static void fill_ray(const SingleRay& single, std::uint32_t i, RTCRay& ray) {
+    ray.org_x = single.origin.x;
+    ray.org_y = single.origin.y;
+    ray.org_z = single.origin.z;
+    ray.dir_x = single.direction.x;
+    ray.dir_y = single.direction.y;
+    ray.dir_z = single.direction.z;
+    ray.tnear = single.tmin;
+    ray.tfar = single.tmax;
     ray.time = 0.0f;
     ray.mask = 0xFFFFFFFFu;
     ray.id = i;

@@ -1,6 +1,7 @@
 // Recursive build (items bucketed into a node's cells by counting, then each crowded cell
 // refined) and recursive 3D-DDA traversal, each grid stopping once its nearest hit lies
 // before its next cell.
+#include "accel/ray_loop.hpp"
 #include "accel/grid/array_grid.hpp"
 
 #include <algorithm>
@@ -241,22 +242,22 @@ class ArrayGridAccelerator final : public Accelerator {
 
   template <bool kAnyHit, typename Probe>
   void traverse_batch(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
-    for (std::uint32_t i = range.begin; i < range.end; ++i) {
-      hits.set_miss(i);
-      if (!(rays.flags[i] & ray_flags::alive)) continue;
+    for_each_ray(rays, hits, range, [&](const SingleRay& ray, std::uint32_t i) {
       RayState state;
-      state.origin = glm::vec3(rays.origin_x[i], rays.origin_y[i], rays.origin_z[i]);
-      state.direction = glm::vec3(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]);
-      state.ray = make_watertight_ray(state.origin, state.direction);
-      state.tmin = rays.tmin[i];
-      state.best = rays.tmax[i];
+      state.origin = ray.origin;
+      state.direction = ray.direction;
+      state.ray = ray.sheared;
+      state.tmin = ray.tmin;
+      state.best = ray.tmax;
       state.found_triangle = kInvalidPrimitive;
       traverse_grid<kAnyHit>(nodes_[0], state, state.tmin, state.best, probe);
       if (state.found_triangle != kInvalidPrimitive) {
         hits.set_hit(i, state.found.t, state.found_triangle, state.found.u, state.found.v);
         set_surface_from_mesh(hits, i, mesh_, state.found_triangle);
+      } else {
+        hits.set_miss(i);
       }
-    }
+    });
   }
 
   const TriangleMesh& mesh_;

@@ -1,6 +1,7 @@
 // Counting construction of the hashed grid (D bits, first-fit row displacement for O, counts
 // and prefix sums for H, reverse insertion for L) and 3D-DDA traversal that stops once the
 // nearest hit found lies before the next cell.
+#include "accel/ray_loop.hpp"
 #include "accel/grid/hashed_grid.hpp"
 
 #include <algorithm>
@@ -269,18 +270,16 @@ class HashedGridAccelerator final : public Accelerator {
   void traverse(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
     const glm::vec3* positions = mesh_.positions.data();
     const glm::uvec3* triangles = mesh_.triangles.data();
-    for (std::uint32_t i = range.begin; i < range.end; ++i) {
+    for_each_ray(rays, hits, range, [&](const SingleRay& single, std::uint32_t i) {
       hits.set_miss(i);
-      if (!(rays.flags[i] & ray_flags::alive)) continue;
-      const glm::vec3 origin(rays.origin_x[i], rays.origin_y[i], rays.origin_z[i]);
-      const glm::vec3 direction(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]);
-      const float tmin = rays.tmin[i];
+      const glm::vec3 &origin = single.origin, &direction = single.direction;
+      const float tmin = single.tmin;
       float near = 0.0f, far = 0.0f;
-      if (!clip_to_box(make_box_ray(origin, direction), bounds_.lower, upper_, tmin, rays.tmax[i], near, far)) continue;
+      if (!clip_to_box(single.box, bounds_.lower, upper_, tmin, single.tmax, near, far)) return;
 
       GridWalk walk(bounds_.lower, cell_size_, origin, direction, glm::ivec3(cell_of(origin + direction * near)));
-      const WatertightRay ray = make_watertight_ray(origin, direction);
-      float best = rays.tmax[i];
+      const WatertightRay& ray = single.sheared;
+      float best = single.tmax;
       TriangleHit found{kInfinity, 0.0f, 0.0f};
       std::uint32_t found_triangle = kInvalidPrimitive;
       while (true) {
@@ -336,7 +335,7 @@ class HashedGridAccelerator final : public Accelerator {
         hits.set_hit(i, found.t, found_triangle, found.u, found.v);
         set_surface_from_mesh(hits, i, mesh_, found_triangle);
       }
-    }
+    });
   }
 
   const TriangleMesh& mesh_;

@@ -1,5 +1,6 @@
 // HMQ build (grid, snapping, SAH tree over the snapped triangles, uncompressed top, blocks
 // of quantized nodes with leaf records) and single-ray traversal decoding on the fly.
+#include "accel/ray_loop.hpp"
 #include "accel/hmq/hmq_accelerator.hpp"
 
 #include <algorithm>
@@ -325,24 +326,15 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
 
   template <bool kAnyHit, typename Probe>
   void traverse(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
-    for (std::uint32_t i = range.begin; i < range.end; ++i) {
-      if (!(rays.flags[i] & ray_flags::alive)) {
-        write_miss(hits, i);
-        continue;
-      }
-      const glm::vec3 origin(rays.origin_x[i], rays.origin_y[i], rays.origin_z[i]);
-      const glm::vec3 direction(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]);
-      const BoxRay box_ray = make_box_ray(origin, direction);
-      const WatertightRay sheared = make_watertight_ray(origin, direction);
-      const float tmin = rays.tmin[i];
-      float tmax = rays.tmax[i];
+    for_each_ray(rays, hits, range, [&](const SingleRay& ray, std::uint32_t i) {
+      float tmax = ray.tmax;
       LeafHit best;
-      walk_bvh(top_.data(), box_ray, tmin, tmax, probe, [&](const BvhNode& leaf) {
-        traverse_blocks<kAnyHit>(leaf, box_ray, sheared, tmin, tmax, best, probe);
+      walk_bvh(top_.data(), ray.box, ray.tmin, tmax, probe, [&](const BvhNode& leaf) {
+        traverse_blocks<kAnyHit>(leaf, ray.box, ray.sheared, ray.tmin, tmax, best, probe);
         return kAnyHit && best.found;
       });
       write_leaf_hit<!kAnyHit>(best, hits, i);
-    }
+    });
   }
 
   // The compressed treelets under one top leaf: nodes decoded from their parents' boxes,

@@ -97,7 +97,7 @@ template <bool kAnyHit, typename Probe>
 // With kSurface (closest hits, whose corners test_leaf_record kept) also the point and normal.
 template <bool kSurface>
 inline void write_leaf_hit(const LeafHit& best, HitBatch& hits, std::uint32_t i) {
-  if (!best.found) return write_miss(hits, i);
+  if (!best.found) return hits.set_miss(i);
   std::uint32_t delta[kMaxLeafTriangles], code[kMaxLeafTriangles];
   read_stream(best.ids, best.header.id_bits, best.triangle + 1, delta);
   read_stream(best.corners, 3, best.triangle + 1, code);

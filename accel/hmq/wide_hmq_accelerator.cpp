@@ -12,6 +12,7 @@
 
 #include <fmt/format.h>
 
+#include "accel/ray_loop.hpp"
 #include "accel/hmq/hmq_accelerator.hpp"
 #include "accel/hmq/leaf_hit.hpp"
 #include "accel/hmq/snapped_tree.hpp"
@@ -392,19 +393,13 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
     const WideHmqNode* nodes = nodes_.data();
     const std::byte* leaves = leaves_.data();
     const __m256i lane_index = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-    for (std::uint32_t i = range.begin; i < range.end; ++i) {
-      if (!(rays.flags[i] & ray_flags::alive)) {
-        write_miss(hits, i);
-        continue;
-      }
-      const glm::vec3 origin(rays.origin_x[i], rays.origin_y[i], rays.origin_z[i]);
-      const glm::vec3 direction(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]);
-      const WatertightRay sheared = make_watertight_ray(origin, direction);
+    for_each_ray(rays, hits, range, [&](const SingleRay& ray, std::uint32_t i) {
+      const glm::vec3 &origin = ray.origin, &inverse = ray.box.inverse_direction;
       const __m256 origin_lanes[3] = {_mm256_set1_ps(origin.x), _mm256_set1_ps(origin.y), _mm256_set1_ps(origin.z)};
-      const __m256 inverse_lanes[3] = {_mm256_set1_ps(1.0f / direction.x), _mm256_set1_ps(1.0f / direction.y),
-                                       _mm256_set1_ps(1.0f / direction.z)};
-      const float tmin = rays.tmin[i];
-      float tmax = rays.tmax[i];
+      const __m256 inverse_lanes[3] = {_mm256_set1_ps(inverse.x), _mm256_set1_ps(inverse.y), _mm256_set1_ps(inverse.z)};
+      const WatertightRay& sheared = ray.sheared;
+      const float tmin = ray.tmin;
+      float tmax = ray.tmax;
       LeafHit best;
       std::uint32_t current = 0, top = 0;
       Box frame = root_;
@@ -472,7 +467,7 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
                  {stack.bound[3][top], stack.bound[4][top], stack.bound[5][top]}};
       }
       write_leaf_hit<!kAnyHit>(best, hits, i);
-    }
+    });
   }
 
   GlobalGrid grid_;

@@ -1,6 +1,7 @@
 // Ray-Strips build (SAH cut into sub-meshes, stripify, top SAH BVH over the strips, encode)
 // and traversal: single rays through the top BVH and each strip, and 2x2 packets for
 // coherent rays (§5.3).
+#include "accel/ray_loop.hpp"
 #include "accel/raystrips/raystrips_accelerator.hpp"
 
 #include <algorithm>
@@ -345,7 +346,7 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
   // With kSurface (closest-hit queries) also the hit's point and normal.
   template <bool kSurface = true, typename Probe = NullProbe>
   void write_hit(const StripRay& ray, HitBatch& hits, std::uint32_t i, Probe* probe = nullptr) const {
-    if (!ray.found()) return write_miss(hits, i);
+    if (!ray.found()) return hits.set_miss(i);
     const StripView strip(ray.hit.strip);
     if constexpr (Probe::kRecords) probe->read(strip.record_address(ray.hit.triangle), 4);
     const std::uint32_t corners = strip.corners(ray.hit.triangle);
@@ -361,13 +362,8 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
   template <bool kAnyHit, typename Probe>
   void traverse(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
     const glm::vec3* positions = positions_.data();
-    for (std::uint32_t i = range.begin; i < range.end; ++i) {
-      if (!(rays.flags[i] & ray_flags::alive)) {
-        write_miss(hits, i);
-        continue;
-      }
-      StripRay ray({rays.origin_x[i], rays.origin_y[i], rays.origin_z[i]},
-                   {rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]}, rays.tmin[i], rays.tmax[i]);
+    for_each_ray(rays, hits, range, [&](const SingleRay& single, std::uint32_t i) {
+      StripRay ray(single);
       walk_bvh(nodes_.data(), ray.box, ray.tmin, ray.tmax, probe, [&](const BvhNode& leaf) {
         float near, far;
         if (!clip_to_box(ray.box, leaf.lower, leaf.upper, ray.tmin, ray.tmax, near, far)) return false;
@@ -382,7 +378,7 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
         return false;
       });
       write_hit<!kAnyHit>(ray, hits, i, &probe);
-    }
+    });
   }
 
   RayStripsOptions options_;

@@ -40,9 +40,7 @@ struct PacketTraversal {
     for (std::uint32_t r = 0; r < range.size(); ++r) {
       const std::uint32_t i = range.begin + r;
       if (!(rays.flags[i] & ray_flags::alive)) continue;
-      const StripRay& ray = packet[r].emplace(glm::vec3(rays.origin_x[i], rays.origin_y[i], rays.origin_z[i]),
-                                              glm::vec3(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]),
-                                              rays.tmin[i], rays.tmax[i]);
+      const StripRay& ray = packet[r].emplace(load_ray(rays, i));
       for (int axis = 0; axis < 3; ++axis) {
         lanes.origin[axis][r] = ray.box.origin[axis];
         lanes.inverse[axis][r] = ray.box.inverse_direction[axis];

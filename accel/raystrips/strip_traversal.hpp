@@ -21,6 +21,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "accel/ray_loop.hpp"
 #include "accel/raystrips/ray_strip_format.hpp"
 #include "kernels/ray_box.hpp"
 #include "kernels/triangle_intersect.hpp"
@@ -47,8 +48,7 @@ struct StripHit {
 
 class StripRay {
  public:
-  StripRay(const glm::vec3& origin, const glm::vec3& direction, float tmin, float tmax)
-      : tmin(tmin), tmax(tmax), box(make_box_ray(origin, direction)), sheared_(make_watertight_ray(origin, direction)) {}
+  explicit StripRay(const SingleRay& ray) : tmin(ray.tmin), tmax(ray.tmax), box(ray.box), sheared_(ray.sheared) {}
 
   float tmin;
   float tmax;  // shrinks to the nearest hit found
