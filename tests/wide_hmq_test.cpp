@@ -7,7 +7,7 @@
 #include <string>
 
 #include "accel/hmq/hmq_accelerator.hpp"
-#include "accel/hmq/wide_hmq_node.hpp"
+#include "accel/bvh/quantized_wide_node.hpp"
 #include "accel/registry.hpp"
 #include "accel_agreement.hpp"
 #include "bench/accel_bench.hpp"
@@ -20,7 +20,6 @@
 namespace wavetrace {
 namespace {
 
-using namespace hmq;
 
 HmqOptions hmq_options(std::uint32_t width, std::uint32_t leaf_size, std::uint32_t bits) {
   HmqOptions options;
@@ -98,11 +97,13 @@ TEST(WideHmq, FewerBytesThanBinaryHmqAndFullNodes) {
 }
 
 TEST(WideHmq, DecodedChildOfAFullStepIsTheFrame) {
-  WideHmqNode node{};
-  const Box frame{{-1.0f, 2.0f, 0.0f}, {3.0f, 2.0f, 1e-3f}};  // one flat axis
+  QuantizedWideNode node{};
+  Bounds3 frame;
+  frame.lower = {-1.0f, 2.0f, 0.0f};
+  frame.upper = {3.0f, 2.0f, 1e-3f};  // one flat axis
   node.upper(0)[3] = 255;
   node.lower(2)[3] = 255;
-  const Box child = decode_wide_child(node, 3, frame);
+  const Bounds3 child = decode_wide_child(node, 3, frame);
   EXPECT_EQ(child.lower.x, -1.0f);
   EXPECT_NEAR(child.upper.x, -1.0f, 1e-6f);
   EXPECT_EQ(child.lower.y, 2.0f);

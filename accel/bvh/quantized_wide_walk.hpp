@@ -1,0 +1,170 @@
+// One ray through a tree of quantized wide nodes (quantized_wide_node.hpp): the eight child
+// boxes decoded and slab-tested in AVX2 lanes, the entered ones sorted by distance and
+// pushed, with their decoded boxes as the frames below, in one pass. HMQ's and Ray-Strips'
+// wide layouts share it; their leaves plug in as a callback.
+#pragma once
+
+#if defined(__AVX2__) && defined(__FMA__)
+
+#include <array>
+#include <bit>
+#include <cstdint>
+#include <limits>
+
+#include <immintrin.h>
+
+#include "accel/bvh/quantized_wide_node.hpp"
+#include "accel/bvh/sah_builder.hpp"
+#include "accel/ray_loop.hpp"
+#include "kernels/ray_box.hpp"
+
+namespace wavetrace {
+
+// A stack or child reference: a node index, or with this bit a leaf reference.
+inline constexpr std::uint32_t kWideLeafReference = 0x8000'0000u;
+
+// The traversal stack, one column per field (SoA) so that eight children are pushed with one
+// store per field. Depth first: a level pushes at most eight and pops one. About 25 KiB: one
+// per batch call, not per ray.
+struct QuantizedWideStack {
+  static constexpr std::size_t kEntries = kMaxTreeDepth * QuantizedWideNode::kWidth + QuantizedWideNode::kWidth;
+  alignas(32) std::uint32_t reference[kEntries];
+  alignas(32) float distance[kEntries];
+  alignas(32) float bound[6][kEntries];  // lower x, y, z, upper x, y, z: the child's frame
+};
+
+namespace quantized_wide {
+
+// Bitonic network over eight int32 lanes, descending: per stage, lane i meets lane i ^ j
+// and keeps the larger or the smaller.
+struct SortStage {
+  int partner[8];
+  int take_max[8];
+};
+inline constexpr std::array<SortStage, 6> kDescendingStages = [] {
+  std::array<SortStage, 6> stages{};
+  int n = 0;
+  for (int k = 2; k <= 8; k *= 2) {
+    for (int j = k / 2; j >= 1; j /= 2, ++n) {
+      for (int i = 0; i < 8; ++i) {
+        stages[n].partner[i] = i ^ j;
+        const bool upper = (i & j) != 0, descending_block = (i & k) != 0;
+        stages[n].take_max[i] = (upper != descending_block) ? 0 : -1;
+      }
+    }
+  }
+  return stages;
+}();
+
+[[gnu::always_inline]] inline __m256i sort_descending(__m256i keys) {
+  for (const SortStage& stage : kDescendingStages) {
+    const __m256i other =
+        _mm256_permutevar8x32_epi32(keys, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(stage.partner)));
+    keys = _mm256_blendv_epi8(_mm256_min_epi32(keys, other), _mm256_max_epi32(keys, other),
+                              _mm256_loadu_si256(reinterpret_cast<const __m256i*>(stage.take_max)));
+  }
+  return keys;
+}
+
+// Each child's reference: inner children number from child_base in slot order, leaves from
+// leaf_base by the weights of the leaf slots before them (exclusive prefix sums over the meta
+// bytes in 16-bit lanes: leaf weights in bits 0-10, the inner count in bits 11-14).
+[[gnu::always_inline]] inline __m256i child_references(const QuantizedWideNode& node) {
+  const __m128i meta = _mm_cvtepu8_epi16(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(node.meta)));
+  const __m128i inner = _mm_cmpeq_epi16(meta, _mm_set1_epi16(QuantizedWideNode::kInnerMeta));
+  const __m128i counts = _mm_or_si128(_mm_andnot_si128(inner, meta), _mm_and_si128(inner, _mm_set1_epi16(1 << 11)));
+  __m128i sums = _mm_add_epi16(counts, _mm_slli_si128(counts, 2));
+  sums = _mm_add_epi16(sums, _mm_slli_si128(sums, 4));
+  sums = _mm_add_epi16(sums, _mm_slli_si128(sums, 8));
+  const __m256i before = _mm256_cvtepu16_epi32(_mm_sub_epi16(sums, counts));
+  const __m256i leaf = _mm256_or_si256(_mm256_add_epi32(_mm256_set1_epi32(int(node.leaf_base)),
+                                                        _mm256_and_si256(before, _mm256_set1_epi32(2047))),
+                                       _mm256_set1_epi32(int(kWideLeafReference)));
+  const __m256i child = _mm256_add_epi32(_mm256_set1_epi32(int(node.child_base)), _mm256_srli_epi32(before, 11));
+  return _mm256_blendv_epi8(leaf, child, _mm256_cvtepi16_epi32(inner));
+}
+
+}  // namespace quantized_wide
+
+// `visit_leaf(reference, box)` handles a leaf (its reference without the leaf bit, its
+// decoded box) and returns true to end the walk (an any-hit query found one); it may shrink
+// `tmax`, which prunes what is left on the stack.
+template <typename Probe, typename VisitLeaf>
+[[gnu::always_inline]] inline void walk_quantized_wide(const QuantizedWideNode* nodes, const Bounds3& root_frame,
+                                                       const SingleRay& ray, const float& tmax, Probe& probe,
+                                                       QuantizedWideStack& stack, VisitLeaf&& visit_leaf) {
+  using namespace quantized_wide;
+  constexpr float kInfinity = std::numeric_limits<float>::infinity();
+  const __m256i lane_index = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  const glm::vec3 &origin = ray.origin, &inverse = ray.box.inverse_direction;
+  const __m256 origin_lanes[3] = {_mm256_set1_ps(origin.x), _mm256_set1_ps(origin.y), _mm256_set1_ps(origin.z)};
+  const __m256 inverse_lanes[3] = {_mm256_set1_ps(inverse.x), _mm256_set1_ps(inverse.y), _mm256_set1_ps(inverse.z)};
+  std::uint32_t current = 0, top = 0;
+  Bounds3 frame = root_frame;
+  while (true) {
+    if (!(current & kWideLeafReference)) {
+      const QuantizedWideNode& node = nodes[current];
+      probe.read(&node, sizeof node);
+      __m256 near = _mm256_set1_ps(ray.tmin), far = _mm256_set1_ps(kInfinity);
+      __m256 bound[6];
+      for (int axis = 0; axis < 3; ++axis) {
+        const __m256 step = _mm256_set1_ps(frame_step(frame, axis));
+        const __m256 q_lower =
+            _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(node.lower(axis)))));
+        const __m256 q_upper =
+            _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(node.upper(axis)))));
+        bound[axis] = _mm256_fmadd_ps(q_lower, step, _mm256_set1_ps(frame.lower[axis]));
+        bound[3 + axis] = _mm256_fnmadd_ps(q_upper, step, _mm256_set1_ps(frame.upper[axis]));
+        const __m256 t0 = _mm256_mul_ps(_mm256_sub_ps(bound[axis], origin_lanes[axis]), inverse_lanes[axis]);
+        const __m256 t1 = _mm256_mul_ps(_mm256_sub_ps(bound[3 + axis], origin_lanes[axis]), inverse_lanes[axis]);
+        // A NaN slab distance (origin on a plane the ray runs parallel to) leaves the interval
+        // as it was, as clip_slab does: max/min return their second operand when one is NaN.
+        near = _mm256_max_ps(_mm256_min_ps(t1, t0), near);
+        far = _mm256_min_ps(_mm256_max_ps(t0, t1), far);
+      }
+      far = _mm256_min_ps(_mm256_mul_ps(far, _mm256_set1_ps(kSlabFarScale)), _mm256_set1_ps(tmax));
+      const __m256i empty = _mm256_cvtepi8_epi32(
+          _mm_cmpeq_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(node.meta)), _mm_setzero_si128()));
+      const __m256 entered = _mm256_andnot_ps(_mm256_castsi256_ps(empty), _mm256_cmp_ps(near, far, _CMP_LE_OQ));
+      const auto entered_mask = static_cast<unsigned>(_mm256_movemask_ps(entered));
+      if (std::has_single_bit(entered_mask)) {  // one child: go down, nothing to order or stack
+        const int lane = std::countr_zero(entered_mask);
+        alignas(32) std::uint32_t reference[8];
+        alignas(32) float lanes[6][8];
+        _mm256_store_si256(reinterpret_cast<__m256i*>(reference), child_references(node));
+        for (int b = 0; b < 6; ++b) _mm256_store_ps(lanes[b], bound[b]);
+        current = reference[lane];
+        frame.lower = {lanes[0][lane], lanes[1][lane], lanes[2][lane]};
+        frame.upper = {lanes[3][lane], lanes[4][lane], lanes[5][lane]};
+        continue;
+      }
+      if (entered_mask != 0) {
+        // Nearest first, by sorting: keys are the entry distance's bits (>= 0, so they order as
+        // integers) with the lane in the low three, lanes not entered -1, sorted descending so
+        // that the nearest child lands on top of the stack.
+        const __m256i keys = _mm256_blendv_epi8(
+            _mm256_set1_epi32(-1),
+            _mm256_or_si256(_mm256_and_si256(_mm256_castps_si256(near), _mm256_set1_epi32(~7)), lane_index),
+            _mm256_castps_si256(entered));
+        const __m256i order = _mm256_and_si256(sort_descending(keys), _mm256_set1_epi32(7));
+        _mm256_storeu_si256(reinterpret_cast<__m256i*>(stack.reference + top),
+                            _mm256_permutevar8x32_epi32(child_references(node), order));
+        _mm256_storeu_ps(stack.distance + top, _mm256_permutevar8x32_ps(near, order));
+        for (int b = 0; b < 6; ++b) _mm256_storeu_ps(stack.bound[b] + top, _mm256_permutevar8x32_ps(bound[b], order));
+        top += static_cast<std::uint32_t>(std::popcount(entered_mask));
+      }
+    } else if (visit_leaf(current & ~kWideLeafReference, frame)) {
+      return;
+    }
+    while (top > 0 && stack.distance[top - 1] > tmax) --top;
+    if (top == 0) return;
+    --top;
+    current = stack.reference[top];
+    frame.lower = {stack.bound[0][top], stack.bound[1][top], stack.bound[2][top]};
+    frame.upper = {stack.bound[3][top], stack.bound[4][top], stack.bound[5][top]};
+  }
+}
+
+}  // namespace wavetrace
+
+#endif
