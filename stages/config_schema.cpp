@@ -70,6 +70,8 @@ const std::vector<ConfigKey>& config_schema() {
       {"accel.raystrips.run_triangles", T::integer, std::int64_t{6}, 2, 64, {},
        "the strip's kd-tree is descended to spans of at most this many triangles, tested together (the paper: 2)"},
       {"accel.raystrips.packets", T::boolean, true, 0, 0, {}, "camera rays as 2x2 packets"},
+      {"accel.raystrips.width", T::integer, std::int64_t{2}, 2, 8, {},
+       "top over the strips: 2, binary 32-byte nodes; 8, quantized 8-wide nodes (no packets)"},
       {"accel.raystrips.packet_min_active", T::integer, std::int64_t{2}, 1, 4, {},
        "below this many active rays a packet continues as single rays"},
       {"accel.hmq.bits", T::integer, std::int64_t{16}, 1, 24, {}, "global grid bits per axis (the paper: 16)"},

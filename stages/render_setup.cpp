@@ -79,6 +79,7 @@ AcceleratorOptions accelerator_options(const Config& config) {
   options.raystrips.packets = config.boolean("accel.raystrips.packets");
   options.raystrips.packet_min_active = static_cast<std::uint32_t>(config.integer("accel.raystrips.packet_min_active"));
   options.raystrips.bins = options.bvh.bins;
+  options.raystrips.width = static_cast<std::uint32_t>(config.integer("accel.raystrips.width"));
   options.hmq.bits = static_cast<std::uint32_t>(config.integer("accel.hmq.bits"));
   options.hmq.epsilon = config.real("accel.hmq.epsilon");
   options.hmq.leaf_size = static_cast<std::uint32_t>(config.integer("accel.hmq.leaf_size"));
@@ -95,6 +96,9 @@ AcceleratorOptions accelerator_options(const Config& config) {
   options.mlgrid.macrocell_factor = static_cast<std::uint32_t>(config.integer("accel.mlgrid.macrocell_factor"));
   if (options.bvh.width != 2 && options.bvh.width != 8) {
     throw ConfigError(fmt::format("accel.bvh.width = {}: must be 2 or 8", options.bvh.width));
+  }
+  if (options.raystrips.width != 2 && options.raystrips.width != 8) {
+    throw ConfigError(fmt::format("accel.raystrips.width = {}: must be 2 or 8", options.raystrips.width));
   }
   if (options.hmq.width != 2 && options.hmq.width != 8) {
     throw ConfigError(fmt::format("accel.hmq.width = {}: must be 2 or 8", options.hmq.width));

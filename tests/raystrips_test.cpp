@@ -174,6 +174,31 @@ INSTANTIATE_TEST_SUITE_P(Scenes, RayStripsAgreesWithEmbree,
                          ::testing::ValuesIn(testing::agreement_scenes("builtin:soup:20k")),
                          testing::agreement_scene_label);
 
+// The 8-wide quantized top holds the same strips as the binary one, so every ray finds the
+// same surface; distances agree to float rounding where coincident triangles (the fur's
+// strands, the stadium's thin plates) are met in another order. A child box quantized too
+// tightly would lose hits here.
+TEST(RayStrips, WideTopFindsWhatTheBinaryTopFinds) {
+  for (const char* source : {"builtin:sphere:30k", "builtin:soup:20k", "builtin:stadium:2000", "builtin:fur:30k"}) {
+    const Scene scene = make_builtin_scene(source);
+    for (const std::uint32_t strips_per_leaf : {1u, 4u}) {
+      RayStripsOptions options;
+      options.strips_per_leaf = strips_per_leaf;
+      const auto binary = make_raystrips_accelerator(scene.mesh, options);
+      options.width = 8;
+      const auto wide = make_raystrips_accelerator(scene.mesh, options);
+      for (const RaySetKind kind : {RaySetKind::primary, RaySetKind::random, RaySetKind::diffuse, RaySetKind::shadow}) {
+        const testing::Agreement result = testing::compare_on_rays(
+            scene, *binary, *wide, kind, 4000, 1e-6f * scene.mesh.bounds().diagonal(), 1e-4f, kind == RaySetKind::primary);
+        const std::string label = std::string(source) + " " + to_string(kind) + " strips/leaf " + std::to_string(strips_per_leaf);
+        EXPECT_EQ(result.hit_differs, 0u) << label;
+        EXPECT_EQ(result.far_t, 0u) << label;
+        EXPECT_EQ(result.far_uv, 0u) << label;
+      }
+    }
+  }
+}
+
 TEST(RayStrips, PacketsAnswerExactlyAsSingleRays) {
   const Scene scene = make_builtin_scene("builtin:sphere:30k");
   RayStripsOptions options;
@@ -199,9 +224,10 @@ TEST(RayStrips, NoRayEscapesClosedMeshes) {
     const LeakReport report =
         run_leak_bench(scene,
                        {parse_accelerator_spec("raystrips", Config{}),
-                        parse_accelerator_spec("raystrips:stripifier=dual_path:run_triangles=2", Config{})},
+                        parse_accelerator_spec("raystrips:stripifier=dual_path:run_triangles=2", Config{}),
+                        parse_accelerator_spec("raystrips:width=8", Config{})},
                        200000, 0);
-    ASSERT_EQ(report.results.size(), 2u);
+    ASSERT_EQ(report.results.size(), 3u);
     for (const LeakResult& result : report.results) EXPECT_EQ(result.escaped, 0u) << source << " " << result.label;
   }
 }
@@ -216,6 +242,13 @@ TEST(RayStrips, MemoryIsItsPartsAndTheSoupStaysNearAnIndexedTriangleList) {
   BvhOptions baseline;
   const auto bvh = make_bvh_accelerator(sphere.mesh, baseline);
   EXPECT_LT(memory.total() * 2, bvh->memory().total()) << "connected meshes: well under half the baseline";
+  RayStripsOptions wide_top;
+  wide_top.width = 8;
+  const auto wide = make_raystrips_accelerator(sphere.mesh, wide_top);
+  span_bytes = 0;
+  for (const auto& span : wide->memory_spans()) span_bytes += span.size();
+  EXPECT_EQ(wide->memory().total(), span_bytes);
+  EXPECT_LT(wide->memory().hierarchy, memory.hierarchy) << "64-byte nodes of eight against 32-byte nodes of two";
 
   // A soup has no connectivity: every strip is one triangle (§6.2).
   const Scene soup = make_builtin_scene("builtin:soup:20k");
@@ -232,6 +265,10 @@ TEST(RayStrips, MemoryIsItsPartsAndTheSoupStaysNearAnIndexedTriangleList) {
 TEST(RayStrips, BadOptionsAreClearErrors) {
   const Scene scene = make_builtin_scene("builtin:sphere:2000");
   RayStripsOptions options;
+  options.width = 4;
+  EXPECT_THROW(make_raystrips_accelerator(scene.mesh, options), std::invalid_argument);
+  EXPECT_THROW(parse_accelerator_spec("raystrips:width=3", Config{}), ConfigError);
+  options = {};
   options.submesh_triangles = 1;
   EXPECT_THROW(make_raystrips_accelerator(scene.mesh, options), std::invalid_argument);
   options = {};

@@ -2,12 +2,15 @@
 // and traversal: single rays through the top BVH and each strip, and 2x2 packets for
 // coherent rays (§5.3).
 #include "accel/ray_loop.hpp"
+#include "accel/bvh/quantized_wide_tree.hpp"
+#include "accel/bvh/quantized_wide_walk.hpp"
 #include "accel/raystrips/raystrips_accelerator.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <numeric>
 #include <stdexcept>
+#include <type_traits>
 
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
@@ -46,6 +49,11 @@ void check_options(const RayStripsOptions& options) {
           fmt::format("run_triangles = {}: must be 2 .. 64", options.run_triangles));
   require(options.packet_min_active >= 1 && options.packet_min_active <= kPacketRays,
           fmt::format("packet_min_active = {}: must be 1 .. {}", options.packet_min_active, kPacketRays));
+  require(options.width == 2 || options.width == 8,
+          fmt::format("width = {}: must be 2 (binary top) or 8 (quantized 8-wide top)", options.width));
+#if !(defined(__AVX2__) && defined(__FMA__))
+  require(options.width == 2, "width = 8 traverses in AVX2 and FMA lanes: build with WAVETRACE_ARCH=x86-64-v3 or newer");
+#endif
 }
 
 // The sub-meshes: ranges of the SAH tree's primitive order under the highest nodes that
@@ -91,7 +99,7 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> cut_submeshes(const BuildTr
   return submeshes;
 }
 
-// What a raystrips world saves besides its arrays, `PREFIX` + "raystrips.state" (144 bytes):
+// What a raystrips world saves besides its arrays, `PREFIX` + "raystrips.state" (176 bytes):
 //   offset  size  field
 //        0     4  run_triangles, uint32 (traversal's span size)
 //        4     4  packet_min_active, uint32
@@ -99,15 +107,21 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> cut_submeshes(const BuildTr
 //       12     4  stripifier, uint32 (0: ours, 1: openmesh; build notes only)
 //       16     4  submesh_triangles, uint32 (build notes only)
 //       20     4  strips_per_leaf, uint32 (build notes only)
-//       24   120  the build's statistics, 15 fields of 8 bytes in RayStripStats' order: strips
+//       24     4  width of the top, uint32 (2 or 8)
+//       28     4  zero
+//       32    24  the 8-wide top's root frame: float lower x, y, z, upper x, y, z (width 2: unused)
+//       56   120  the build's statistics, 15 fields of 8 bytes in RayStripStats' order: strips
 //                 (uint64), 10 doubles (mean triangles .. encode seconds), 4 byte counts (uint64)
 // and the triangle count and build report in "common" (section_archive.hpp). Arrays:
-// "raystrips.nodes" (BvhNode, bvh_node.hpp; a leaf's first is a word offset into the strips),
-// "raystrips.strips" (bytes, ray_strip_format.hpp), "raystrips.positions" (float x, y, z).
+// "raystrips.nodes" (width 2: BvhNode, bvh_node.hpp; a leaf's first is a word offset into the
+// strips), "raystrips.wide_nodes" (width 8: QuantizedWideNode, a leaf child's reference is its
+// number) and "raystrips.leaf_words" (width 8: uint32, leaf n's strips are the words
+// [leaf_words[n], leaf_words[n + 1]) of the strips; one entry more than leaves), the unused
+// ones empty; "raystrips.strips" (bytes, ray_strip_format.hpp), "raystrips.positions" (float x, y, z).
 struct RayStripsSavedOptions {
-  std::uint32_t run_triangles, packet_min_active, packets, stripifier, submesh_triangles, strips_per_leaf;
+  std::uint32_t run_triangles, packet_min_active, packets, stripifier, submesh_triangles, strips_per_leaf, width, zero;
 };
-constexpr std::uint32_t kRayStripsSavedVersion = 1;
+constexpr std::uint32_t kRayStripsSavedVersion = 2;
 
 class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator> {
   friend class ProbedAccelerator<RayStripsAccelerator>;
@@ -123,15 +137,19 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
   static void archive(auto& self, Archive& a) {
     struct State {
       RayStripsSavedOptions options;
+      Bounds3 root;
       RayStripStats stats;
     };
-    static_assert(sizeof(State) == 144);
+    static_assert(sizeof(State) == 176);
     State state{{self.options_.run_triangles, self.options_.packet_min_active, self.options_.packets ? 1u : 0u,
                  static_cast<std::uint32_t>(self.options_.stripifier), self.options_.submesh_triangles,
-                 self.options_.strips_per_leaf},
+                 self.options_.strips_per_leaf, self.options_.width, 0},
+                self.root_,
                 self.stats_};
     a.value("raystrips.state", state);
     a.array("raystrips.nodes", self.nodes_);
+    a.array("raystrips.wide_nodes", self.wide_nodes_);
+    a.array("raystrips.leaf_words", self.leaf_words_);
     a.array("raystrips.strips", self.strip_bytes_);
     a.array("raystrips.positions", self.positions_);
     archive_common_state(a, self.triangles_, self.build_);
@@ -142,8 +160,14 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
       self.options_.stripifier = static_cast<StripifierKind>(state.options.stripifier);
       self.options_.submesh_triangles = state.options.submesh_triangles;
       self.options_.strips_per_leaf = state.options.strips_per_leaf;
+      self.options_.width = state.options.width;
+      self.root_ = state.root;
       self.stats_ = state.stats;
-      if (self.nodes_.empty()) a.fail("raystrips.nodes", "is empty: no raystrips structure was saved");
+      if (state.options.width != 2 && state.options.width != 8) a.fail("raystrips.state", "holds a top width other than 2 or 8");
+      if (state.options.width == 2 && self.nodes_.empty()) a.fail("raystrips.nodes", "is empty: no raystrips structure was saved");
+      if (state.options.width == 8 && (self.wide_nodes_.empty() || self.leaf_words_.size() < 2)) {
+        a.fail("raystrips.wide_nodes", "is empty: no raystrips structure was saved");
+      }
       if (state.options.run_triangles < 2 || state.options.run_triangles > 64 || state.options.packet_min_active < 1 ||
           state.options.packet_min_active > kPacketRays) {
         a.fail("raystrips.state", "holds traversal settings out of range");
@@ -206,22 +230,32 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
     const BuildTree top = build_sah_tree(strip_bounds, sah);
     peak = std::max(peak, top.peak_bytes + strip_bounds.size() * sizeof(Bounds3));
     strip_bounds = {};
-    const std::vector<std::uint32_t> node_order_list = node_order(top, NodeLayout::depth_first);
-
-    // Vertices renumbered by first use in leaf order, so a strip's indices lie close together.
-    std::vector<std::uint32_t> vertex_id(mesh.vertex_count(), kNoTriangle);
-    std::vector<std::uint32_t> strip_order;  // strips in storage order
+    // The strips in storage order: the top's leaves in the order its layout references them.
+    std::vector<std::uint32_t> strip_order;
     strip_order.reserve(strips.size());
+    auto store_leaf = [&](const BuildNode& leaf) {
+      for (std::uint32_t k = 0; k < leaf.count; ++k) strip_order.push_back(top.primitive_order[leaf.first + k]);
+    };
+    const std::vector<std::uint32_t> node_order_list = node_order(top, NodeLayout::depth_first);
+    std::vector<std::size_t> leaf_first_strip;  // width 8: each leaf's first place in strip_order
+    QuantizedWideTree wide;
+    if (options.width == 8) {
+      wide = build_quantized_wide_tree(top, [&](const BuildNode& leaf, const Bounds3&) {
+        leaf_first_strip.push_back(strip_order.size());
+        store_leaf(leaf);
+        return 1u;  // references number the leaves
+      });
+    } else {
+      for (const std::uint32_t built : node_order_list) {
+        if (top.nodes[built].leaf()) store_leaf(top.nodes[built]);
+      }
+    }
+    // Vertices renumbered by first use in storage order, so a strip's indices lie close together.
+    std::vector<std::uint32_t> vertex_id(mesh.vertex_count(), kNoTriangle);
     std::uint32_t next_vertex = 0;
-    for (const std::uint32_t built : node_order_list) {
-      const BuildNode& node = top.nodes[built];
-      if (!node.leaf()) continue;
-      for (std::uint32_t k = 0; k < node.count; ++k) {
-        const std::uint32_t s = top.primitive_order[node.first + k];
-        strip_order.push_back(s);
-        for (const std::uint32_t vertex : strips[s].vertices) {
-          if (vertex_id[vertex] == kNoTriangle) vertex_id[vertex] = next_vertex++;
-        }
+    for (const std::uint32_t s : strip_order) {
+      for (const std::uint32_t vertex : strips[s].vertices) {
+        if (vertex_id[vertex] == kNoTriangle) vertex_id[vertex] = next_vertex++;
       }
     }
     LargeArray<glm::vec3> positions(next_vertex);
@@ -244,16 +278,26 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
       encode_strip(strips[strip_order[i]], encodings[i], vertex_id, positions, mesh, strip_bytes.data() + offset[i]);
     });
 
-    // Flatten the top BVH: a leaf's `first` is the word offset of its first strip.
-    std::size_t next_strip = 0;
-    LargeArray<BvhNode> nodes;
-    flatten_tree(top, node_order_list, nodes, [&](const BuildNode& leaf) {
-      const std::uint32_t first = checked_uint32(
-          offset[next_strip] / 4, "raystrips strip offset in 4-byte words; build in smaller chunks (build.chunk_triangles)");
-      next_strip += leaf.count;
-      return first;
-    });
-    nodes_ = StoredArray<BvhNode>(std::move(nodes));
+    if (options.width == 8) {
+      // Leaf n's strips run from its first strip's word to the next leaf's.
+      LargeArray<std::uint32_t> leaf_words(leaf_first_strip.size() + 1);
+      for (std::size_t n = 0; n < leaf_first_strip.size(); ++n) leaf_words[n] = static_cast<std::uint32_t>(offset[leaf_first_strip[n]] / 4);
+      leaf_words.back() = static_cast<std::uint32_t>(offset.back() / 4);
+      root_ = wide.root_frame;
+      wide_nodes_ = StoredArray<QuantizedWideNode>(std::move(wide.nodes));
+      leaf_words_ = StoredArray<std::uint32_t>(std::move(leaf_words));
+    } else {
+      // Flatten the top BVH: a leaf's `first` is the word offset of its first strip.
+      std::size_t next_strip = 0;
+      LargeArray<BvhNode> nodes;
+      flatten_tree(top, node_order_list, nodes, [&](const BuildNode& leaf) {
+        const std::uint32_t first = checked_uint32(
+            offset[next_strip] / 4, "raystrips strip offset in 4-byte words; build in smaller chunks (build.chunk_triangles)");
+        next_strip += leaf.count;
+        return first;
+      });
+      nodes_ = StoredArray<BvhNode>(std::move(nodes));
+    }
     strip_bytes_ = StoredArray<std::byte>(std::move(strip_bytes));
     positions_ = StoredArray<glm::vec3>(std::move(positions));
     stats_.encode_seconds = seconds_since(encode_start);
@@ -266,7 +310,7 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
   std::string name() const override { return "raystrips"; }
 
   void intersect_coherent(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
-    if (!options_.packets) return intersect_closest(rays, hits, range);
+    if (!options_.packets || options_.width == 8) return intersect_closest(rays, hits, range);
     PacketTraversal packets{nodes_.data(), strip_bytes_.data(), positions_.data(), options_.run_triangles,
                             options_.packet_min_active};
     for (std::uint32_t begin = range.begin; begin < range.end; begin += kPacketRays) {
@@ -276,7 +320,8 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
   }
   MemoryReport memory() const override {
     MemoryReport report;
-    report.hierarchy = nodes_.size() * sizeof(BvhNode) + stats_.header_and_tree_bytes;
+    report.hierarchy = nodes_.size() * sizeof(BvhNode) + wide_nodes_.size() * sizeof(QuantizedWideNode) +
+                       leaf_words_.size() * sizeof(std::uint32_t) + stats_.header_and_tree_bytes;
     report.geometry = positions_.size() * sizeof(glm::vec3) + stats_.index_bytes;
     report.other = stats_.record_bytes;
     return report;
@@ -296,7 +341,7 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
   }
 
   std::vector<std::span<const std::byte>> memory_spans() const override {
-    return {nodes_.bytes(), strip_bytes_.bytes(), positions_.bytes()};
+    return {nodes_.bytes(), wide_nodes_.bytes(), leaf_words_.bytes(), strip_bytes_.bytes(), positions_.bytes()};
   }
 
  private:
@@ -333,6 +378,7 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
       s.strip_vectors_bytes += (strip.vertices.capacity() + strip.triangles.capacity()) * 4;
     }
     for (const BvhNode& node : nodes_) leaves += node.leaf();
+    if (!leaf_words_.empty()) leaves = leaf_words_.size() - 1;
     s.mean_triangles = double(distinct) / double(strips.size());
     s.mean_strip_triangles = double(listed) / double(strips.size());
     s.strips_per_leaf = double(strips.size()) / double(leaves);
@@ -361,6 +407,9 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
 
   template <bool kAnyHit, typename Probe>
   void traverse(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
+#if defined(__AVX2__) && defined(__FMA__)
+    if (options_.width == 8) return traverse_wide<kAnyHit>(rays, hits, range, probe);
+#endif
     const glm::vec3* positions = positions_.data();
     for_each_ray(rays, hits, range, [&](const SingleRay& single, std::uint32_t i) {
       StripRay ray(single);
@@ -368,21 +417,57 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
         float near, far;
         if (!clip_to_box(ray.box, leaf.lower, leaf.upper, ray.tmin, ray.tmax, near, far)) return false;
         const std::byte* strip_data = strip_bytes_.data() + std::size_t(leaf.first) * 4;
-        for (std::uint32_t s = 0; s < leaf.triangle_count(); ++s) {
-          probe.read(strip_data, ray_strip::kHeaderBytes);
-          const StripView strip(strip_data);
-          ray.traverse<kAnyHit>(strip, positions, near, far, options_.run_triangles, probe);
-          if (kAnyHit && ray.found()) return true;
-          strip_data += strip.size();
-        }
-        return false;
+        return trace_strips<kAnyHit>(ray, strip_data, leaf.triangle_count(), near, far, positions, probe);
       });
       write_hit<!kAnyHit>(ray, hits, i, &probe);
     });
   }
 
+#if defined(__AVX2__) && defined(__FMA__)
+  template <bool kAnyHit, typename Probe>
+  void traverse_wide(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
+    const glm::vec3* positions = positions_.data();
+    const std::uint32_t* leaf_words = leaf_words_.data();
+    QuantizedWideStack stack;
+    for_each_ray(rays, hits, range, [&](const SingleRay& single, std::uint32_t i) {
+      StripRay ray(single);
+      walk_quantized_wide(wide_nodes_.data(), root_, single, ray.tmax, probe, stack, [&](std::uint32_t leaf, const Bounds3& box) {
+        float near, far;
+        if (!clip_to_box(ray.box, box.lower, box.upper, ray.tmin, ray.tmax, near, far)) return false;
+        probe.read(leaf_words + leaf, 2 * sizeof(std::uint32_t));
+        const std::byte* strip_data = strip_bytes_.data() + std::size_t(leaf_words[leaf]) * 4;
+        const std::byte* end = strip_bytes_.data() + std::size_t(leaf_words[leaf + 1]) * 4;
+        return trace_strips<kAnyHit>(ray, strip_data, end, near, far, positions, probe);
+      });
+      write_hit<!kAnyHit>(ray, hits, i, &probe);
+    });
+  }
+#endif
+
+  // The strips of one top leaf, from `strip_data` on: `count` of them, or (wide top) up to
+  // `end`. True when an any-hit query is answered.
+  template <bool kAnyHit, typename Probe, typename Until>
+  bool trace_strips(StripRay& ray, const std::byte* strip_data, Until until, float near, float far,
+                    const glm::vec3* positions, Probe& probe) const {
+    for (std::uint32_t s = 0;; ++s) {
+      if constexpr (std::is_integral_v<Until>) {
+        if (s == until) return false;
+      } else {
+        if (strip_data >= until) return false;
+      }
+      probe.read(strip_data, ray_strip::kHeaderBytes);
+      const StripView strip(strip_data);
+      ray.traverse<kAnyHit>(strip, positions, near, far, options_.run_triangles, probe);
+      if (kAnyHit && ray.found()) return true;
+      strip_data += strip.size();
+    }
+  }
+
   RayStripsOptions options_;
-  StoredArray<BvhNode> nodes_;
+  StoredArray<BvhNode> nodes_;                      // width 2
+  StoredArray<QuantizedWideNode> wide_nodes_;       // width 8
+  StoredArray<std::uint32_t> leaf_words_;           // width 8
+  Bounds3 root_;                                    // width 8: the root's frame
   StoredArray<std::byte> strip_bytes_;
   StoredArray<glm::vec3> positions_;
   RayStripStats stats_;

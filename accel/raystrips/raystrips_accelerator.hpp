@@ -1,6 +1,7 @@
 // `raystrips`: Lauterbach, Yoon and Manocha's Ray-Strips (2007). The mesh is cut by the
 // SAH into sub-meshes, each stripified; the strips carry an implicit spatial kd-tree
-// (ray_strip_format.hpp) and sit in the leaves of the baseline's SAH BVH. Triangles are
+// (ray_strip_format.hpp) and sit in the leaves of the baseline's SAH BVH (or, width 8, of
+// quantized 8-wide nodes). Triangles are
 // tested by Plücker edges shared along the strip (strip_traversal.hpp).
 #pragma once
 
@@ -29,6 +30,10 @@ struct RayStripsOptions {
   // edge test and measured 1.4x faster than 2). 2 .. 64.
   std::uint32_t run_triangles = 6;
   std::uint32_t bins = 16;  // SAH bins, for the sub-mesh cut and the top BVH
+  // The top over the strips: 2, the baseline's 32-byte binary nodes; 8, the quantized 8-wide
+  // nodes HMQ's wide layout has (accel/bvh/quantized_wide_node.hpp) and a 4-byte offset per
+  // top leaf. Packets (below) need the binary top.
+  std::uint32_t width = 2;
   // Camera rays (intersect_coherent) as 2x2 packets (§5.3); below `packet_min_active`
   // active rays in a strip, the packet falls back to single-ray strip traversal.
   bool packets = true;
