@@ -28,23 +28,23 @@ namespace {
 using namespace ray_strip;
 
 TEST(RayStripFormat, SizeOfAStripOfNTrianglesFollowsTheFormula) {
-  // 12-byte header, 9 bytes per node (ceil(n/2) - 1 of them), indices and records, each
+  // 12-byte header, 3 bytes per node (ceil(n/2) - 1 of them), indices and records, each
   // aligned to its width, the whole to 4 bytes.
   EXPECT_EQ(strip_layout(1, kShortIndices | kShortRecords).size, 12u + 3 * 2 + 1 * 2 + 0);  // 20
   EXPECT_EQ(strip_layout(2, kShortIndices | kShortRecords).size, 24u);  // 12 + 8 + 4
-  EXPECT_EQ(strip_layout(5, kShortIndices | kShortRecords).size, 56u);  // 12 + 18 = 30, +14 = 44, +10 = 54 -> 56
-  EXPECT_EQ(strip_layout(5, 0).size, 80u);                              // 30 -> 32, +28 = 60, +20 = 80
-  EXPECT_EQ(strip_layout(100, kShortIndices).size, 1060u);  // 12 + 441 = 453 -> 454, +204 = 658 -> 660, +400
+  EXPECT_EQ(strip_layout(5, kShortIndices | kShortRecords).size, 44u);  // 12 + 6 = 18, +14 = 32, +10 = 42 -> 44
+  EXPECT_EQ(strip_layout(5, 0).size, 68u);                              // 18 -> 20, +28 = 48, +20 = 68
+  EXPECT_EQ(strip_layout(100, kShortIndices).size, 764u);   // 12 + 147 = 159 -> 160, +204 = 364, +400 = 764
   for (std::uint32_t n = 1; n <= 2000; ++n) {
     for (std::uint8_t widths = 0; widths < 4; ++widths) {
       const std::size_t w = (widths & kShortIndices) ? 2 : 4, v = (widths & kShortRecords) ? 2 : 4;
       const std::size_t nodes = (n + 1) / 2 - 1;
-      std::size_t size = 12 + 9 * nodes;
+      std::size_t size = 12 + 3 * nodes;
       size = (size + w - 1) / w * w + w * (n + 2);
       size = (size + v - 1) / v * v + v * n;
       size = (size + 3) / 4 * 4;
       ASSERT_EQ(strip_layout(n, widths).size, size) << n << " triangles, widths " << int(widths);
-      ASSERT_LE(strip_layout(n, widths).size, 12 + 4.5 * n + w * (n + 2) + v * n + 6);
+      ASSERT_LE(strip_layout(n, widths).size, 12 + 1.5 * n + w * (n + 2) + v * n + 6);
     }
   }
 }
@@ -70,7 +70,9 @@ TEST(RayStripFormat, EncodedStripDecodesToItsVerticesTrianglesAndCorners) {
     const StripEncoding encoding = choose_encoding(strip, identity);
     const auto n = static_cast<std::uint32_t>(strip.triangles.size());
     std::vector<std::byte> buffer(encoding.size(n) + 64, std::byte{0xAB});
-    encode_strip(strip, encoding, identity, mesh.positions, mesh, buffer.data());
+    Bounds3 frame;  // the strip's own box, as a binary top leaf of one strip has
+    for (const std::uint32_t vertex : strip.vertices) frame.extend(mesh.positions[vertex]);
+    encode_strip(strip, encoding, identity, mesh.positions, mesh, frame, buffer.data());
     for (std::size_t i = encoding.size(n); i < buffer.size(); ++i) ASSERT_EQ(buffer[i], std::byte{0xAB}) << "wrote past the formula";
     const StripView view(buffer.data());
     ASSERT_EQ(view.triangles(), n);
@@ -82,23 +84,29 @@ TEST(RayStripFormat, EncodedStripDecodesToItsVerticesTrianglesAndCorners) {
       EXPECT_EQ(view.vertex(k + view.corners(k) / 3), corners.y);
       EXPECT_EQ(view.vertex(k + view.corners(k) % 3), corners.z);
     }
-    // The root's planes bound its children: the lower child ends at lower_child_max, the
-    // upper one starts at upper_child_min.
+    // The root's decoded planes bound its children: the lower child ends at or before
+    // lower_child_max, the upper one starts at or after upper_child_min, each within a step.
     if (node_count(n) > 0) {
       const int axis = view.node_bits(0) & kAxisMask;
       ASSERT_LT(axis, 3);
+      const SplitPlanes planes = decode_split(view.split_steps(0), frame, axis);
+      float lower_max = -1e30f, upper_min = 1e30f;
       const std::uint32_t split_vertex = 2 * ((leaf_count(n) + 1) / 2);  // first child: vertices [0, split + 2)
       const bool reverse = (view.node_bits(0) & kReverse) != 0;
       for (std::uint32_t i = 0; i < n + 2; ++i) {
         const float coordinate = mesh.positions[view.vertex(i)][axis];
         const bool in_first = i < split_vertex + 2, in_second = i >= split_vertex;
         if ((in_first && !reverse) || (in_second && reverse)) {
-          EXPECT_LE(coordinate, view.splits(0)[0]) << i;
+          EXPECT_LE(coordinate, planes.lower_child_max) << i;
+          lower_max = std::max(lower_max, coordinate);
         }
         if ((in_second && !reverse) || (in_first && reverse)) {
-          EXPECT_GE(coordinate, view.splits(0)[1]) << i;
+          EXPECT_GE(coordinate, planes.upper_child_min) << i;
+          upper_min = std::min(upper_min, coordinate);
         }
       }
+      EXPECT_LE(planes.lower_child_max - lower_max, split_step(frame, axis) * 1.001f);
+      EXPECT_LE(upper_min - planes.upper_child_min, split_step(frame, axis) * 1.001f);
     }
     covered += n;
   }

@@ -5,7 +5,9 @@
 // A Ray-Strip of n triangles (1 <= n <= 65535) lists n + 2 vertices s[0 .. n+1]; triangle k
 // has the corners (s[k], s[k+1], s[k+2]). Turns of the strip repeat a triangle (a swap
 // vertex), so n counts those repeats too; a repeated triangle answers exactly as its first
-// copy. Little-endian; a strip starts 4-byte aligned; N = ceil(n / 2) - 1 kd-tree nodes.
+// copy. Little-endian; a strip starts 4-byte aligned; N = ceil(n / 2) - 1 kd-tree nodes. The
+// strip's frame F is the box of the top leaf that holds it (its float box in the binary top,
+// its decoded box in the 8-wide one), which the owner knows when it encodes and traverses.
 //
 //   offset            size        field
 //        0               2        n             uint16  triangles (repeats included)
@@ -15,10 +17,14 @@
 //        3               1        zero
 //        4               4        vertex_base   uint32  added to every stored vertex index
 //        8               4        triangle_base uint32  added to every record's triangle delta
-//       12             8 N        splits        per node: float lower_child_max, float upper_child_min
-//   12 + 8N              N        node_bits     per node: bits 0-1 split axis (0 x, 1 y, 2 z),
+//       12             2 N       splits        per node, on its split axis a: uint8 q_max, uint8 q_min;
+//                                               with step = (F.upper[a] - F.lower[a]) * (1.0f / 255.0f),
+//                                               lower_child_max = fma(-q_max, step, F.upper[a]),
+//                                               upper_child_min = fma(q_min, step, F.lower[a])
+//                                               (rounded outward by the encoder through this arithmetic)
+//   12 + 2N              N        node_bits     per node: bits 0-1 split axis (0 x, 1 y, 2 z),
 //                                               bit 2 reverse, bits 3-7 zero
-//   I = align(12 + 9N, W)         indices       (n + 2) x W bytes, W = 2 or 4 (widths bit 0):
+//   I = align(12 + 3N, W)         indices       (n + 2) x W bytes, W = 2 or 4 (widths bit 0):
 //                                               s[i] = vertex_base + stored[i]
 //   R = align(I + W(n + 2), V)    records       n x V bytes, V = 2 or 4 (widths bit 1):
 //                                               record = (triangle - triangle_base) << 3 | corners
@@ -43,7 +49,10 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cmath>
 #include <cstring>
+
+#include "scene/triangle_mesh.hpp"
 
 namespace wavetrace::ray_strip {
 
@@ -75,7 +84,7 @@ constexpr StripLayout strip_layout(std::uint32_t triangles, std::uint8_t widths)
   const std::size_t record_bytes = (widths & kShortRecords) ? 2 : 4;
   StripLayout layout{};
   layout.splits = kHeaderBytes;
-  layout.node_bits = kHeaderBytes + 8 * nodes;
+  layout.node_bits = kHeaderBytes + 2 * nodes;
   layout.indices = align_up(layout.node_bits + nodes, index_bytes);
   layout.records = align_up(layout.indices + index_bytes * (triangles + 2), record_bytes);
   layout.size = align_up(layout.records + record_bytes * triangles, 4);
@@ -101,8 +110,8 @@ class StripView {
   const StripLayout& layout() const { return layout_; }
   std::uint8_t widths() const { return widths_; }
 
-  const float* splits(std::uint32_t node) const {
-    return reinterpret_cast<const float*>(base_ + layout_.splits) + 2 * node;
+  const std::uint8_t* split_steps(std::uint32_t node) const {
+    return reinterpret_cast<const std::uint8_t*>(base_ + layout_.splits) + 2 * node;
   }
   std::uint8_t node_bits(std::uint32_t node) const { return static_cast<std::uint8_t>(base_[layout_.node_bits + node]); }
 
@@ -134,5 +143,15 @@ class StripView {
   std::uint32_t triangle_base_;
   StripLayout layout_;
 };
+
+// A node's planes on its split axis a (see above), from the strip's frame.
+struct SplitPlanes {
+  float lower_child_max, upper_child_min;
+};
+inline float split_step(const Bounds3& frame, int axis) { return (frame.upper[axis] - frame.lower[axis]) * (1.0f / 255.0f); }
+inline SplitPlanes decode_split(const std::uint8_t* steps, const Bounds3& frame, int axis) {
+  const float step = split_step(frame, axis);
+  return {std::fma(-float(steps[0]), step, frame.upper[axis]), std::fma(float(steps[1]), step, frame.lower[axis])};
+}
 
 }  // namespace wavetrace::ray_strip

@@ -121,7 +121,7 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> cut_submeshes(const BuildTr
 struct RayStripsSavedOptions {
   std::uint32_t run_triangles, packet_min_active, packets, stripifier, submesh_triangles, strips_per_leaf, width, zero;
 };
-constexpr std::uint32_t kRayStripsSavedVersion = 2;
+constexpr std::uint32_t kRayStripsSavedVersion = 3;  // 3: 8-bit split planes; 2: the width 8 top
 
 class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator> {
   friend class ProbedAccelerator<RayStripsAccelerator>;
@@ -231,23 +231,30 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
     peak = std::max(peak, top.peak_bytes + strip_bounds.size() * sizeof(Bounds3));
     strip_bounds = {};
     // The strips in storage order: the top's leaves in the order its layout references them.
+    // Each strip's frame is its top leaf's box as traversal sees it: the float box of a binary
+    // leaf, the decoded box of a wide one.
     std::vector<std::uint32_t> strip_order;
+    std::vector<Bounds3> strip_frame;
     strip_order.reserve(strips.size());
-    auto store_leaf = [&](const BuildNode& leaf) {
-      for (std::uint32_t k = 0; k < leaf.count; ++k) strip_order.push_back(top.primitive_order[leaf.first + k]);
+    strip_frame.reserve(strips.size());
+    auto store_leaf = [&](const BuildNode& leaf, const Bounds3& frame) {
+      for (std::uint32_t k = 0; k < leaf.count; ++k) {
+        strip_order.push_back(top.primitive_order[leaf.first + k]);
+        strip_frame.push_back(frame);
+      }
     };
     const std::vector<std::uint32_t> node_order_list = node_order(top, NodeLayout::depth_first);
     std::vector<std::size_t> leaf_first_strip;  // width 8: each leaf's first place in strip_order
     QuantizedWideTree wide;
     if (options.width == 8) {
-      wide = build_quantized_wide_tree(top, [&](const BuildNode& leaf, const Bounds3&) {
+      wide = build_quantized_wide_tree(top, [&](const BuildNode& leaf, const Bounds3& box) {
         leaf_first_strip.push_back(strip_order.size());
-        store_leaf(leaf);
+        store_leaf(leaf, box);
         return 1u;  // references number the leaves
       });
     } else {
       for (const std::uint32_t built : node_order_list) {
-        if (top.nodes[built].leaf()) store_leaf(top.nodes[built]);
+        if (top.nodes[built].leaf()) store_leaf(top.nodes[built], top.nodes[built].bounds);
       }
     }
     // Vertices renumbered by first use in storage order, so a strip's indices lie close together.
@@ -275,7 +282,8 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
     }
     LargeArray<std::byte> strip_bytes(offset.back());
     tbb::parallel_for(std::size_t{0}, strip_order.size(), [&](std::size_t i) {
-      encode_strip(strips[strip_order[i]], encodings[i], vertex_id, positions, mesh, strip_bytes.data() + offset[i]);
+      encode_strip(strips[strip_order[i]], encodings[i], vertex_id, positions, mesh, strip_frame[i],
+                   strip_bytes.data() + offset[i]);
     });
 
     if (options.width == 8) {
@@ -417,7 +425,8 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
         float near, far;
         if (!clip_to_box(ray.box, leaf.lower, leaf.upper, ray.tmin, ray.tmax, near, far)) return false;
         const std::byte* strip_data = strip_bytes_.data() + std::size_t(leaf.first) * 4;
-        return trace_strips<kAnyHit>(ray, strip_data, leaf.triangle_count(), near, far, positions, probe);
+        return trace_strips<kAnyHit>(ray, Bounds3{leaf.lower, leaf.upper}, strip_data, leaf.triangle_count(), near, far,
+                                     positions, probe);
       });
       write_hit<!kAnyHit>(ray, hits, i, &probe);
     });
@@ -437,18 +446,18 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
         probe.read(leaf_words + leaf, 2 * sizeof(std::uint32_t));
         const std::byte* strip_data = strip_bytes_.data() + std::size_t(leaf_words[leaf]) * 4;
         const std::byte* end = strip_bytes_.data() + std::size_t(leaf_words[leaf + 1]) * 4;
-        return trace_strips<kAnyHit>(ray, strip_data, end, near, far, positions, probe);
+        return trace_strips<kAnyHit>(ray, box, strip_data, end, near, far, positions, probe);
       });
       write_hit<!kAnyHit>(ray, hits, i, &probe);
     });
   }
 #endif
 
-  // The strips of one top leaf, from `strip_data` on: `count` of them, or (wide top) up to
-  // `end`. True when an any-hit query is answered.
+  // The strips of one top leaf (whose box is `frame`), from `strip_data` on: `count` of them,
+  // or (wide top) up to `end`. True when an any-hit query is answered.
   template <bool kAnyHit, typename Probe, typename Until>
-  bool trace_strips(StripRay& ray, const std::byte* strip_data, Until until, float near, float far,
-                    const glm::vec3* positions, Probe& probe) const {
+  bool trace_strips(StripRay& ray, const Bounds3& frame, const std::byte* strip_data, Until until, float near,
+                    float far, const glm::vec3* positions, Probe& probe) const {
     for (std::uint32_t s = 0;; ++s) {
       if constexpr (std::is_integral_v<Until>) {
         if (s == until) return false;
@@ -457,7 +466,7 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
       }
       probe.read(strip_data, ray_strip::kHeaderBytes);
       const StripView strip(strip_data);
-      ray.traverse<kAnyHit>(strip, positions, near, far, options_.run_triangles, probe);
+      ray.traverse<kAnyHit>(strip, frame, positions, near, far, options_.run_triangles, probe);
       if (kAnyHit && ray.found()) return true;
       strip_data += strip.size();
     }

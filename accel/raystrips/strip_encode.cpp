@@ -2,6 +2,7 @@
 #include "accel/raystrips/strip_encode.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <stdexcept>
 
@@ -19,11 +20,27 @@ Bounds3 bounds_of_triangles(const TriangleStrip& strip, std::span<const std::uin
   return bounds;
 }
 
+// The split steps of one node, rounded outward: the decoded lower child's max at or above its
+// true max, the upper child's min at or below its true min (decode_split's arithmetic).
+void quantize_split(const Bounds3& frame, int axis, float lower_child_max, float upper_child_min, std::uint8_t* steps) {
+  const float step = split_step(frame, axis);
+  float q_max = 0.0f, q_min = 0.0f;
+  if (step > 0.0f) {
+    q_max = std::clamp(std::floor((frame.upper[axis] - lower_child_max) / step), 0.0f, 255.0f);
+    while (q_max > 0.0f && std::fma(-q_max, step, frame.upper[axis]) < lower_child_max) q_max -= 1.0f;
+    q_min = std::clamp(std::floor((upper_child_min - frame.lower[axis]) / step), 0.0f, 255.0f);
+    while (q_min > 0.0f && std::fma(q_min, step, frame.lower[axis]) > upper_child_min) q_min -= 1.0f;
+  }
+  steps[0] = static_cast<std::uint8_t>(q_max);
+  steps[1] = static_cast<std::uint8_t>(q_min);
+}
+
 struct TreeWriter {
   const TriangleStrip& strip;
   std::span<const std::uint32_t> vertex_id;
   std::span<const glm::vec3> positions;
-  float* splits;
+  const Bounds3& frame;
+  std::uint8_t* splits;
   std::byte* node_bits;
   std::uint32_t triangles;
 
@@ -46,8 +63,7 @@ struct TreeWriter {
     const bool reverse = a.lower[axis] + a.upper[axis] > b.lower[axis] + b.upper[axis];
     const Bounds3& lower = reverse ? b : a;
     const Bounds3& upper = reverse ? a : b;
-    splits[2 * node] = lower.upper[axis];
-    splits[2 * node + 1] = upper.lower[axis];
+    quantize_split(frame, axis, lower.upper[axis], upper.lower[axis], splits + 2 * node);
     node_bits[node] = static_cast<std::byte>(axis | (reverse ? kReverse : 0));
     if (first_leaves >= 2) write(node + 1, first, first_leaves);
     if (leaves - first_leaves >= 2) write(node + first_leaves, middle, leaves - first_leaves);
@@ -97,7 +113,7 @@ StripEncoding choose_encoding(const TriangleStrip& strip, std::span<const std::u
 }
 
 void encode_strip(const TriangleStrip& strip, const StripEncoding& encoding, std::span<const std::uint32_t> vertex_id,
-                  std::span<const glm::vec3> positions, const TriangleMesh& mesh, std::byte* out) {
+                  std::span<const glm::vec3> positions, const TriangleMesh& mesh, const Bounds3& frame, std::byte* out) {
   const auto triangles = static_cast<std::uint32_t>(strip.triangles.size());
   const StripLayout layout = strip_layout(triangles, encoding.widths);
   std::memset(out, 0, layout.size);
@@ -108,8 +124,8 @@ void encode_strip(const TriangleStrip& strip, const StripEncoding& encoding, std
   std::memcpy(out + 8, &encoding.triangle_base, 4);
 
   if (leaf_count(triangles) >= 2) {
-    TreeWriter writer{strip, vertex_id, positions, reinterpret_cast<float*>(out + layout.splits), out + layout.node_bits,
-                      triangles};
+    TreeWriter writer{strip, vertex_id, positions, frame, reinterpret_cast<std::uint8_t*>(out + layout.splits),
+                      out + layout.node_bits, triangles};
     writer.write(0, 0, leaf_count(triangles));
   }
   for (std::uint32_t i = 0; i < triangles + 2; ++i) {

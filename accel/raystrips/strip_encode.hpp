@@ -25,8 +25,9 @@ struct StripEncoding {
 StripEncoding choose_encoding(const TriangleStrip& strip, std::span<const std::uint32_t> vertex_id);
 
 // Writes the strip at `out` (encoding.size(n) bytes, 4-byte aligned); `positions` are in
-// the accelerator's vertex numbering, `mesh` gives each triangle's corner order.
+// the accelerator's vertex numbering, `mesh` gives each triangle's corner order, `frame` is
+// the box of the top leaf holding the strip, which its split planes are quantized against.
 void encode_strip(const TriangleStrip& strip, const StripEncoding& encoding, std::span<const std::uint32_t> vertex_id,
-                  std::span<const glm::vec3> positions, const TriangleMesh& mesh, std::byte* out);
+                  std::span<const glm::vec3> positions, const TriangleMesh& mesh, const Bounds3& frame, std::byte* out);
 
 }  // namespace wavetrace

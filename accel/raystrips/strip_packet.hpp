@@ -80,7 +80,7 @@ struct PacketTraversal {
         const std::byte* strip_data = strips + std::size_t(current.first) * 4;
         for (std::uint32_t s = 0; s < current.triangle_count(); ++s) {
           const ray_strip::StripView strip(strip_data);
-          traverse_strip(strip, packet, lanes, inside, near, far);
+          traverse_strip(strip, Bounds3{current.lower, current.upper}, packet, lanes, inside, near, far);
           strip_data += strip.size();
         }
       }
@@ -132,7 +132,8 @@ struct PacketTraversal {
   static Lanes widen_entry(Lanes t) { return t * (t > 0.0f ? Lanes{} + (1.0f - kPlaneDistanceSlack) : Lanes{} + (1.0f + kPlaneDistanceSlack)); }
 
   // The packet's rays in `mask` through one strip, each within its own [dmin, dmax].
-  void traverse_strip(const ray_strip::StripView& strip, std::optional<StripRay>* packet, Packet& lanes,
+  void traverse_strip(const ray_strip::StripView& strip, const Bounds3& frame, std::optional<StripRay>* packet,
+                      Packet& lanes,
                       std::uint32_t mask, Lanes entry, Lanes exit) const {
     using namespace ray_strip;
     NullProbe probe;
@@ -150,15 +151,16 @@ struct PacketTraversal {
         for (std::uint32_t bits = current.mask; bits != 0; bits &= bits - 1) {
           const int r = std::countr_zero(bits);
           StripRay& ray = *packet[r];
-          ray.traverse_subtree<false>(strip, positions, current.node, current.first, current.leaves, current.dmin[r],
+          ray.traverse_subtree<false>(strip, frame, positions, current.node, current.first, current.leaves, current.dmin[r],
                                       current.dmax[r], run_triangles, probe);
           lanes.tmax[r] = ray.tmax;
         }
       } else if (current.leaves >= 2 &&
                  std::min(2 * (current.first + current.leaves), triangles) - 2 * current.first > run_triangles) {
-        const float* split = strip.splits(current.node);
         const std::uint8_t bits = strip.node_bits(current.node);
         const int axis = bits & kAxisMask;
+        const SplitPlanes planes = decode_split(strip.split_steps(current.node), frame, axis);
+        const float split[2] = {planes.lower_child_max, planes.upper_child_min};
         const bool reverse = (bits & kReverse) != 0;
         const std::uint32_t first_leaves = (current.leaves + 1) / 2;
         const Lanes dmin = current.dmin;

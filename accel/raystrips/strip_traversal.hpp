@@ -57,18 +57,20 @@ class StripRay {
 
   bool found() const { return hit.strip != nullptr; }
 
-  // Walks the strip's kd-tree inside [dmin, dmax] (the part of the ray in the strip's box),
-  // testing runs of at most `run_triangles` triangles. With kAnyHit stops at the first hit.
+  // Walks the strip's kd-tree inside [dmin, dmax] (the part of the ray in the strip's frame,
+  // the box of its top leaf), testing runs of at most `run_triangles` triangles. With kAnyHit
+  // stops at the first hit.
   template <bool kAnyHit, typename Probe>
-  void traverse(const ray_strip::StripView& strip, const glm::vec3* positions, float dmin, float dmax,
-                std::uint32_t run_triangles, Probe& probe) {
-    traverse_subtree<kAnyHit>(strip, positions, 0, 0, ray_strip::leaf_count(strip.triangles()), dmin, dmax,
+  void traverse(const ray_strip::StripView& strip, const Bounds3& frame, const glm::vec3* positions, float dmin,
+                float dmax, std::uint32_t run_triangles, Probe& probe) {
+    traverse_subtree<kAnyHit>(strip, frame, positions, 0, 0, ray_strip::leaf_count(strip.triangles()), dmin, dmax,
                               run_triangles, probe);
   }
 
   // The same from kd-node `node` spanning leaves [first, first + leaves).
   template <bool kAnyHit, typename Probe>
-  void traverse_subtree(const ray_strip::StripView& strip, const glm::vec3* positions, std::uint32_t node,
+  void traverse_subtree(const ray_strip::StripView& strip, const Bounds3& frame, const glm::vec3* positions,
+                        std::uint32_t node,
                         std::uint32_t first, std::uint32_t leaves, float dmin, float dmax, std::uint32_t run_triangles,
                         Probe& probe) {
     using namespace ray_strip;
@@ -83,11 +85,12 @@ class StripRay {
     while (true) {
       // Descend while the span holds more triangles than one run tests.
       while (leaves >= 2 && std::min(2 * (first + leaves), triangles) - 2 * first > run_triangles) {
-        probe.read(strip.splits(node), 8);
+        probe.read(strip.split_steps(node), 2);
         probe.read(strip.data() + strip.layout().node_bits + node, 1);
-        const float* split = strip.splits(node);
         const std::uint8_t bits = strip.node_bits(node);
         const int axis = bits & kAxisMask;
+        const SplitPlanes planes = decode_split(strip.split_steps(node), frame, axis);
+        const float split[2] = {planes.lower_child_max, planes.upper_child_min};
         const bool reverse = (bits & kReverse) != 0;
         const std::uint32_t first_leaves = (leaves + 1) / 2;
         const Pending strip_first{node + 1, first, first_leaves, 0, 0};
