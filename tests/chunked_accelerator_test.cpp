@@ -3,6 +3,8 @@
 // only its own memory when probed.
 #include <gtest/gtest.h>
 
+#include <sstream>
+
 #include <limits>
 
 #include "accel/chunked/chunked_accelerator.hpp"
@@ -38,9 +40,14 @@ TEST(PlanChunks, ObjectsSplitEvenlyAndNeverShareAChunk) {
   EXPECT_EQ(covered, 1000003u);
 }
 
+// `type` is an accelerator name, optionally followed by settings: "hmq accel.hmq.width=8".
 AcceleratorOptions options_for(const std::string& type, std::size_t chunk_triangles) {
   Config config;
-  config.set("accel.type=" + type);
+  std::istringstream words(type);
+  std::string name, setting;
+  words >> name;
+  config.set("accel.type=" + name);
+  while (words >> setting) config.set(setting);
   config.set("build.chunk_triangles=" + std::to_string(chunk_triangles));
   return accelerator_options(config);
 }
@@ -74,13 +81,21 @@ TEST_P(ChunkedWorld, AnswersAsTheMonolithicBuildDoes) {
                                                                    kind, 20000, 1e-5f * diagonal, 1e-3f, packets);
         EXPECT_LE(double(result.hit_differs), 1e-4 * double(result.rays)) << label;
         EXPECT_LE(double(result.far_t), 1e-4 * double(result.rays)) << label;
-        if (kind != RaySetKind::shadow) EXPECT_GT(result.same_primitive, result.rays * 9 / 10) << label;
+        if (kind != RaySetKind::shadow) {
+          EXPECT_GT(result.same_primitive, result.rays * 9 / 10) << label;
+        }
       }
     }
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Types, ChunkedWorld, ::testing::Values("hmq", "raystrips", "bvh"));
+INSTANTIATE_TEST_SUITE_P(Types, ChunkedWorld,
+                         ::testing::Values("hmq", "raystrips", "bvh", "hmq accel.hmq.width=8",
+                                           "raystrips accel.raystrips.width=8"),
+                         [](const ::testing::TestParamInfo<std::string>& info) {
+                           std::string name = info.param.substr(0, info.param.find(' '));
+                           return info.param.find("width=8") != std::string::npos ? name + "_wide" : name;
+                         });
 
 TEST(ChunkedWorld, HmqChunksShareOneGlobalGrid) {
   // Every chunk snaps to the scene's grid: a vertex on a chunk border decodes alike in both
