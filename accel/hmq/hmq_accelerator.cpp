@@ -56,10 +56,6 @@ std::uint32_t quantize_child(const Box& parent, const Bounds3& child) {
   return bits;
 }
 
-struct PartBytes {
-  std::size_t hierarchy = 0, geometry = 0, other = 0;
-};
-
 class BlockEncoder {
  public:
   BlockEncoder(const BuildTree& tree, const QuantizedMesh& quantized, const GlobalGrid& grid,
@@ -316,9 +312,7 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
   }
 
   std::optional<TriangleMesh> represented_mesh(const TriangleMesh& source) const override {
-    TriangleMesh snapped = source;
-    for (glm::vec3& p : snapped.positions) p = grid_.point(grid_.snap(p));
-    return snapped;
+    return snapped_mesh(grid_, source);
   }
 
  private:

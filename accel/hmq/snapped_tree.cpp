@@ -60,4 +60,10 @@ SnappedTree build_snapped_tree(const TriangleMesh& mesh, const HmqOptions& optio
   return snapped;
 }
 
+TriangleMesh snapped_mesh(const GlobalGrid& grid, const TriangleMesh& source) {
+  TriangleMesh snapped = source;
+  for (glm::vec3& p : snapped.positions) p = grid.point(grid.snap(p));
+  return snapped;
+}
+
 }  // namespace wavetrace::hmq

@@ -11,6 +11,11 @@
 
 namespace wavetrace::hmq {
 
+// Bytes of either layout by part, as MemoryReport gives them.
+struct PartBytes {
+  std::size_t hierarchy = 0, geometry = 0, other = 0;
+};
+
 struct SnappedTree {
   GlobalGrid grid;
   QuantizedMesh quantized;
@@ -21,5 +26,7 @@ struct SnappedTree {
 // Throws std::invalid_argument for options outside their ranges or an empty mesh.
 void check_options(const HmqOptions& options);
 SnappedTree build_snapped_tree(const TriangleMesh& mesh, const HmqOptions& options);
+// The mesh either layout represents: every vertex moved to its grid point.
+TriangleMesh snapped_mesh(const GlobalGrid& grid, const TriangleMesh& source);
 
 }  // namespace wavetrace::hmq

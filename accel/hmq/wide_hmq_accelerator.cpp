@@ -27,10 +27,6 @@ using namespace hmq;
 // 508 bytes, above the largest, 472: 14 triangles, 42 vertices of 3 x 25 bits, 32-bit id deltas).
 constexpr std::size_t kUnit = 2;
 
-struct PartBytes {
-  std::size_t hierarchy = 0, geometry = 0, other = 0;
-};
-
 // What an hmq:width=8 world saves besides its arrays, `PREFIX` + "hmq8.state" (112 bytes):
 //   offset  size  field
 //        0    56  the global grid, as in "hmq.state" (hmq_accelerator.cpp)
@@ -145,9 +141,7 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
   std::vector<std::span<const std::byte>> memory_spans() const override { return {nodes_.bytes(), leaves_.bytes()}; }
 
   std::optional<TriangleMesh> represented_mesh(const TriangleMesh& source) const override {
-    TriangleMesh snapped = source;
-    for (glm::vec3& p : snapped.positions) p = grid_.point(grid_.snap(p));
-    return snapped;
+    return snapped_mesh(grid_, source);
   }
 
  private:
