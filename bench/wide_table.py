@@ -30,3 +30,23 @@ for path in sorted(glob.glob(os.path.join(out, "leak_*.json"))):
     report = json.load(open(path))
     print(f"\nLeaks, {os.path.basename(path)[5:-5]}, {report['results'][0]['rays']} rays each:",
           ", ".join(f"{r.get('label', r.get('accel'))} {r['escaped']}" for r in report["results"]))
+
+# The same as one row per layout: bytes per triangle and the ratio to default Embree, primary / diffuse, per scene.
+print("\n| accel | " + " | ".join(f"{n} B/tri, prim / diff" for n in order) + " |")
+print("|---|" + "---|" * len(order))
+rows = {}
+for name in order:
+    cells = {}
+    for rays in ["primary", "diffuse"]:
+        path = os.path.join(out, f"{name}_{rays}.json")
+        if not os.path.exists(path):
+            continue
+        report = json.load(open(path))
+        first = report["results"][0]
+        for r in report["results"]:
+            cell = cells.setdefault(r["accel"], [r["bytes_per_triangle"], None, None])
+            cell[1 if rays == "primary" else 2] = r["mrays_per_s"] / first["mrays_per_s"]
+    for accel, (bpt, prim, diff) in cells.items():
+        rows.setdefault(accel, {})[name] = f"{bpt:.1f}, {prim:.2f}x / {diff:.2f}x"
+for accel, cells in rows.items():
+    print(f"| {accel} | " + " | ".join(cells.get(n, "") for n in order) + " |")
