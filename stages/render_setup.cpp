@@ -103,6 +103,12 @@ AcceleratorOptions accelerator_options(const Config& config) {
   if (options.hmq.width != 2 && options.hmq.width != 8) {
     throw ConfigError(fmt::format("accel.hmq.width = {}: must be 2 or 8", options.hmq.width));
   }
+  // A top share set for the wide layout, which has no float top, is refused, not ignored.
+  if (options.hmq.width == 8 && options.hmq.top_fraction != HmqOptions{}.top_fraction) {
+    throw ConfigError(fmt::format("accel.hmq.top_fraction = {} applies to the binary layout (width 2): width 8 "
+                                  "quantizes every node",
+                                  options.hmq.top_fraction));
+  }
   return options;
 }
 

@@ -119,6 +119,9 @@ TEST(WideHmq, BadWidthIsAClearError) {
   config.set("accel.hmq.width=4");
   EXPECT_THROW(accelerator_options(config), ConfigError);
   EXPECT_THROW(parse_accelerator_spec("hmq:width=16", Config{}), ConfigError);
+  // A float top share for the layout that has none is refused, not ignored.
+  EXPECT_THROW(parse_accelerator_spec("hmq:width=8:top_fraction=0.1", Config{}), ConfigError);
+  EXPECT_NO_THROW(parse_accelerator_spec("hmq:width=8:leaf_size=12", Config{}));
 }
 
 }  // namespace
