@@ -25,7 +25,7 @@ struct HmqOptions {
   double top_fraction = 0.05;    // share of the BVH's nodes kept uncompressed at its top, 0 .. 1
                                  // (binary layout only: the 8-wide one quantizes every node)
   // 2: the paper's binary tree of 4-byte nodes in blocks; 8: 64-byte nodes of eight children
-  // quantized to 8 bits per plane, tested in AVX2 lanes (wide_hmq_node.hpp). Same leaves.
+  // quantized to 8 bits per plane, tested in AVX2 lanes (accel/bvh/quantized_wide_node.hpp). Same leaves.
   std::uint32_t width = 2;
   std::uint32_t bins = 16;       // SAH bins
   // The box the global grid spans: the whole scene's when a chunk is built, so that every

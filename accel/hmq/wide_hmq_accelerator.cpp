@@ -59,17 +59,17 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
     std::vector<std::byte> leaves;
     PartBytes parts;
     QuantizedWideTree tree = build_quantized_wide_tree(snapped.tree, [&](const BuildNode& leaf, const Bounds3& box) {
-      const std::size_t start = leaves.size();
+      const std::size_t at = leaves.size();
       encode_leaf(snapped.quantized, std::span(snapped.tree.primitive_order.data() + leaf.first, leaf.count),
                   snap_outward(grid_, Box{box.lower, box.upper}), leaves);
-      const LeafHeader header = read_leaf_header(leaves.data() + start);
+      const LeafHeader header = read_leaf_header(leaves.data() + at);
       const std::size_t identity = stream_bytes(header.id_bits, leaf.count) + stream_bytes(3, leaf.count);
-      const std::size_t record = leaves.size() - start;
-      leaves.resize(start + (record + kUnit - 1) / kUnit * kUnit, std::byte{0});
+      const std::size_t record = leaves.size() - at;
+      leaves.resize(at + (record + kUnit - 1) / kUnit * kUnit, std::byte{0});
       parts.other += identity;
       parts.geometry += record - identity;
-      parts.hierarchy += leaves.size() - start - record;
-      return static_cast<std::uint32_t>((leaves.size() - start) / kUnit);
+      parts.hierarchy += leaves.size() - at - record;
+      return static_cast<std::uint32_t>((leaves.size() - at) / kUnit);
     });
     leaves.resize(leaves.size() + 8, std::byte{0});  // read slack for unaligned 8-byte stream loads
     parts.hierarchy += 8 + tree.nodes.size() * sizeof(QuantizedWideNode);
