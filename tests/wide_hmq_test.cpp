@@ -12,6 +12,7 @@
 #include "accel_agreement.hpp"
 #include "bench/accel_bench.hpp"
 #include "bench/leak_bench.hpp"
+#include "bench/ray_sets.hpp"
 #include "scene/builtin_scenes.hpp"
 #include "scene/scene.hpp"
 #include "stages/render_setup.hpp"
@@ -65,6 +66,28 @@ INSTANTIATE_TEST_SUITE_P(Scenes, WideHmqMatchesBinary,
                                            "builtin:stadium:2000", "builtin:fur:30k",
                                            std::string(WAVETRACE_DATA_DIR) + "/bunny00.off"),
                          scene_label);
+
+TEST(WideHmq, PacketsAnswerExactlyAsSingleRays) {
+  for (const char* source : {"builtin:sphere:30k", "builtin:room:50k", "builtin:fur:20k"}) {
+    const Scene scene = make_builtin_scene(source);
+    const auto wide = make_hmq_accelerator(scene.mesh, hmq_options(8, 8, 16));
+    const RaySet rays = make_ray_set(RaySetKind::primary, scene, *wide, 20000);
+    const auto single = trace_ray_set(*wide, rays, false);
+    const auto packets = trace_ray_set(*wide, rays, true);
+    std::size_t hits = 0;
+    for (std::size_t b = 0; b < rays.batches.size(); ++b) {
+      for (std::size_t i = 0; i < rays.batches[b]->count; ++i) {
+        ASSERT_EQ(single[b]->t[i], packets[b]->t[i]) << source;
+        if (std::string(source) != "builtin:fur:20k") {  // coincident strands may tie in another order
+          ASSERT_EQ(single[b]->primitive[i], packets[b]->primitive[i]) << source;
+          ASSERT_EQ(single[b]->u[i], packets[b]->u[i]) << source;
+        }
+        hits += single[b]->is_hit(i);
+      }
+    }
+    EXPECT_GT(hits, 1000u) << source;
+  }
+}
 
 TEST(WideHmq, NoRayEscapesClosedMeshes) {
   for (const char* source : {"builtin:sphere:100k", "builtin:room:50k"}) {

@@ -165,6 +165,128 @@ template <typename Probe, typename VisitLeaf>
   }
 }
 
+
+// Up to eight coherent rays (two 2x2 pixel quads) through the tree together: each node's boxes
+// are decoded once for the packet and slab-tested per ray, and each child is visited once
+// with the mask of the rays that entered it, nearest first for the packet (by the least
+// entry distance among its rays). A ray leaves a subtree once its own nearest hit lies
+// before its entry there.
+inline constexpr int kWidePacketRays = 8;
+
+struct QuantizedWidePacketStack {
+  static constexpr std::size_t kEntries = kMaxTreeDepth * QuantizedWideNode::kWidth + QuantizedWideNode::kWidth;
+  struct Entry {
+    std::uint32_t reference;
+    std::uint32_t rays;                   // bit r: ray r entered this child
+    float distance[kWidePacketRays];      // ray r's entry distance (valid where its bit is set)
+    Bounds3 frame;
+  };
+  Entry entries[kEntries];
+};
+
+// `visit_leaf(reference, box, rays)` handles a leaf for the rays in the mask `rays`, shrinking
+// their `tmax`; `live` marks the rays of `rays_in` that take part.
+template <typename Probe, typename VisitLeaf>
+[[gnu::always_inline]] inline void walk_quantized_wide_packet(const QuantizedWideNode* nodes, const Bounds3& root_frame,
+                                                              const SingleRay* rays_in, unsigned live,
+                                                              const float* tmax, Probe& probe,
+                                                              QuantizedWidePacketStack& stack, VisitLeaf&& visit_leaf) {
+  using namespace quantized_wide;
+  using Entry = QuantizedWidePacketStack::Entry;
+  constexpr float kInfinity = std::numeric_limits<float>::infinity();
+  const __m256i lane_index = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  __m256 origin[kWidePacketRays][3], inverse[kWidePacketRays][3];
+  for (unsigned bits = live; bits != 0; bits &= bits - 1) {
+    const int r = std::countr_zero(bits);
+    for (int axis = 0; axis < 3; ++axis) {
+      origin[r][axis] = _mm256_set1_ps(rays_in[r].origin[axis]);
+      inverse[r][axis] = _mm256_set1_ps(rays_in[r].box.inverse_direction[axis]);
+    }
+  }
+  Entry current{0, live, {}, root_frame};
+  std::uint32_t top = 0;
+  while (true) {
+    if (!(current.reference & kWideLeafReference)) {
+      const QuantizedWideNode& node = nodes[current.reference];
+      probe.read(&node, sizeof node);
+      __m256 bound[6];
+      for (int axis = 0; axis < 3; ++axis) {
+        const __m256 step = _mm256_set1_ps(frame_step(current.frame, axis));
+        const __m256 q_lower =
+            _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(node.lower(axis)))));
+        const __m256 q_upper =
+            _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(node.upper(axis)))));
+        bound[axis] = _mm256_fmadd_ps(q_lower, step, _mm256_set1_ps(current.frame.lower[axis]));
+        bound[3 + axis] = _mm256_fnmadd_ps(q_upper, step, _mm256_set1_ps(current.frame.upper[axis]));
+      }
+      const auto occupied = static_cast<unsigned>(
+          ~_mm_movemask_epi8(_mm_cmpeq_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(node.meta)), _mm_setzero_si128())) &
+          0xff);
+      alignas(32) float near[kWidePacketRays][8];
+      unsigned entered[kWidePacketRays] = {};
+      __m256 least = _mm256_set1_ps(kInfinity);
+      for (unsigned bits = current.rays; bits != 0; bits &= bits - 1) {
+        const int r = std::countr_zero(bits);
+        __m256 entry = _mm256_set1_ps(rays_in[r].tmin), exit = _mm256_set1_ps(kInfinity);
+        for (int axis = 0; axis < 3; ++axis) {  // the single-ray walk's slab test, lane for lane
+          const __m256 t0 = _mm256_mul_ps(_mm256_sub_ps(bound[axis], origin[r][axis]), inverse[r][axis]);
+          const __m256 t1 = _mm256_mul_ps(_mm256_sub_ps(bound[3 + axis], origin[r][axis]), inverse[r][axis]);
+          entry = _mm256_max_ps(_mm256_min_ps(t1, t0), entry);
+          exit = _mm256_min_ps(_mm256_max_ps(t0, t1), exit);
+        }
+        exit = _mm256_min_ps(_mm256_mul_ps(exit, _mm256_set1_ps(kSlabFarScale)), _mm256_set1_ps(tmax[r]));
+        const __m256 in = _mm256_cmp_ps(entry, exit, _CMP_LE_OQ);
+        entered[r] = static_cast<unsigned>(_mm256_movemask_ps(in)) & occupied;
+        _mm256_store_ps(near[r], entry);
+        least = _mm256_blendv_ps(least, _mm256_min_ps(least, entry), in);
+      }
+      unsigned any = 0;
+      for (int r = 0; r < kWidePacketRays; ++r) any |= entered[r];
+      if (any != 0) {
+        const __m256 any_lanes = _mm256_castsi256_ps(_mm256_cmpgt_epi32(
+            _mm256_and_si256(_mm256_set1_epi32(int(any)), _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128)),
+            _mm256_setzero_si256()));
+        const __m256i keys = _mm256_blendv_epi8(
+            _mm256_set1_epi32(-1),
+            _mm256_or_si256(_mm256_and_si256(_mm256_castps_si256(least), _mm256_set1_epi32(~7)), lane_index),
+            _mm256_castps_si256(any_lanes));
+        alignas(32) std::int32_t order[8];
+        alignas(32) std::uint32_t reference[8];
+        alignas(32) float lanes[6][8];
+        _mm256_store_si256(reinterpret_cast<__m256i*>(order), _mm256_and_si256(sort_descending(keys), _mm256_set1_epi32(7)));
+        _mm256_store_si256(reinterpret_cast<__m256i*>(reference), child_references(node));
+        for (int b = 0; b < 6; ++b) _mm256_store_ps(lanes[b], bound[b]);
+        for (int n = 0, count = std::popcount(any); n < count; ++n) {  // farthest first: the nearest ends on top
+          const int k = order[n];
+          Entry& pushed = stack.entries[top++];
+          pushed.reference = reference[k];
+          pushed.rays = 0;
+          for (int r = 0; r < kWidePacketRays; ++r) {
+            pushed.rays |= ((entered[r] >> k) & 1u) << r;
+            pushed.distance[r] = near[r][k];
+          }
+          pushed.frame.lower = {lanes[0][k], lanes[1][k], lanes[2][k]};
+          pushed.frame.upper = {lanes[3][k], lanes[4][k], lanes[5][k]};
+        }
+      }
+    } else {
+      visit_leaf(current.reference & ~kWideLeafReference, current.frame, current.rays);
+    }
+    // Pop the nearest subtree some ray can still improve on.
+    while (true) {
+      if (top == 0) return;
+      current = stack.entries[--top];
+      unsigned still = 0;
+      for (unsigned bits = current.rays; bits != 0; bits &= bits - 1) {
+        const int r = std::countr_zero(bits);
+        if (!(current.distance[r] > tmax[r])) still |= 1u << r;
+      }
+      current.rays = still;
+      if (still != 0) break;
+    }
+  }
+}
+
 }  // namespace wavetrace
 
 #endif

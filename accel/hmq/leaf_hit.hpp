@@ -31,32 +31,32 @@ struct LeafHit {
   bool found = false;
 };
 
-// Tests the triangles of the leaf record at `record`, whose decoded box is `box`; a hit
-// nearer than `tmax` shrinks it and replaces `best` (with kAnyHit, the first one ends the test).
-template <bool kAnyHit, typename Probe>
-[[gnu::always_inline]] inline void test_leaf_record(const std::byte* record, const GlobalGrid& grid, const Box& box,
-                                                    const WatertightRay& sheared, float tmin, float& tmax,
-                                                    LeafHit& best, Probe& probe) {
-  if constexpr (Probe::kRecords) probe.read(record, leaf_record_bytes(record));
+// A leaf decoded once, with its triangles' corners gathered into lanes (eight triangles a
+// pass), ready to be tested by one ray or by each ray of a packet.
+struct LeafTriangles {
   DecodedLeaf decoded;
-  decode_leaf(record, grid, snap_outward(grid, box), decoded);
-  const StripLayoutEntry& layout = *decoded.layout;
-  auto corner = [&](std::uint32_t k, std::uint32_t c) { return decoded.slot_position(layout.first_slot[k] + c); };
-  auto accept = [&](std::uint32_t k, const TriangleHit& hit) {
-    tmax = hit.t;
-    best = {hit.t, hit.u, hit.v, decoded.header, decoded.ids, decoded.corners, k, {corner(k, 0), corner(k, 1), corner(k, 2)}, true};
-  };
 #if defined(__AVX2__)
-  // Eight triangles a pass, their corners gathered from the vertex columns; candidates are
-  // then taken in triangle order against the shrinking tmax, exactly as the scalar loop
-  // takes them (same hit, same ties).
+  TriangleLanes lanes[2];  // triangles 0-7 and 8-13
+#endif
+  glm::vec3 corner(std::uint32_t k, std::uint32_t c) const {
+    return decoded.slot_position(decoded.layout->first_slot[k] + c);
+  }
+};
+
+template <typename Probe>
+[[gnu::always_inline]] inline void prepare_leaf(const std::byte* record, const GlobalGrid& grid, const Box& box,
+                                                LeafTriangles& leaf, Probe& probe) {
+  if constexpr (Probe::kRecords) probe.read(record, leaf_record_bytes(record));
+  DecodedLeaf& decoded = leaf.decoded;
+  decode_leaf(record, grid, snap_outward(grid, box), decoded);
+#if defined(__AVX2__)
+  const StripLayoutEntry& layout = *decoded.layout;
   const __m256i index_mask = _mm256_set1_epi32(63);  // lanes past the last triangle gather in bounds
   for (std::uint32_t base = 0; base < layout.triangles; base += 8) {
-    const std::uint32_t count = std::min<std::uint32_t>(8, layout.triangles - base);
     __m128i first_bytes = _mm_setzero_si128();
     std::memcpy(&first_bytes, layout.first_slot.data() + base, 8);
     const __m256i first_slot = _mm256_cvtepu8_epi32(first_bytes);
-    TriangleLanes lanes;
+    TriangleLanes& lanes = leaf.lanes[base / 8];
     for (int c = 0; c < 3; ++c) {
       __m256i vertex = _mm256_and_si256(_mm256_add_epi32(first_slot, _mm256_set1_epi32(c)), index_mask);
       if (decoded.header.indexed) {
@@ -67,14 +67,37 @@ template <bool kAnyHit, typename Probe>
         _mm256_store_ps(lanes.corner[c][axis], _mm256_i32gather_ps(decoded.position[axis], vertex, 4));
       }
     }
+  }
+#endif
+}
+
+// Tests a prepared leaf's triangles against one ray; a hit nearer than `tmax` shrinks it and
+// replaces `best` (with kAnyHit, the first one ends the test).
+template <bool kAnyHit>
+[[gnu::always_inline]] inline void test_leaf_triangles(const LeafTriangles& leaf, const WatertightRay& sheared,
+                                                       float tmin, float& tmax, LeafHit& best) {
+  const DecodedLeaf& decoded = leaf.decoded;
+  const std::uint32_t triangles = decoded.layout->triangles;
+  auto accept = [&](std::uint32_t k, const TriangleHit& hit) {
+    tmax = hit.t;
+    best = {hit.t, hit.u, hit.v, decoded.header, decoded.ids, decoded.corners, k,
+            {leaf.corner(k, 0), leaf.corner(k, 1), leaf.corner(k, 2)}, true};
+  };
+#if defined(__AVX2__)
+  // Candidates of each pass are taken in triangle order against the shrinking tmax, exactly
+  // as the scalar loop takes them (same hit, same ties).
+  for (std::uint32_t base = 0; base < triangles; base += 8) {
+    const std::uint32_t count = std::min<std::uint32_t>(8, triangles - base);
     WatertightLanes result;
-    intersect_watertight_lanes(sheared, lanes, (1u << count) - 1, tmin, tmax, result);
+    intersect_watertight_lanes(sheared, leaf.lanes[base / 8], (1u << count) - 1, tmin, tmax, result);
     for (unsigned pending = result.candidates | result.on_edge; pending != 0; pending &= pending - 1) {
       const int lane = std::countr_zero(pending);
       const std::uint32_t k = base + lane;
       TriangleHit hit;
       if (result.on_edge >> lane & 1u) {
-        if (!intersect_watertight(sheared, corner(k, 0), corner(k, 1), corner(k, 2), tmin, tmax, hit)) continue;
+        if (!intersect_watertight(sheared, leaf.corner(k, 0), leaf.corner(k, 1), leaf.corner(k, 2), tmin, tmax, hit)) {
+          continue;
+        }
       } else {
         if (result.signed_t[lane] > tmax * result.abs_determinant[lane]) continue;
         hit = {result.t[lane], result.u[lane], result.v[lane]};
@@ -84,14 +107,24 @@ template <bool kAnyHit, typename Probe>
     }
   }
 #else
-  for (std::uint32_t k = 0; k < layout.triangles; ++k) {
+  for (std::uint32_t k = 0; k < triangles; ++k) {
     TriangleHit hit;
-    if (intersect_watertight(sheared, corner(k, 0), corner(k, 1), corner(k, 2), tmin, tmax, hit)) {
+    if (intersect_watertight(sheared, leaf.corner(k, 0), leaf.corner(k, 1), leaf.corner(k, 2), tmin, tmax, hit)) {
       accept(k, hit);
       if constexpr (kAnyHit) return;
     }
   }
 #endif
+}
+
+// The leaf record at `record`, whose decoded box is `box`, against one ray.
+template <bool kAnyHit, typename Probe>
+[[gnu::always_inline]] inline void test_leaf_record(const std::byte* record, const GlobalGrid& grid, const Box& box,
+                                                    const WatertightRay& sheared, float tmin, float& tmax,
+                                                    LeafHit& best, Probe& probe) {
+  LeafTriangles leaf;
+  prepare_leaf(record, grid, box, leaf, probe);
+  test_leaf_triangles<kAnyHit>(leaf, sheared, tmin, tmax, best);
 }
 
 // With kSurface (closest hits, whose corners test_leaf_record kept) also the point and normal.

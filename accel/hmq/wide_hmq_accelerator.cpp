@@ -2,6 +2,7 @@
 // (accel/bvh/quantized_wide_node.hpp), the same top Ray-Strips' wide layout has. A leaf
 // child's weight is its record's size in 2-byte units, so records need no offset table.
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <stdexcept>
 
@@ -123,6 +124,48 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
   }
 
   std::string name() const override { return "hmq8"; }
+
+  // Camera rays eight at a time (two 2x2 quads): nodes decoded once a packet, leaves decoded
+  // and gathered once a packet, each ray tested against them alone (the same hits as single
+  // rays). On room:1M primary rays: 3.1-3.5 Mrays/s single, 5.0 in packets of 4, 6.2-6.8 of 8,
+  // 6.1 of 16.
+  void intersect_coherent(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
+    NullProbe probe;
+    QuantizedWidePacketStack stack;
+    const std::byte* leaves = leaves_.data();
+    for (std::uint32_t begin = range.begin; begin < range.end; begin += kWidePacketRays) {
+      const std::uint32_t end = std::min<std::uint32_t>(begin + kWidePacketRays, range.end);
+      SingleRay packet[kWidePacketRays];
+      float tmax[kWidePacketRays];
+      LeafHit best[kWidePacketRays];
+      unsigned live = 0;
+      for (std::uint32_t i = begin; i < end; ++i) {
+        if (!(rays.flags[i] & ray_flags::alive)) continue;
+        packet[i - begin] = load_ray(rays, i);
+        tmax[i - begin] = packet[i - begin].tmax;
+        live |= 1u << (i - begin);
+      }
+      if (live != 0) {
+        walk_quantized_wide_packet(nodes_.data(), root_, packet, live, tmax, probe, stack,
+                                   [&](std::uint32_t units, const Bounds3& box, unsigned members) {
+                                     LeafTriangles leaf;
+                                     prepare_leaf(leaves + std::size_t(units) * kUnit, grid_, Box{box.lower, box.upper},
+                                                  leaf, probe);
+                                     for (; members != 0; members &= members - 1) {
+                                       const int r = std::countr_zero(members);
+                                       test_leaf_triangles<false>(leaf, packet[r].sheared, packet[r].tmin, tmax[r], best[r]);
+                                     }
+                                   });
+      }
+      for (std::uint32_t i = begin; i < end; ++i) {
+        if (live >> (i - begin) & 1u) {
+          write_leaf_hit<true>(best[i - begin], hits, i);
+        } else {
+          hits.set_miss(i);
+        }
+      }
+    }
+  }
 
   MemoryReport memory() const override { return {parts_.hierarchy, parts_.geometry, parts_.other}; }
   BuildReport build() const override { return build_; }
