@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Issue 17's table: every layout, compact and not, on the room at 1M and 8M triangles and on
-# three scanned meshes subdivided twice, primary and diffuse rays, agreement against robust
+# three scanned meshes subdivided twice, primary (single and in packets) and diffuse rays, agreement against robust
 # Embree; and the leak test of the wide layouts on a closed sphere and room.
 # Usage: bench/wide_suite.sh [OUT_DIR] [WAVETRACE]   (JSON per run in OUT_DIR, default out/wide)
 set -euo pipefail
@@ -17,6 +17,9 @@ run() {  # NAME SCENE [--set ...]
     "$wavetrace" bench accel --scene "$scene" "$@" --accel "$accels" --rays "$rays" --count 500000 --threads 2 \
       --repeat 5 --reference embree:mode=robust --json "$out/${name}_${rays}.json"
   done
+  # Camera rays through intersect_coherent, where a layout has packets (raystrips, hmq:width=8).
+  "$wavetrace" bench accel --scene "$scene" "$@" --accel "$accels" --rays primary --packets --count 500000 \
+    --threads 2 --repeat 5 --reference embree:mode=robust --json "$out/${name}_packets.json"
 }
 run room_1M builtin:room:1M
 run room_8M builtin:room:8M

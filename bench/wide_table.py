@@ -13,7 +13,7 @@ order = ["room_1M", "room_8M", "bunny00_sub2", "diplodocus_sub2", "bear_sub2"]
 print("| scene (triangles) | rays | accel | B/tri | hier | geom | other | Mrays/s | vs embree | hit agr. | prim. agr. |")
 print("|---|---|---|---|---|---|---|---|---|---|---|")
 for name in order:
-    for rays in ["primary", "diffuse"]:
+    for rays in ["primary", "packets", "diffuse"]:
         path = os.path.join(out, f"{name}_{rays}.json")
         if not os.path.exists(path):
             continue
@@ -31,22 +31,24 @@ for path in sorted(glob.glob(os.path.join(out, "leak_*.json"))):
     print(f"\nLeaks, {os.path.basename(path)[5:-5]}, {report['results'][0]['rays']} rays each:",
           ", ".join(f"{r.get('label', r.get('accel'))} {r['escaped']}" for r in report["results"]))
 
-# The same as one row per layout: bytes per triangle and the ratio to default Embree, primary / diffuse, per scene.
-print("\n| accel | " + " | ".join(f"{n} B/tri, prim / diff" for n in order) + " |")
+# The same as one row per layout: bytes per triangle and the ratio to default Embree on primary
+# rays, primary rays through intersect_coherent (packets where a layout has them) and diffuse rays.
+print("\n| accel | " + " | ".join(f"{n}: B/tri, prim / packets / diff" for n in order) + " |")
 print("|---|" + "---|" * len(order))
 rows = {}
 for name in order:
     cells = {}
-    for rays in ["primary", "diffuse"]:
+    kinds = ["primary", "packets", "diffuse"]
+    for rays in kinds:
         path = os.path.join(out, f"{name}_{rays}.json")
         if not os.path.exists(path):
             continue
         report = json.load(open(path))
         first = report["results"][0]
         for r in report["results"]:
-            cell = cells.setdefault(r["accel"], [r["bytes_per_triangle"], None, None])
-            cell[1 if rays == "primary" else 2] = r["mrays_per_s"] / first["mrays_per_s"]
-    for accel, (bpt, prim, diff) in cells.items():
-        rows.setdefault(accel, {})[name] = f"{bpt:.1f}, {prim:.2f}x / {diff:.2f}x"
+            cell = cells.setdefault(r["accel"], [r["bytes_per_triangle"], None, None, None])
+            cell[1 + kinds.index(rays)] = r["mrays_per_s"] / first["mrays_per_s"]
+    for accel, (bpt, *ratios) in cells.items():
+        rows.setdefault(accel, {})[name] = f"{bpt:.1f}, " + " / ".join("-" if x is None else f"{x:.2f}x" for x in ratios)
 for accel, cells in rows.items():
     print(f"| {accel} | " + " | ".join(cells.get(n, "") for n in order) + " |")
