@@ -1,6 +1,5 @@
 // Build (bounds, optional Morton reorder, SAH tree, flatten in the chosen node order) and
 // single-ray ordered traversal with a short stack of (node, entry distance) pairs.
-#include "accel/ray_loop.hpp"
 #include "accel/bvh/bvh_accelerator.hpp"
 
 #include <chrono>
@@ -13,6 +12,7 @@
 #include "accel/bvh/node_layout.hpp"
 #include "accel/bvh/wide_bvh_accelerator.hpp"
 #include "accel/probed_accelerator.hpp"
+#include "accel/ray_loop.hpp"
 #include "accel/section_archive.hpp"
 #include "kernels/ray_box.hpp"
 #include "memory/cache_aligned_allocator.hpp"

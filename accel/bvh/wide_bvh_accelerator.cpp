@@ -1,7 +1,6 @@
 // The 8-wide BVH: the binary SAH tree collapsed (each node adopts the largest-area inner
 // child's children until it has eight), traversed one ray at a time with all eight child
 // boxes tested in one AVX2 pass, nearest child first.
-#include "accel/ray_loop.hpp"
 #include "accel/bvh/wide_bvh_accelerator.hpp"
 
 #include <algorithm>
@@ -14,6 +13,7 @@
 #endif
 
 #include "accel/bvh/bvh_build.hpp"
+#include "accel/ray_loop.hpp"
 #include "accel/section_archive.hpp"
 #include "accel/bvh/indexed_face_set.hpp"
 #include "accel/bvh/wide_bvh_node.hpp"

@@ -1,8 +1,8 @@
 // Embree 3 wrapper: one triangle geometry with shared buffers, rtcIntersect1/rtcOccluded1
 // per ray (the configuration the papers and PLATFORM.md measure).
-#include "accel/ray_loop.hpp"
 #include "accel/embree/embree_accelerator.hpp"
 #include "accel/hit_surface.hpp"
+#include "accel/ray_loop.hpp"
 
 #include <atomic>
 #include <chrono>

@@ -1,7 +1,6 @@
 // Recursive build (items bucketed into a node's cells by counting, then each crowded cell
 // refined) and recursive 3D-DDA traversal, each grid stopping once its nearest hit lies
 // before its next cell.
-#include "accel/ray_loop.hpp"
 #include "accel/grid/array_grid.hpp"
 
 #include <algorithm>
@@ -14,6 +13,7 @@
 
 #include "accel/grid/grid_walk.hpp"
 #include "accel/hit_surface.hpp"
+#include "accel/ray_loop.hpp"
 #include "kernels/checked_narrowing.hpp"
 #include "kernels/ray_box.hpp"
 #include "kernels/triangle_intersect.hpp"

@@ -1,7 +1,6 @@
 // Counting construction of the hashed grid (D bits, first-fit row displacement for O, counts
 // and prefix sums for H, reverse insertion for L) and 3D-DDA traversal that stops once the
 // nearest hit found lies before the next cell.
-#include "accel/ray_loop.hpp"
 #include "accel/grid/hashed_grid.hpp"
 
 #include <algorithm>
@@ -16,6 +15,7 @@
 
 #include "accel/grid/grid_walk.hpp"
 #include "accel/hit_surface.hpp"
+#include "accel/ray_loop.hpp"
 #include "kernels/checked_narrowing.hpp"
 #include "kernels/ray_box.hpp"
 #include "kernels/triangle_intersect.hpp"

@@ -1,6 +1,5 @@
 // HMQ build (grid, snapping, SAH tree over the snapped triangles, uncompressed top, blocks
 // of quantized nodes with leaf records) and single-ray traversal decoding on the fly.
-#include "accel/ray_loop.hpp"
 #include "accel/hmq/hmq_accelerator.hpp"
 
 #include <algorithm>
@@ -24,6 +23,7 @@
 #include "accel/hmq/leaf_hit.hpp"
 #include "accel/hmq/snapped_tree.hpp"
 #include "accel/probed_accelerator.hpp"
+#include "accel/ray_loop.hpp"
 #include "accel/section_archive.hpp"
 #include "kernels/checked_narrowing.hpp"
 #include "kernels/ray_box.hpp"

@@ -1,9 +1,6 @@
 // Ray-Strips build (SAH cut into sub-meshes, stripify, top SAH BVH over the strips, encode)
 // and traversal: single rays through the top BVH and each strip, and 2x2 packets for
 // coherent rays (§5.3).
-#include "accel/ray_loop.hpp"
-#include "accel/bvh/quantized_wide_tree.hpp"
-#include "accel/bvh/quantized_wide_walk.hpp"
 #include "accel/raystrips/raystrips_accelerator.hpp"
 
 #include <algorithm>
@@ -20,8 +17,11 @@
 #include "accel/bvh/bvh_walk.hpp"
 #include "accel/bvh/leaf_query.hpp"
 #include "accel/bvh/node_layout.hpp"
+#include "accel/bvh/quantized_wide_tree.hpp"
+#include "accel/bvh/quantized_wide_walk.hpp"
 #include "accel/bvh/sah_builder.hpp"
 #include "accel/probed_accelerator.hpp"
+#include "accel/ray_loop.hpp"
 #include "accel/section_archive.hpp"
 #include "accel/raystrips/strip_encode.hpp"
 #include "accel/raystrips/strip_packet.hpp"
