@@ -84,6 +84,62 @@ inline constexpr std::array<SortStage, 6> kDescendingStages = [] {
   return _mm256_blendv_epi8(leaf, child, _mm256_cvtepi16_epi32(inner));
 }
 
+// The eight child boxes of `node`, decoded against its frame: bound[0..2] lower x, y, z,
+// bound[3..5] upper x, y, z, lane k = slot k (the arithmetic of decode_wide_child).
+[[gnu::always_inline]] inline void decode_children(const QuantizedWideNode& node, const Bounds3& frame, __m256 bound[6]) {
+  for (int axis = 0; axis < 3; ++axis) {
+    const __m256 step = _mm256_set1_ps(frame_step(frame, axis));
+    const __m256 q_lower =
+        _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(node.lower(axis)))));
+    const __m256 q_upper =
+        _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(node.upper(axis)))));
+    bound[axis] = _mm256_fmadd_ps(q_lower, step, _mm256_set1_ps(frame.lower[axis]));
+    bound[3 + axis] = _mm256_fnmadd_ps(q_upper, step, _mm256_set1_ps(frame.upper[axis]));
+  }
+}
+
+// The robust slab test of one ray against the eight boxes: writes the entry distances to
+// `near` and returns the mask of the lanes entered within [tmin, tmax].
+[[gnu::always_inline]] inline unsigned enter_children(const __m256 bound[6], const __m256 origin[3],
+                                                      const __m256 inverse[3], float tmin, float tmax, __m256& near) {
+  near = _mm256_set1_ps(tmin);
+  __m256 far = _mm256_set1_ps(std::numeric_limits<float>::infinity());
+  for (int axis = 0; axis < 3; ++axis) {
+    const __m256 t0 = _mm256_mul_ps(_mm256_sub_ps(bound[axis], origin[axis]), inverse[axis]);
+    const __m256 t1 = _mm256_mul_ps(_mm256_sub_ps(bound[3 + axis], origin[axis]), inverse[axis]);
+    // A NaN slab distance (origin on a plane the ray runs parallel to) leaves the interval as
+    // it was, as clip_slab does: max/min return their second operand when one is NaN.
+    near = _mm256_max_ps(_mm256_min_ps(t1, t0), near);
+    far = _mm256_min_ps(_mm256_max_ps(t0, t1), far);
+  }
+  far = _mm256_min_ps(_mm256_mul_ps(far, _mm256_set1_ps(kSlabFarScale)), _mm256_set1_ps(tmax));
+  return static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(near, far, _CMP_LE_OQ)));
+}
+
+// Bit k set: slot k holds a child.
+[[gnu::always_inline]] inline unsigned occupied_slots(const QuantizedWideNode& node) {
+  const __m128i meta = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(node.meta));
+  return ~static_cast<unsigned>(_mm_movemask_epi8(_mm_cmpeq_epi8(meta, _mm_setzero_si128()))) & 0xffu;
+}
+
+// All bits of lane k set where bit k of `mask` is.
+[[gnu::always_inline]] inline __m256i lanes_of(unsigned mask) {
+  return _mm256_cmpgt_epi32(_mm256_and_si256(_mm256_set1_epi32(int(mask)), _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128)),
+                            _mm256_setzero_si256());
+}
+
+// The children in `entered`, farthest first (so the nearest ends on top of a stack): a key
+// is the entry distance's bits (>= 0, so they order as integers) with the lane in the low
+// three, lanes not entered -1, sorted descending.
+[[gnu::always_inline]] inline __m256i nearest_last(__m256 near, unsigned entered) {
+  const __m256i keys = _mm256_blendv_epi8(
+      _mm256_set1_epi32(-1),
+      _mm256_or_si256(_mm256_and_si256(_mm256_castps_si256(near), _mm256_set1_epi32(~7)),
+                      _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)),
+      lanes_of(entered));
+  return _mm256_and_si256(sort_descending(keys), _mm256_set1_epi32(7));
+}
+
 }  // namespace quantized_wide
 
 // `visit_leaf(reference, box)` handles a leaf (its reference without the leaf bit, its
@@ -94,8 +150,6 @@ template <typename Probe, typename VisitLeaf>
                                                        const SingleRay& ray, const float& tmax, Probe& probe,
                                                        QuantizedWideStack& stack, VisitLeaf&& visit_leaf) {
   using namespace quantized_wide;
-  constexpr float kInfinity = std::numeric_limits<float>::infinity();
-  const __m256i lane_index = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
   const glm::vec3 &origin = ray.origin, &inverse = ray.box.inverse_direction;
   const __m256 origin_lanes[3] = {_mm256_set1_ps(origin.x), _mm256_set1_ps(origin.y), _mm256_set1_ps(origin.z)};
   const __m256 inverse_lanes[3] = {_mm256_set1_ps(inverse.x), _mm256_set1_ps(inverse.y), _mm256_set1_ps(inverse.z)};
@@ -105,28 +159,10 @@ template <typename Probe, typename VisitLeaf>
     if (!(current & kWideLeafReference)) {
       const QuantizedWideNode& node = nodes[current];
       probe.read(&node, sizeof node);
-      __m256 near = _mm256_set1_ps(ray.tmin), far = _mm256_set1_ps(kInfinity);
-      __m256 bound[6];
-      for (int axis = 0; axis < 3; ++axis) {
-        const __m256 step = _mm256_set1_ps(frame_step(frame, axis));
-        const __m256 q_lower =
-            _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(node.lower(axis)))));
-        const __m256 q_upper =
-            _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(node.upper(axis)))));
-        bound[axis] = _mm256_fmadd_ps(q_lower, step, _mm256_set1_ps(frame.lower[axis]));
-        bound[3 + axis] = _mm256_fnmadd_ps(q_upper, step, _mm256_set1_ps(frame.upper[axis]));
-        const __m256 t0 = _mm256_mul_ps(_mm256_sub_ps(bound[axis], origin_lanes[axis]), inverse_lanes[axis]);
-        const __m256 t1 = _mm256_mul_ps(_mm256_sub_ps(bound[3 + axis], origin_lanes[axis]), inverse_lanes[axis]);
-        // A NaN slab distance (origin on a plane the ray runs parallel to) leaves the interval
-        // as it was, as clip_slab does: max/min return their second operand when one is NaN.
-        near = _mm256_max_ps(_mm256_min_ps(t1, t0), near);
-        far = _mm256_min_ps(_mm256_max_ps(t0, t1), far);
-      }
-      far = _mm256_min_ps(_mm256_mul_ps(far, _mm256_set1_ps(kSlabFarScale)), _mm256_set1_ps(tmax));
-      const __m256i empty = _mm256_cvtepi8_epi32(
-          _mm_cmpeq_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(node.meta)), _mm_setzero_si128()));
-      const __m256 entered = _mm256_andnot_ps(_mm256_castsi256_ps(empty), _mm256_cmp_ps(near, far, _CMP_LE_OQ));
-      const auto entered_mask = static_cast<unsigned>(_mm256_movemask_ps(entered));
+      __m256 bound[6], near;
+      decode_children(node, frame, bound);
+      const unsigned entered_mask =
+          enter_children(bound, origin_lanes, inverse_lanes, ray.tmin, tmax, near) & occupied_slots(node);
       if (std::has_single_bit(entered_mask)) {  // one child: go down, nothing to order or stack
         const int lane = std::countr_zero(entered_mask);
         alignas(32) std::uint32_t reference[8];
@@ -138,15 +174,8 @@ template <typename Probe, typename VisitLeaf>
         frame.upper = {lanes[3][lane], lanes[4][lane], lanes[5][lane]};
         continue;
       }
-      if (entered_mask != 0) {
-        // Nearest first, by sorting: keys are the entry distance's bits (>= 0, so they order as
-        // integers) with the lane in the low three, lanes not entered -1, sorted descending so
-        // that the nearest child lands on top of the stack.
-        const __m256i keys = _mm256_blendv_epi8(
-            _mm256_set1_epi32(-1),
-            _mm256_or_si256(_mm256_and_si256(_mm256_castps_si256(near), _mm256_set1_epi32(~7)), lane_index),
-            _mm256_castps_si256(entered));
-        const __m256i order = _mm256_and_si256(sort_descending(keys), _mm256_set1_epi32(7));
+      if (entered_mask != 0) {  // nearest first, by sorting
+        const __m256i order = nearest_last(near, entered_mask);
         _mm256_storeu_si256(reinterpret_cast<__m256i*>(stack.reference + top),
                             _mm256_permutevar8x32_epi32(child_references(node), order));
         _mm256_storeu_ps(stack.distance + top, _mm256_permutevar8x32_ps(near, order));
@@ -194,7 +223,6 @@ template <typename Probe, typename VisitLeaf>
   using namespace quantized_wide;
   using Entry = QuantizedWidePacketStack::Entry;
   constexpr float kInfinity = std::numeric_limits<float>::infinity();
-  const __m256i lane_index = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
   __m256 origin[kWidePacketRays][3], inverse[kWidePacketRays][3];
   for (unsigned bits = live; bits != 0; bits &= bits - 1) {
     const int r = std::countr_zero(bits);
@@ -210,50 +238,25 @@ template <typename Probe, typename VisitLeaf>
       const QuantizedWideNode& node = nodes[current.reference];
       probe.read(&node, sizeof node);
       __m256 bound[6];
-      for (int axis = 0; axis < 3; ++axis) {
-        const __m256 step = _mm256_set1_ps(frame_step(current.frame, axis));
-        const __m256 q_lower =
-            _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(node.lower(axis)))));
-        const __m256 q_upper =
-            _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(node.upper(axis)))));
-        bound[axis] = _mm256_fmadd_ps(q_lower, step, _mm256_set1_ps(current.frame.lower[axis]));
-        bound[3 + axis] = _mm256_fnmadd_ps(q_upper, step, _mm256_set1_ps(current.frame.upper[axis]));
-      }
-      const auto occupied = static_cast<unsigned>(
-          ~_mm_movemask_epi8(_mm_cmpeq_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(node.meta)), _mm_setzero_si128())) &
-          0xff);
+      decode_children(node, current.frame, bound);
+      const unsigned occupied = occupied_slots(node);
       alignas(32) float near[kWidePacketRays][8];
       unsigned entered[kWidePacketRays] = {};
       __m256 least = _mm256_set1_ps(kInfinity);
       for (unsigned bits = current.rays; bits != 0; bits &= bits - 1) {
         const int r = std::countr_zero(bits);
-        __m256 entry = _mm256_set1_ps(rays_in[r].tmin), exit = _mm256_set1_ps(kInfinity);
-        for (int axis = 0; axis < 3; ++axis) {  // the single-ray walk's slab test, lane for lane
-          const __m256 t0 = _mm256_mul_ps(_mm256_sub_ps(bound[axis], origin[r][axis]), inverse[r][axis]);
-          const __m256 t1 = _mm256_mul_ps(_mm256_sub_ps(bound[3 + axis], origin[r][axis]), inverse[r][axis]);
-          entry = _mm256_max_ps(_mm256_min_ps(t1, t0), entry);
-          exit = _mm256_min_ps(_mm256_max_ps(t0, t1), exit);
-        }
-        exit = _mm256_min_ps(_mm256_mul_ps(exit, _mm256_set1_ps(kSlabFarScale)), _mm256_set1_ps(tmax[r]));
-        const __m256 in = _mm256_cmp_ps(entry, exit, _CMP_LE_OQ);
-        entered[r] = static_cast<unsigned>(_mm256_movemask_ps(in)) & occupied;
+        __m256 entry;
+        entered[r] = enter_children(bound, origin[r], inverse[r], rays_in[r].tmin, tmax[r], entry) & occupied;
         _mm256_store_ps(near[r], entry);
-        least = _mm256_blendv_ps(least, _mm256_min_ps(least, entry), in);
+        least = _mm256_blendv_ps(least, _mm256_min_ps(least, entry), _mm256_castsi256_ps(lanes_of(entered[r])));
       }
       unsigned any = 0;
       for (int r = 0; r < kWidePacketRays; ++r) any |= entered[r];
       if (any != 0) {
-        const __m256 any_lanes = _mm256_castsi256_ps(_mm256_cmpgt_epi32(
-            _mm256_and_si256(_mm256_set1_epi32(int(any)), _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128)),
-            _mm256_setzero_si256()));
-        const __m256i keys = _mm256_blendv_epi8(
-            _mm256_set1_epi32(-1),
-            _mm256_or_si256(_mm256_and_si256(_mm256_castps_si256(least), _mm256_set1_epi32(~7)), lane_index),
-            _mm256_castps_si256(any_lanes));
         alignas(32) std::int32_t order[8];
         alignas(32) std::uint32_t reference[8];
         alignas(32) float lanes[6][8];
-        _mm256_store_si256(reinterpret_cast<__m256i*>(order), _mm256_and_si256(sort_descending(keys), _mm256_set1_epi32(7)));
+        _mm256_store_si256(reinterpret_cast<__m256i*>(order), nearest_last(least, any));
         _mm256_store_si256(reinterpret_cast<__m256i*>(reference), child_references(node));
         for (int b = 0; b < 6; ++b) _mm256_store_ps(lanes[b], bound[b]);
         for (int n = 0, count = std::popcount(any); n < count; ++n) {  // farthest first: the nearest ends on top
