@@ -18,6 +18,27 @@ inline void set_surface_from_mesh(HitBatch& hits, std::size_t ray, const Triangl
   hits.set_surface(ray, mesh.positions[corners.x], mesh.positions[corners.y], mesh.positions[corners.z]);
 }
 
+// The surfaces of a range's closest hits, read from the mesh a few rays ahead of their use:
+// each hit's corners are two dependent cache misses (index, then vertices), and over a
+// batch they overlap instead of following one another.
+inline void set_surfaces_from_mesh(HitBatch& hits, RayRange range, const TriangleMesh& mesh) {
+  constexpr std::uint32_t kIndexAhead = 8, kVertexAhead = 4;
+  const glm::uvec3* triangles = mesh.triangles.data();
+  const glm::vec3* positions = mesh.positions.data();
+  for (std::uint32_t i = range.begin; i < range.end; ++i) {
+    if (i + kIndexAhead < range.end && hits.is_hit(i + kIndexAhead)) {
+      __builtin_prefetch(triangles + hits.primitive[i + kIndexAhead]);
+    }
+    if (i + kVertexAhead < range.end && hits.is_hit(i + kVertexAhead)) {
+      const glm::uvec3& corners = triangles[hits.primitive[i + kVertexAhead]];
+      __builtin_prefetch(positions + corners.x);
+      __builtin_prefetch(positions + corners.y);
+      __builtin_prefetch(positions + corners.z);
+    }
+    if (hits.is_hit(i)) set_surface_from_mesh(hits, i, mesh, hits.primitive[i]);
+  }
+}
+
 // `strip_corner` holds the triangle's corners in strip order; `code` is the strip formats'
 // corner code: the mesh's second corner is strip corner code / 3, its third code % 3 (and
 // the first the remaining one), the same code that maps the barycentrics back.

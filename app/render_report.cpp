@@ -105,6 +105,7 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
   }
   nlohmann::json render = {{"seconds", facts.output.run.seconds}, {"threads", facts.output.run.threads}};
   render["stages"] = facts.plan.stages;
+  render["mode"] = to_string(facts.plan.pipeline.mode);
   render["reorder"] = {{"heuristic", to_string(facts.plan.reorder.heuristic)},
                        {"curve", to_string(facts.plan.reorder.curve)},
                        {"buffer_rays", facts.plan.reorder.buffer_rays},
@@ -153,7 +154,7 @@ std::string render_table(const RenderFacts& facts) {
   for (const StageStats& stage : run.stages) {
     table += fmt::format("{:<10} {:>14} {:>14} {:>10.3f} {:>7.1f}% {:>12.2f}\n", stage.name, stage.rays_in,
                          stage.rays_out, stage.seconds, 100.0 * stage.seconds / thread_seconds, stage.mrays_per_s());
-    if (stage.name == "trace") traced = double(stage.rays_in);
+    if (stage.name == "trace" || stage.name == "megakernel") traced = double(stage.rays_in);
   }
   if (!facts.output.hit_rates.empty()) {
     table += "hit rate by depth (camera 0, bounces 1+):";
@@ -177,8 +178,8 @@ std::string render_table(const RenderFacts& facts) {
   }
   const MemoryReport memory = facts.accelerator.memory();
   const BuildReport build = facts.accelerator.build();
-  table += fmt::format("render: {:.3f} s wall on {} threads ({:.3f} thread-seconds), {:.2f} Mrays/s traced\n",
-                       run.seconds, run.threads, thread_seconds, traced / run.seconds * 1e-6);
+  table += fmt::format("render ({}): {:.3f} s wall on {} threads ({:.3f} thread-seconds), {:.2f} Mrays/s traced\n",
+                       to_string(facts.plan.pipeline.mode), run.seconds, run.threads, thread_seconds, traced / run.seconds * 1e-6);
   table += fmt::format("accel {}: {:.1f} MB, {:.1f} bytes/triangle (hierarchy {:.1f}, geometry {:.1f}), built in {:.3f} s\n",
                        facts.accelerator.name(), double(memory.total()) * 1e-6,
                        double(memory.total()) / double(facts.scene.triangle_count),

@@ -39,6 +39,8 @@ const std::vector<ConfigKey>& config_schema() {
       {"accel.type", T::text, std::string("embree"), 0, 0, {"embree", "bvh", "raystrips", "hmq", "grid", "mlgrid", "arraygrid"}, "main accelerator"},
       {"accel.embree.mode", T::text, std::string("default"), 0, 0, {"default", "compact", "robust"},
        "Embree scene flags"},
+      {"accel.embree.queries", T::text, std::string("stream"), 0, 0, {"single", "stream"},
+       "rtcIntersect1 per ray, or a batch range through rtcIntersectNp (camera rays flagged coherent)"},
       {"accel.bvh.leaf_size", T::integer, std::int64_t{4}, 1, 16, {}, "most triangles per BVH leaf"},
       {"accel.bvh.layout", T::text, std::string("depth_first"), 0, 0, {"depth_first", "breadth_first", "veb"},
        "BVH node order in memory"},
@@ -122,6 +124,10 @@ const std::vector<ConfigKey>& config_schema() {
       {"pipeline.stages", T::text_list, std::vector<std::string>{"auto"}, 0, 0,
        {"auto", "generate", "approx_hit", "zsort", "trace", "shade", "spawn"},
        "the stage chain; spawn at the end loops back. auto: the chain reorder.heuristic needs"},
+      {"pipeline.mode", T::text, std::string("wavefront"), 0, 0, {"wavefront", "megakernel"},
+       "wavefront: batches through the stage graph; megakernel: one path at a time per worker (the control)"},
+      {"pipeline.tile", T::integer, std::int64_t{16}, 1, 4096, {},
+       "megakernel: side in pixels of the square tiles workers take"},
   };
   return schema;
 }

@@ -21,6 +21,8 @@ PixelOrder parse_pixel_order(const std::string& text) {
 GenerateStage::GenerateStage(const Camera& camera, const ImageSpec& image, PixelOrder order)
     : frame_(camera, float(image.width) / float(image.height)),
       image_(image),
+      inverse_width_(1.0f / float(image.width)),
+      inverse_height_(1.0f / float(image.height)),
       total_(std::uint64_t(image.pixel_count()) * image.samples_per_pixel) {
   if (order == PixelOrder::zcurve) {
     // Walk the Z-curve of the enclosing power-of-two square, keeping the pixels inside.
@@ -41,36 +43,32 @@ std::size_t GenerateStage::fill(RayBatch& rays) {
   // Walk (pixel, sample) incrementally: one division per batch, not two per ray.
   auto order_index = static_cast<std::uint32_t>(first / spp);
   auto sample = static_cast<std::uint32_t>(first % spp);
-  std::uint32_t pixel = 0;
-  float pixel_x = 0.0f, pixel_y = 0.0f;
-  const auto enter_pixel = [&] {
-    pixel = pixel_order_.empty() ? order_index : pixel_order_[order_index];
-    pixel_x = float(pixel % image_.width);
-    pixel_y = float(pixel / image_.width);
-  };
-  enter_pixel();
-  const float inverse_width = 1.0f / float(image_.width), inverse_height = 1.0f / float(image_.height);
+  std::uint32_t pixel = pixel_order_.empty() ? order_index : pixel_order_[order_index];
   for (std::size_t i = 0; i < count; ++i) {
-    const UnitPair jitter = unit_pair(random_bits(pixel, sample, 0, RandomPurpose::pixel_jitter));
-    const float x = (pixel_x + jitter.first) * inverse_width;
-    const float y = 1.0f - (pixel_y + jitter.second) * inverse_height;
-    const glm::vec3 direction = glm::normalize(frame_.direction(x, y));
-    rays.set_geometry(i, frame_.origin, direction, 0.0f, std::numeric_limits<float>::infinity());
-    rays.pixel[i] = pixel;
-    rays.sample[i] = sample;
-    rays.depth[i] = 0;
-    rays.kind[i] = RayKind::camera;
-    rays.throughput_r[i] = rays.throughput_g[i] = rays.throughput_b[i] = 1.0f;
-    rays.flags[i] = ray_flags::alive;
+    write_camera_ray(rays, i, pixel, sample);
     if (++sample == spp && i + 1 < count) {
       sample = 0;
       ++order_index;
-      enter_pixel();
+      pixel = pixel_order_.empty() ? order_index : pixel_order_[order_index];
     }
   }
   rays.count = count;
   next_.store(first + count, std::memory_order_relaxed);
   return count;
+}
+
+void GenerateStage::write_camera_ray(RayBatch& rays, std::size_t slot, std::uint32_t pixel, std::uint32_t sample) const {
+  const UnitPair jitter = unit_pair(random_bits(pixel, sample, 0, RandomPurpose::pixel_jitter));
+  const float x = (float(pixel % image_.width) + jitter.first) * inverse_width_;
+  const float y = 1.0f - (float(pixel / image_.width) + jitter.second) * inverse_height_;
+  const glm::vec3 direction = glm::normalize(frame_.direction(x, y));
+  rays.set_geometry(slot, frame_.origin, direction, 0.0f, std::numeric_limits<float>::infinity());
+  rays.pixel[slot] = pixel;
+  rays.sample[slot] = sample;
+  rays.depth[slot] = 0;
+  rays.kind[slot] = RayKind::camera;
+  rays.throughput_r[slot] = rays.throughput_g[slot] = rays.throughput_b[slot] = 1.0f;
+  rays.flags[slot] = ray_flags::alive;
 }
 
 }  // namespace wavetrace

@@ -35,9 +35,15 @@ class GenerateStage {
   // Not reentrant: the pipeline calls it from one serial node.
   std::size_t fill(RayBatch& rays);
 
+  // The camera ray of (pixel, sample) into slot `slot`: a pure function of the two, so
+  // the megakernel, which walks pixels its own way, makes the very rays fill makes.
+  void write_camera_ray(RayBatch& rays, std::size_t slot, std::uint32_t pixel, std::uint32_t sample) const;
+  const ImageSpec& image() const { return image_; }
+
  private:
   CameraFrame frame_;
   ImageSpec image_;
+  float inverse_width_, inverse_height_;
   std::vector<std::uint32_t> pixel_order_;  // empty: scanline
   std::uint64_t total_;
   std::atomic<std::uint64_t> next_{0};

@@ -1,11 +1,9 @@
 // Flow-graph nodes around stages, ray accounting, and the threaded run.
 #include "stages/pipeline.hpp"
 
-#include <condition_variable>
-#include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <string>
-#include <thread>
 
 #include "stages/tracing_arena.hpp"
 
@@ -38,6 +36,14 @@ class PortOutput final : public StageOutput {
 };
 
 }  // namespace
+
+PipelineMode parse_pipeline_mode(const std::string& text) {
+  if (text == "wavefront") return PipelineMode::wavefront;
+  if (text == "megakernel") return PipelineMode::megakernel;
+  throw std::invalid_argument("unknown pipeline mode '" + text + "' (wavefront, megakernel)");
+}
+
+std::string to_string(PipelineMode mode) { return mode == PipelineMode::megakernel ? "megakernel" : "wavefront"; }
 
 PipelineContext::PipelineContext(std::size_t batch_capacity, std::size_t rays_in_flight)
     : pool_(batch_capacity), budget_(std::max(rays_in_flight, 2 * batch_capacity)) {}
@@ -148,21 +154,14 @@ PipelineRun Pipeline::run(const std::function<void(const Progress&)>& on_progres
   PipelineContext context(options_.batch_size, options_.rays_in_flight);
   const Clock::time_point start = Clock::now();
 
-  // Progress reporting runs beside the graph and stops when it drains.
-  std::mutex done_mutex;
-  std::condition_variable done_signal;
-  bool done = false;
-  std::thread reporter;
-  if (on_progress) {
-    reporter = std::thread([&] {
-      std::unique_lock lock(done_mutex);
-      while (!done_signal.wait_for(lock, interval, [&] { return done; })) {
-        on_progress({generate_.generated(), generate_.total_rays(), trace_counters ? trace_counters->rays_in() : 0,
-                     std::chrono::duration<double>(Clock::now() - start).count()});
-      }
-    });
-  }
-
+  std::optional<ProgressReporter> reporter;
+  reporter.emplace(
+      on_progress,
+      [&] {
+        return Progress{generate_.generated(), generate_.total_rays(), trace_counters ? trace_counters->rays_in() : 0,
+                        std::chrono::duration<double>(Clock::now() - start).count()};
+      },
+      interval);
   arena.execute([&] {
     tbb::flow::graph graph;
     auto generate_node = make_generate_node(graph, generate_, context, generate_counters);
@@ -199,14 +198,7 @@ PipelineRun Pipeline::run(const std::function<void(const Progress&)>& on_progres
 
   PipelineRun result;
   result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
-  if (reporter.joinable()) {
-    {
-      std::lock_guard lock(done_mutex);
-      done = true;
-    }
-    done_signal.notify_all();
-    reporter.join();
-  }
+  reporter.reset();
   result.threads = threads;
   result.stages.push_back(generate_counters.snapshot());
   for (const auto& c : counters) result.stages.push_back(c->snapshot());

@@ -21,6 +21,7 @@
 
 #include "memory/batch_pool.hpp"
 #include "stages/generate.hpp"
+#include "stages/progress_reporter.hpp"
 #include "stages/stage.hpp"
 #include "stages/stage_counters.hpp"
 #include "stages/zsort.hpp"
@@ -82,17 +83,17 @@ std::unique_ptr<BatchNode> make_zsort_node(tbb::flow::graph& graph, const ZSortS
 std::unique_ptr<tbb::flow::function_node<Batch*>> make_retire_node(tbb::flow::graph& graph,
                                                                    PipelineContext& context);
 
+// How paths are run: batches through the stage graph, or one path at a time per worker.
+enum class PipelineMode { wavefront, megakernel };
+PipelineMode parse_pipeline_mode(const std::string& text);
+std::string to_string(PipelineMode mode);
+
 struct PipelineOptions {
+  PipelineMode mode = PipelineMode::wavefront;
+  std::uint32_t tile_side = 16;  // megakernel tiles
   std::size_t batch_size = kDefaultBatchCapacity;
   std::size_t rays_in_flight = std::size_t{1} << 18;
   int threads = 0;  // 0: all cores
-};
-
-struct Progress {
-  std::uint64_t camera_rays_generated = 0;
-  std::uint64_t camera_rays_total = 0;
-  std::uint64_t rays_traced = 0;
-  double seconds = 0.0;
 };
 
 struct PipelineRun {

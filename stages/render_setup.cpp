@@ -4,11 +4,13 @@
 #include <algorithm>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <tbb/info.h>
 
 #include "memory/process_memory.hpp"
 #include "scene/builtin_scenes.hpp"
 #include "stages/approx_hit.hpp"
+#include "stages/megakernel.hpp"
 #include "stages/shade.hpp"
 #include "stages/spawn.hpp"
 #include "stages/trace.hpp"
@@ -53,12 +55,32 @@ void check_stage_order(const std::vector<std::string>& names, ReorderHeuristic h
   }
 }
 
+// The megakernel runs generate, trace, shade and spawn one path at a time: settings that
+// only the wavefront can honour are refused rather than ignored.
+void check_megakernel_plan(const RenderPlan& plan) {
+  if (plan.reorder.heuristic != ReorderHeuristic::none) {
+    throw ConfigError(fmt::format("reorder.heuristic = '{}' reorders batches of rays: pipeline.mode = megakernel has "
+                                  "none (set reorder.heuristic = none or pipeline.mode = wavefront)",
+                                  to_string(plan.reorder.heuristic)));
+  }
+  const std::vector<std::string> chain = {"generate", "trace", "shade", "spawn"};
+  if (plan.stages != chain) {
+    throw ConfigError(fmt::format("pipeline.stages = [{}]: pipeline.mode = megakernel runs generate, trace, shade, "
+                                  "spawn (set pipeline.stages = auto)",
+                                  fmt::join(plan.stages, ", ")));
+  }
+  if (plan.memory.enabled()) {
+    throw ConfigError("[memory] observation (pager, cache) counts the wavefront's stages: set pipeline.mode = wavefront");
+  }
+}
+
 }  // namespace
 
 AcceleratorOptions accelerator_options(const Config& config) {
   AcceleratorOptions options;
   options.type = config.text("accel.type");
   options.embree.mode = parse_embree_mode(config.text("accel.embree.mode"));
+  options.embree.queries = parse_embree_queries(config.text("accel.embree.queries"));
   options.embree.threads = static_cast<int>(config.integer("render.threads"));
   options.bvh.max_leaf_size = static_cast<std::uint32_t>(config.integer("accel.bvh.leaf_size"));
   options.bvh.layout = parse_node_layout(config.text("accel.bvh.layout"));
@@ -166,6 +188,8 @@ RenderPlan plan_render(const Config& config) {
   plan.pipeline.batch_size = static_cast<std::size_t>(config.integer("render.batch_size"));
   plan.pipeline.rays_in_flight = static_cast<std::size_t>(config.integer("render.rays_in_flight"));
   plan.pipeline.threads = static_cast<int>(config.integer("render.threads"));
+  plan.pipeline.mode = parse_pipeline_mode(config.text("pipeline.mode"));
+  plan.pipeline.tile_side = static_cast<std::uint32_t>(config.integer("pipeline.tile"));
   plan.memory = plan_memory(config);
 
   plan.accelerator = accelerator_options(config);
@@ -189,6 +213,7 @@ RenderPlan plan_render(const Config& config) {
     throw ConfigError("pipeline.stages: 'auto' stands alone");
   }
   check_stage_order(plan.stages, plan.reorder.heuristic);
+  if (plan.pipeline.mode == PipelineMode::megakernel) check_megakernel_plan(plan);
   return plan;
 }
 
@@ -268,8 +293,17 @@ RenderOutput render_image(const RenderPlan& plan, const World& world, const Came
     }
   }
   const StageChain chain(plan, world, film, observation ? &observation->observers() : nullptr);
-  Pipeline pipeline(generate, chain.stages(), chain.loops(), plan.pipeline);
-  output.run = pipeline.run(on_progress);
+  if (plan.pipeline.mode == PipelineMode::megakernel) {
+    // The control experiment runs without the trace stage's per-run clocks and counters.
+    const TraceStage trace(world.accelerator, world.scene.material_runs);
+    const ShadeStage shade(world, film, plan.rules);
+    const SpawnStage spawn(world, plan.rules);
+    output.run = run_megakernel(generate, trace, shade, &spawn, {plan.pipeline.threads, plan.pipeline.tile_side},
+                                on_progress);
+  } else {
+    Pipeline pipeline(generate, chain.stages(), chain.loops(), plan.pipeline);
+    output.run = pipeline.run(on_progress);
+  }
   if (observation) observation->report(output.run.stages);
   if (chain.zsort() != nullptr) output.sort_seconds = chain.zsort()->sort_seconds();
   output.closest_mrays_per_s = chain.trace_times().closest_mrays_per_s();

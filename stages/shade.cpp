@@ -9,11 +9,19 @@
 namespace wavetrace {
 
 void ShadeStage::process(Batch* batch, StageOutput& out) const {
-  RayBatch& rays = batch->rays;
-  const HitBatch& hits = batch->hits;
+  if (shade(*batch, batch->rays.all()) == 0) {
+    out.release(batch);
+  } else {
+    out.emit(batch);
+  }
+}
+
+std::size_t ShadeStage::shade(Batch& batch, RayRange range) const {
+  RayBatch& rays = batch.rays;
+  const HitBatch& hits = batch.hits;
   const Scene& scene = world_.scene;
   std::size_t survivors = 0;
-  for (std::size_t i = 0; i < rays.count; ++i) {
+  for (std::size_t i = range.begin; i < range.end; ++i) {
     if (!(rays.flags[i] & ray_flags::alive)) continue;
     if (!hits.is_hit(i)) {
       add_escaped_ray_light(film_, rays, i, scene.background);
@@ -46,11 +54,7 @@ void ShadeStage::process(Batch* batch, StageOutput& out) const {
     rays.flags[i] = continues ? std::uint8_t(ray_flags::alive | ray_flags::continues) : ray_flags::alive;
     ++survivors;
   }
-  if (survivors == 0) {
-    out.release(batch);
-  } else {
-    out.emit(batch);
-  }
+  return survivors;
 }
 
 }  // namespace wavetrace

@@ -16,6 +16,10 @@ class ShadeStage final : public Stage {
   std::string name() const override { return "shade"; }
   void process(Batch* batch, StageOutput& out) const override;
 
+  // Shades `range` of `batch` (the megakernel calls it for one ray); returns how many of
+  // its rays stay alive for spawn.
+  std::size_t shade(Batch& batch, RayRange range) const;
+
  private:
   const World& world_;
   Film& film_;

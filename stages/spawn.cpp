@@ -31,13 +31,25 @@ void write_ray(RayBatch& to, std::size_t slot, const RayBatch& parent, std::size
 }  // namespace
 
 void SpawnStage::process(Batch* batch, StageOutput& out) const {
-  const RayBatch& rays = batch->rays;
-  const HitBatch& hits = batch->hits;
-  const bool has_lights = !world_.lights.empty();
   Batch* bounces = out.acquire();
-  Batch* shadows = has_lights ? out.acquire() : nullptr;
+  Batch* shadows = world_.lights.empty() ? nullptr : out.acquire();
+  spawn(*batch, batch->rays.all(), bounces->rays, shadows != nullptr ? &shadows->rays : nullptr);
+  out.release(batch);
+  for (Batch* made : {bounces, shadows}) {
+    if (made == nullptr) continue;
+    if (made->rays.count == 0) {
+      out.release(made);
+    } else {
+      out.emit(made);
+    }
+  }
+}
 
-  for (std::size_t i = 0; i < rays.count; ++i) {
+void SpawnStage::spawn(const Batch& batch, RayRange range, RayBatch& bounces, RayBatch* shadows) const {
+  const RayBatch& rays = batch.rays;
+  const HitBatch& hits = batch.hits;
+  const bool has_lights = shadows != nullptr && !world_.lights.empty();
+  for (std::size_t i = range.begin; i < range.end; ++i) {
     if (!(rays.flags[i] & ray_flags::alive)) continue;
     // The accelerator's point is from barycentrics rather than origin + t * direction:
     // exact to the triangle's plane.
@@ -63,7 +75,7 @@ void SpawnStage::process(Batch* batch, StageOutput& out) const {
       if (cos_surface > 0.0f && cos_light > 0.0f && distance_squared > 0.0f) {
         const glm::vec3 carried = throughput * albedo * (1.0f / kPi) * light.emission *
                                   (cos_surface * cos_light / (distance_squared * light.pdf_area));
-        RayBatch& to = shadows->rays;
+        RayBatch& to = *shadows;
         write_ray(to, to.count++, rays, i, origin, toward, distance * (1.0f - kShadowRayShortening),
                   RayKind::shadow, static_cast<std::uint16_t>(depth), carried);
       }
@@ -75,19 +87,9 @@ void SpawnStage::process(Batch* batch, StageOutput& out) const {
       // Cosine-weighted sampling of a Lambertian surface: f cos / pdf = albedo.
       glm::vec3 next = throughput * albedo;
       if (rules_.roulette_applies(depth)) next /= survival_probability(albedo);
-      RayBatch& to = bounces->rays;
+      RayBatch& to = bounces;
       write_ray(to, to.count++, rays, i, origin, bounce, std::numeric_limits<float>::infinity(), RayKind::bounce,
                 static_cast<std::uint16_t>(depth + 1), next);
-    }
-  }
-
-  out.release(batch);
-  for (Batch* made : {bounces, shadows}) {
-    if (made == nullptr) continue;
-    if (made->rays.count == 0) {
-      out.release(made);
-    } else {
-      out.emit(made);
     }
   }
 }

@@ -15,6 +15,10 @@ class SpawnStage final : public Stage {
   std::string name() const override { return "spawn"; }
   void process(Batch* batch, StageOutput& out) const override;
 
+  // Appends the rays spawned from the live rays of `range` of `batch` to `bounces` and
+  // (when the scene has lights) `shadows`; the megakernel calls it for one ray.
+  void spawn(const Batch& batch, RayRange range, RayBatch& bounces, RayBatch* shadows) const;
+
  private:
   const World& world_;
   PathRules rules_;

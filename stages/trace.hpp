@@ -45,6 +45,10 @@ class TraceStage final : public Stage {
   std::string name() const override { return "trace"; }
   void process(Batch* batch, StageOutput& out) const override;
 
+  // Traces `range` of `batch`, whose rays are all of one kind; the megakernel calls it
+  // for one ray at a time. `probe` sees every read (null: unobserved).
+  void trace_run(Batch& batch, RayRange range, RecordingProbe* probe = nullptr) const;
+
  private:
   const Accelerator& accelerator_;
   const MaterialRuns& materials_;

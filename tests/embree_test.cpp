@@ -2,6 +2,7 @@
 // ray intervals, any-hit, memory accounting.
 #include <cmath>
 #include <limits>
+#include <tuple>
 
 #include <gtest/gtest.h>
 
@@ -27,12 +28,13 @@ void set_ray(RayBatch& rays, std::size_t i, glm::vec3 origin, glm::vec3 directio
   rays.kind[i] = RayKind::camera;
 }
 
-class EmbreeModes : public ::testing::TestWithParam<EmbreeMode> {};
+class EmbreeModes : public ::testing::TestWithParam<std::tuple<EmbreeMode, EmbreeQueries>> {};
 
 TEST_P(EmbreeModes, HitsTheSquareWhereGeometrySays) {
   const TriangleMesh mesh = unit_square();
   AcceleratorOptions options;
-  options.embree.mode = GetParam();
+  options.embree.mode = std::get<0>(GetParam());
+  options.embree.queries = std::get<1>(GetParam());
   const auto accel = make_accelerator(mesh, options);
   RayBatch rays(8);
   HitBatch hits(8);
@@ -71,8 +73,61 @@ TEST_P(EmbreeModes, HitsTheSquareWhereGeometrySays) {
 }
 
 INSTANTIATE_TEST_SUITE_P(AllModes, EmbreeModes,
-                         ::testing::Values(EmbreeMode::standard, EmbreeMode::compact, EmbreeMode::robust),
-                         [](const ::testing::TestParamInfo<EmbreeMode>& info) { return to_string(info.param); });
+                         ::testing::Combine(::testing::Values(EmbreeMode::standard, EmbreeMode::compact,
+                                                              EmbreeMode::robust),
+                                            ::testing::Values(EmbreeQueries::single, EmbreeQueries::stream)),
+                         [](const auto& info) {
+                           return to_string(std::get<0>(info.param)) + "_" + to_string(std::get<1>(info.param));
+                         });
+
+// The stream entries answer exactly what rtcIntersect1/rtcOccluded1 answer, ray for ray, for
+// closest, coherent and any-hit queries over a range with dead rays and short segments.
+TEST(Embree, StreamQueriesAnswerWhatSingleQueriesAnswer) {
+  const Scene room = make_builtin_scene("builtin:room:20k");
+  AcceleratorOptions single_options, stream_options;
+  single_options.embree.queries = EmbreeQueries::single;
+  stream_options.embree.queries = EmbreeQueries::stream;
+  const auto single = make_accelerator(room.mesh, single_options);
+  const auto stream = make_accelerator(room.mesh, stream_options);
+  constexpr std::size_t kRays = 1000;
+  RayBatch rays(kRays);
+  const glm::vec3 center = 0.5f * (room.bounds.lower + room.bounds.upper);
+  for (std::size_t i = 0; i < kRays; ++i) {
+    const float z = 1.0f - 2.0f * (float(i) + 0.5f) / float(kRays), phi = 2.39996f * float(i);
+    const float r = std::sqrt(1.0f - z * z);
+    const float tmax = i % 3 == 0 ? 0.5f : std::numeric_limits<float>::infinity();
+    set_ray(rays, i, center, {r * std::cos(phi), r * std::sin(phi), z}, 0.0f, tmax);
+    if (i % 7 == 0) rays.flags[i] = 0;
+  }
+  rays.count = kRays;
+  const RayRange range{3, kRays - 2};
+  for (int query = 0; query < 3; ++query) {
+    HitBatch expected(kRays), found(kRays);
+    if (query == 0) {
+      single->intersect_closest(rays, expected, range);
+      stream->intersect_closest(rays, found, range);
+    } else if (query == 1) {
+      single->intersect_coherent(rays, expected, range);
+      stream->intersect_coherent(rays, found, range);
+    } else {
+      single->intersect_any(rays, expected, range);
+      stream->intersect_any(rays, found, range);
+    }
+    std::size_t hit_count = 0;
+    for (std::uint32_t i = range.begin; i < range.end; ++i) {
+      ASSERT_EQ(found.primitive[i], expected.primitive[i]) << "query " << query << " ray " << i;
+      hit_count += expected.is_hit(i);
+      if (query == 2 || !expected.is_hit(i)) continue;
+      EXPECT_EQ(found.t[i], expected.t[i]) << i;
+      EXPECT_EQ(found.u[i], expected.u[i]) << i;
+      EXPECT_EQ(found.v[i], expected.v[i]) << i;
+      EXPECT_EQ(found.point(i), expected.point(i)) << i;
+      EXPECT_EQ(found.normal(i), expected.normal(i)) << i;
+    }
+    EXPECT_GT(hit_count, range.size() / 3) << "query " << query;
+    for (std::uint32_t i = (range.begin + 6) / 7 * 7; i < range.end; i += 7) EXPECT_FALSE(found.is_hit(i)) << "dead ray " << i;
+  }
+}
 
 TEST(Embree, RangesTouchOnlyTheirRays) {
   const TriangleMesh mesh = unit_square();

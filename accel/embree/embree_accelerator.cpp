@@ -1,5 +1,6 @@
-// Embree 3 wrapper: one triangle geometry with shared buffers, rtcIntersect1/rtcOccluded1
-// per ray (the configuration the papers and PLATFORM.md measure).
+// Embree 3 wrapper: one triangle geometry with shared buffers, traced per ray
+// (rtcIntersect1/rtcOccluded1, the configuration the papers and PLATFORM.md measure) or a
+// batch range at a time through Embree's stream entries over our columns.
 #include "accel/embree/embree_accelerator.hpp"
 #include "accel/hit_surface.hpp"
 #include "accel/ray_loop.hpp"
@@ -8,6 +9,7 @@
 #include <chrono>
 #include <limits>
 #include <stdexcept>
+#include <vector>
 
 #include <embree3/rtcore.h>
 #include <fmt/format.h>
@@ -83,25 +85,31 @@ class EmbreeAccelerator final : public Accelerator {
     return options_.mode == EmbreeMode::standard ? "embree" : "embree-" + to_string(options_.mode);
   }
 
+  // A stream of one ray (the megakernel's) goes to rtcIntersect1: the same hits, without
+  // the stream's set-up.
   void intersect_closest(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
-    for_each_ray(rays, hits, range, [&](const SingleRay& ray, std::uint32_t i) {
-      RTCRayHit query;
-      fill_ray(ray, i, query.ray);
-      query.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-      query.hit.primID = RTC_INVALID_GEOMETRY_ID;
-      rtcIntersect1(scene_, &context, &query);
-      if (query.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
-        hits.set_miss(i);
-      } else {
-        hits.set_hit(i, query.ray.tfar, query.hit.primID, query.hit.u, query.hit.v);
-        set_surface_from_mesh(hits, i, mesh_, query.hit.primID);
-      }
-    });
+    if (options_.queries == EmbreeQueries::stream && range.size() > 1) {
+      intersect_stream(rays, hits, range, RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
+    } else {
+      intersect_single(rays, hits, range);
+    }
+    set_surfaces_from_mesh(hits, range, mesh_);
+  }
+
+  void intersect_coherent(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
+    if (options_.queries == EmbreeQueries::single || range.size() == 1) {
+      intersect_closest(rays, hits, range);
+      return;
+    }
+    intersect_stream(rays, hits, range, RTC_INTERSECT_CONTEXT_FLAG_COHERENT);
+    set_surfaces_from_mesh(hits, range, mesh_);
   }
 
   void intersect_any(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
+    if (options_.queries == EmbreeQueries::stream && range.size() > 1) {
+      occluded_stream(rays, hits, range);
+      return;
+    }
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     for_each_ray(rays, hits, range, [&](const SingleRay& ray, std::uint32_t i) {
@@ -124,6 +132,95 @@ class EmbreeAccelerator final : public Accelerator {
   BuildReport build() const override { return build_; }
 
  private:
+  // t, primitive, u, v of each ray; the caller adds the surfaces.
+  void intersect_single(const RayBatch& rays, HitBatch& hits, RayRange range) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    for_each_ray(rays, hits, range, [&](const SingleRay& ray, std::uint32_t i) {
+      RTCRayHit query;
+      fill_ray(ray, i, query.ray);
+      query.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+      query.hit.primID = RTC_INVALID_GEOMETRY_ID;
+      rtcIntersect1(scene_, &context, &query);
+      if (query.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+        hits.set_miss(i);
+      } else {
+        hits.set_hit(i, query.ray.tfar, query.hit.primID, query.hit.u, query.hit.v);
+      }
+    });
+  }
+
+  // The columns Embree's pointer-SoA stream reads and writes that a batch does not have.
+  struct StreamScratch {
+    std::vector<float> time;
+    std::vector<unsigned> mask, id, flags, geometry;
+    std::vector<float> normal_x, normal_y, normal_z;
+    void reserve(std::size_t count) {
+      if (time.size() >= count) return;
+      time.assign(count, 0.0f);
+      mask.assign(count, 0xFFFFFFFFu);
+      flags.assign(count, 0u);
+      id.resize(count);
+      for (std::size_t i = 0; i < count; ++i) id[i] = unsigned(i);
+      geometry.resize(count);
+      normal_x.resize(count);
+      normal_y.resize(count);
+      normal_z.resize(count);
+    }
+  };
+  static StreamScratch& stream_scratch(std::size_t count) {
+    thread_local StreamScratch scratch;
+    scratch.reserve(count);
+    return scratch;
+  }
+
+  // The range's rays in place: origins, directions and tnear from the batch, tfar in the
+  // hit's t column (Embree shortens it to the hit), u, v and primitive written by Embree.
+  // A dead ray gets tfar = -inf, which Embree skips as an empty segment.
+  RTCRayNp stream_rays(const RayBatch& rays, HitBatch& hits, RayRange range, StreamScratch& scratch) const {
+    for (std::uint32_t i = range.begin; i < range.end; ++i) {
+      hits.t[i] = (rays.flags[i] & ray_flags::alive) ? rays.tmax[i] : -std::numeric_limits<float>::infinity();
+    }
+    const std::uint32_t b = range.begin;
+    return {const_cast<float*>(rays.origin_x + b), const_cast<float*>(rays.origin_y + b),
+            const_cast<float*>(rays.origin_z + b),  const_cast<float*>(rays.tmin + b),
+            const_cast<float*>(rays.direction_x + b), const_cast<float*>(rays.direction_y + b),
+            const_cast<float*>(rays.direction_z + b), scratch.time.data(),
+            hits.t + b, scratch.mask.data(), scratch.id.data(), scratch.flags.data()};
+  }
+
+  void intersect_stream(const RayBatch& rays, HitBatch& hits, RayRange range, RTCIntersectContextFlags flags) const {
+    StreamScratch& scratch = stream_scratch(range.size());
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = flags;
+    const std::uint32_t b = range.begin;
+    std::fill_n(scratch.geometry.data(), range.size(), RTC_INVALID_GEOMETRY_ID);
+    RTCRayHitNp query;
+    query.ray = stream_rays(rays, hits, range, scratch);
+    query.hit = {scratch.normal_x.data(), scratch.normal_y.data(), scratch.normal_z.data(), hits.u + b, hits.v + b,
+                 hits.primitive + b, scratch.geometry.data(), {nullptr}};
+    rtcIntersectNp(scene_, &context, &query, range.size());
+    for (std::uint32_t i = range.begin; i < range.end; ++i) {
+      if (scratch.geometry[i - b] == RTC_INVALID_GEOMETRY_ID) hits.set_miss(i);
+    }
+  }
+
+  void occluded_stream(const RayBatch& rays, HitBatch& hits, RayRange range) const {
+    StreamScratch& scratch = stream_scratch(range.size());
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+    RTCRayNp query = stream_rays(rays, hits, range, scratch);
+    rtcOccludedNp(scene_, &context, &query, range.size());
+    for (std::uint32_t i = range.begin; i < range.end; ++i) {
+      const bool occluded = hits.t[i] == -std::numeric_limits<float>::infinity() && (rays.flags[i] & ray_flags::alive);
+      hits.set_miss(i);
+      // Embree says which ray was blocked, not by what: report primitive 0 as "occluded".
+      if (occluded) hits.primitive[i] = 0;
+    }
+  }
+
   static void fill_ray(const SingleRay& single, std::uint32_t i, RTCRay& ray) {
     ray.org_x = single.origin.x;
     ray.org_y = single.origin.y;
@@ -168,6 +265,14 @@ std::string to_string(EmbreeMode mode) {
     default: return "default";
   }
 }
+
+EmbreeQueries parse_embree_queries(const std::string& text) {
+  if (text == "single") return EmbreeQueries::single;
+  if (text == "stream") return EmbreeQueries::stream;
+  throw std::invalid_argument(fmt::format("unknown embree queries '{}' (single, stream)", text));
+}
+
+std::string to_string(EmbreeQueries queries) { return queries == EmbreeQueries::stream ? "stream" : "single"; }
 
 std::unique_ptr<Accelerator> make_embree_accelerator(const TriangleMesh& mesh, const EmbreeOptions& options) {
   return std::make_unique<EmbreeAccelerator>(mesh, options);
