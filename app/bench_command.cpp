@@ -1,4 +1,4 @@
-// `wavetrace bench accel`, `bench leak`, `bench reorder` and `bench image`.
+// `wavetrace bench accel`, `bench leak`, `bench reorder`, `bench pipeline` and `bench image`.
 #include <fstream>
 #include <memory>
 #include <sstream>
@@ -9,6 +9,7 @@
 #include "bench/accel_bench.hpp"
 #include "bench/image_bench.hpp"
 #include "bench/leak_bench.hpp"
+#include "bench/pipeline_bench.hpp"
 #include "bench/reorder_bench.hpp"
 #include "stages/render_setup.hpp"
 #include "stages/world_file.hpp"
@@ -166,6 +167,45 @@ int run_reorder(const ReorderArguments& args) {
   return 0;
 }
 
+struct PipelineArguments {
+  std::string scene = "builtin:room:1M";
+  std::string accel = "embree";
+  std::string heuristics = "none,hph";
+  std::string threads = "1,2";
+  std::string size = "320x240";
+  int spp = 4;
+  int repeat = 3;
+  std::string json;
+  std::vector<std::string> assignments;
+};
+
+int run_pipeline(const PipelineArguments& args) {
+  Config config = render_bench_config({}, args.assignments, args.scene, args.spp, 0, args.size);
+  apply_accelerator_spec(config, args.accel);
+  PipelineBenchRequest request;
+  for (const std::string& name : split_commas(args.heuristics)) {
+    try {
+      request.heuristics.push_back(parse_reorder_heuristic(name));
+    } catch (const std::invalid_argument& error) {
+      throw ConfigError(fmt::format("--heuristics: {}", error.what()));
+    }
+  }
+  for (const std::string& count : split_commas(args.threads)) {
+    try {
+      std::size_t used = 0;
+      request.threads.push_back(std::stoi(count, &used));
+      if (used != count.size()) throw std::invalid_argument(count);
+    } catch (const std::exception&) {
+      throw ConfigError(fmt::format("--threads '{}': expected comma-separated thread counts, e.g. 1,2", args.threads));
+    }
+  }
+  request.repeats = args.repeat;
+  const PipelineBenchReport report = run_pipeline_bench(config, request);
+  fmt::print("{}", to_table(report));
+  if (!args.json.empty()) write_text(args.json, to_json(report).dump(2) + "\n");
+  return 0;
+}
+
 struct ImageArguments {
   std::string scene = "builtin:room:1M";
   std::string accel = "embree:mode=robust,hmq:bits=8,hmq:bits=12,hmq:bits=16";
@@ -239,6 +279,23 @@ void add_bench_command(CLI::App& app, int& exit_code) {
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   reorder->callback([reorder_args, &exit_code] { exit_code = run_reorder(*reorder_args); });
+
+  auto pipeline_args = std::make_shared<PipelineArguments>();
+  CLI::App* pipeline = bench->add_subcommand(
+      "pipeline", "the megakernel against the wavefront with each reorder heuristic: speed, stage costs, images");
+  pipeline->add_option("--scene", pipeline_args->scene, "mesh file, scene file (.toml), builtin:NAME[:TRIANGLES] or world file");
+  pipeline->add_option("--accel", pipeline_args->accel, "main accelerator, TYPE[:key=value]..., e.g. hmq:width=8");
+  pipeline->add_option("--heuristics", pipeline_args->heuristics,
+                       "comma-separated wavefront heuristics: none, origin, origin_dir, hph, hph_origin, hph_dir");
+  pipeline->add_option("--threads", pipeline_args->threads, "comma-separated thread counts, each a full set of rows");
+  pipeline->add_option("--spp", pipeline_args->spp, "samples per pixel");
+  pipeline->add_option("--size", pipeline_args->size, "image size as WIDTHxHEIGHT");
+  pipeline->add_option("--repeat", pipeline_args->repeat, "renders per row, interleaved (the median is reported)");
+  pipeline->add_option("--json", pipeline_args->json, "write results as JSON");
+  pipeline->add_option("--set", pipeline_args->assignments, "config override section.key=value (e.g. render.max_depth=8)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  pipeline->callback([pipeline_args, &exit_code] { exit_code = run_pipeline(*pipeline_args); });
 
   auto image_args = std::make_shared<ImageArguments>();
   CLI::App* image = bench->add_subcommand("image", "render the same image with each accelerator, RMSE against the first");

@@ -48,8 +48,7 @@ void compare(const RaySet& rays, const std::vector<std::unique_ptr<HitBatch>>& h
 
 }  // namespace
 
-AcceleratorSpec parse_accelerator_spec(const std::string& text, const Config& base) {
-  Config config = base;
+void apply_accelerator_spec(Config& config, const std::string& text) {
   std::size_t colon = text.find(':');
   const std::string type = text.substr(0, colon);
   config.set("accel.type=" + type);
@@ -63,6 +62,11 @@ AcceleratorSpec parse_accelerator_spec(const std::string& text, const Config& ba
     config.set((option.starts_with("chunk_triangles=") ? "build." : "accel." + type + ".") + option);
     colon = next;
   }
+}
+
+AcceleratorSpec parse_accelerator_spec(const std::string& text, const Config& base) {
+  Config config = base;
+  apply_accelerator_spec(config, text);
   return {text, accelerator_options(config)};
 }
 

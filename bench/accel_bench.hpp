@@ -23,6 +23,8 @@ struct AcceleratorSpec {
   AcceleratorOptions options;
 };
 AcceleratorSpec parse_accelerator_spec(const std::string& text, const Config& base);
+// Sets the keys a TYPE[:key=value]... spec names (accel.type, accel.TYPE.key, build.chunk_triangles).
+void apply_accelerator_spec(Config& config, const std::string& text);
 
 // One probed pass of the ray set: the pager at one budget and/or the simulated cache, and
 // the trace speed with the probes on (the uninstrumented speed is the result's own).

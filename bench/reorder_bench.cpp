@@ -3,10 +3,8 @@
 
 #include <fmt/format.h>
 
-#include "accel/registry.hpp"
-#include "scene/lights.hpp"
+#include "bench/render_world.hpp"
 #include "stages/render_setup.hpp"
-#include "stages/world_file.hpp"
 
 namespace wavetrace {
 namespace {
@@ -29,31 +27,14 @@ ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<Reo
   }
   bool hit_points = false;
   for (ReorderHeuristic heuristic : heuristics) hit_points = hit_points || uses_hit_points(heuristic);
-  // A scene is loaded and built here; a saved world is mapped, or paged from its file.
-  std::unique_ptr<LoadedWorld> saved;
-  Scene built_scene;
-  std::unique_ptr<Accelerator> built_accelerator;
-  std::unique_ptr<LightSampler> built_lights;
-  std::unique_ptr<Proxy> built_proxy;
-  if (is_world_file(base.scene.source)) {
-    saved = load_world(base.scene.source, world_paging(base), base.pipeline.threads);
-    if (hit_points && !saved->proxy) {
-      throw ConfigError(fmt::format("{} was saved without a proxy, which hit-point heuristics need: build it with --proxy",
-                                    base.scene.source));
-    }
-  } else {
-    if (base.memory.file_backing) throw ConfigError("memory.backing = file pages a world file: give one (wavetrace build)");
-    built_scene = load_scene(base.scene);
-    built_accelerator = build_world_accelerator(built_scene, base.accelerator);
-    built_lights = std::make_unique<LightSampler>(built_scene);
-    if (hit_points) built_proxy = std::make_unique<Proxy>(built_scene.mesh, base.proxy, *built_accelerator);
-  }
-  const Scene& scene = saved ? saved->scene : built_scene;
-  const Accelerator* accelerator = saved ? saved->accelerator.get() : built_accelerator.get();
-  const Proxy* proxy = saved ? saved->proxy.get() : built_proxy.get();
-  FilePager* file_pager = saved ? saved->file->pager() : nullptr;
+  const RenderWorld opened(base, hit_points);
+  const Scene& scene = opened.scene();
+  const Accelerator* accelerator = &opened.accelerator();
+  const Proxy* proxy = opened.proxy();
+  FilePager* file_pager = opened.file_pager();
+  const LoadedWorld* saved = opened.saved();
   const Camera camera = resolve_camera(base.camera, scene);
-  const World world{scene, *accelerator, saved ? *saved->lights : *built_lights, proxy, file_pager};
+  const World world = opened.world();
 
   ReorderBenchReport report;
   report.scene = scene.name;

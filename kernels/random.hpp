@@ -29,11 +29,20 @@ constexpr std::uint64_t mix64(std::uint64_t x) {
   return x;
 }
 
+// Every draw of one path starts from its (pixel, sample) key: a stage that makes several
+// draws for a ray hashes the pair once (path_key) and finishes each draw from it.
+constexpr std::uint64_t path_key(std::uint32_t pixel, std::uint32_t sample) {
+  return mix64((std::uint64_t{pixel} << 32) | sample);
+}
+
+constexpr std::uint64_t path_random_bits(std::uint64_t path, std::uint32_t depth, RandomPurpose purpose,
+                                         std::uint32_t dimension = 0) {
+  return mix64(path ^ ((std::uint64_t{depth} << 40) | (std::uint64_t(purpose) << 24) | dimension));
+}
+
 constexpr std::uint64_t random_bits(std::uint32_t pixel, std::uint32_t sample, std::uint32_t depth,
                                     RandomPurpose purpose, std::uint32_t dimension = 0) {
-  std::uint64_t key = mix64((std::uint64_t{pixel} << 32) | sample);
-  key = mix64(key ^ ((std::uint64_t{depth} << 40) | (std::uint64_t(purpose) << 24) | dimension));
-  return key;
+  return path_random_bits(path_key(pixel, sample), depth, purpose, dimension);
 }
 
 // Uniform float in [0, 1) from the top 24 bits.

@@ -47,20 +47,47 @@ LightSampler::LightSampler(const Scene& scene) {
     triangles_[i].pdf_area = static_cast<float>(power[i] / total) / triangles_[i].pdf_area;
   }
   if (!cumulative_.empty()) cumulative_.back() = 1.0f;
+  build_alias_table();
 }
 
 LightSampler::LightSampler(std::vector<EmissiveTriangle> triangles, std::vector<float> cumulative)
     : triangles_(std::move(triangles)), cumulative_(std::move(cumulative)) {
   if (triangles_.size() != cumulative_.size()) throw std::invalid_argument("light sampler: one cumulative weight per light");
+  for (std::size_t i = 0; i < cumulative_.size(); ++i) {
+    const float previous = i == 0 ? 0.0f : cumulative_[i - 1];
+    if (!(cumulative_[i] >= previous) || !(cumulative_[i] <= 1.0f)) {
+      throw std::invalid_argument("light sampler: cumulative weights must rise from 0 to 1");
+    }
+  }
+  build_alias_table();
 }
 
-LightSample LightSampler::sample(float u_choice, float u1, float u2) const {
-  const std::size_t index = std::min<std::size_t>(
-      std::upper_bound(cumulative_.begin(), cumulative_.end(), u_choice) - cumulative_.begin(),
-      triangles_.size() - 1);
-  const EmissiveTriangle& light = triangles_[index];
-  const Barycentrics bary = uniform_triangle(u1, u2);
-  return {light.corner + light.edge1 * bary.b1 + light.edge2 * bary.b2, light.normal, light.emission, light.pdf_area};
+void LightSampler::build_alias_table() {
+  const std::size_t n = cumulative_.size();
+  alias_.assign(n, {1.0f, 0});
+  if (n == 0) return;
+  // Each light's probability times n: slots under 1 are topped up from slots over 1.
+  std::vector<double> scaled(n);
+  std::vector<std::uint32_t> small, large;
+  for (std::size_t i = 0; i < n; ++i) {
+    scaled[i] = (double(cumulative_[i]) - (i == 0 ? 0.0 : double(cumulative_[i - 1]))) * double(n);
+    alias_[i].other = std::uint32_t(i);
+    (scaled[i] < 1.0 ? small : large).push_back(std::uint32_t(i));
+  }
+  while (!small.empty() && !large.empty()) {
+    const std::uint32_t under = small.back(), over = large.back();
+    small.pop_back();
+    alias_[under] = {static_cast<float>(scaled[under]), over};
+    scaled[over] -= 1.0 - scaled[under];
+    if (scaled[over] < 1.0) {
+      large.pop_back();
+      small.push_back(over);
+    }
+  }
+  // What rounding leaves on either list is a full slot.
+  for (std::uint32_t i : small) alias_[i] = {1.0f, i};
+  for (std::uint32_t i : large) alias_[i] = {1.0f, i};
 }
+
 
 }  // namespace wavetrace

@@ -1,12 +1,14 @@
 // Area lights: the emissive triangles of a scene, sampled in proportion to their power.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <vector>
 
 #include <glm/vec3.hpp>
 
+#include "kernels/sampling.hpp"
 #include "scene/scene.hpp"
 
 namespace wavetrace {
@@ -40,11 +42,30 @@ class LightSampler {
   std::size_t count() const { return triangles_.size(); }
 
   // u_choice picks a triangle, (u1, u2) a point on it; all in [0, 1).
-  LightSample sample(float u_choice, float u1, float u2) const;
+  LightSample sample(float u_choice, float u1, float u2) const;  // inline below: called per shadow ray
 
  private:
+  // Walker's alias table over the lights' choice probabilities (Vose's construction), so a
+  // sample picks its light in constant time: slot floor(u n) keeps its own light when the
+  // rest of u n is under `keep`, else takes `other`. Derived from cumulative_, not saved.
+  struct AliasSlot {
+    float keep;
+    std::uint32_t other;
+  };
+  void build_alias_table();
+
   std::vector<EmissiveTriangle> triangles_;
   std::vector<float> cumulative_;  // normalized running sum of power
+  std::vector<AliasSlot> alias_;
 };
+
+inline LightSample LightSampler::sample(float u_choice, float u1, float u2) const {
+  const float scaled = u_choice * float(alias_.size());
+  const std::size_t slot = std::min(static_cast<std::size_t>(scaled), alias_.size() - 1);
+  const AliasSlot& entry = alias_[slot];
+  const EmissiveTriangle& light = triangles_[scaled - float(slot) < entry.keep ? slot : entry.other];
+  const Barycentrics bary = uniform_triangle(u1, u2);
+  return {light.corner + light.edge1 * bary.b1 + light.edge2 * bary.b2, light.normal, light.emission, light.pdf_area};
+}
 
 }  // namespace wavetrace

@@ -31,8 +31,9 @@ const std::vector<ConfigKey>& config_schema() {
        "bounce depth from which Russian roulette may end a path"},
       {"render.threads", T::integer, std::int64_t{0}, 0, 1024, {}, "worker threads (0: all cores)"},
       {"render.batch_size", T::integer, std::int64_t{4096}, 16, 1 << 20, {}, "rays per batch"},
-      {"render.rays_in_flight", T::integer, std::int64_t{1} << 18, 1024, std::int64_t{1} << 30, {},
-       "most rays alive in the pipeline at once (bounds memory)"},
+      {"render.rays_in_flight", T::integer, std::nullopt, 1024, std::int64_t{1} << 30, {},
+       "most rays alive at once (bounds memory); default: reorder.buffer_rays with zsort in the chain, else 4 "
+       "batches per worker"},
       {"render.pixel_order", T::text, std::string("scanline"), 0, 0, {"scanline", "zcurve"},
        "order in which camera rays are generated"},
 

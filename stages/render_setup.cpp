@@ -186,7 +186,6 @@ RenderPlan plan_render(const Config& config) {
   plan.rules.max_depth = static_cast<std::uint32_t>(config.integer("render.max_depth"));
   plan.rules.russian_roulette_depth = static_cast<std::uint32_t>(config.integer("render.russian_roulette_depth"));
   plan.pipeline.batch_size = static_cast<std::size_t>(config.integer("render.batch_size"));
-  plan.pipeline.rays_in_flight = static_cast<std::size_t>(config.integer("render.rays_in_flight"));
   plan.pipeline.threads = static_cast<int>(config.integer("render.threads"));
   plan.pipeline.mode = parse_pipeline_mode(config.text("pipeline.mode"));
   plan.pipeline.tile_side = static_cast<std::uint32_t>(config.integer("pipeline.tile"));
@@ -213,6 +212,16 @@ RenderPlan plan_render(const Config& config) {
     throw ConfigError("pipeline.stages: 'auto' stands alone");
   }
   check_stage_order(plan.stages, plan.reorder.heuristic);
+  if (config.has("render.rays_in_flight")) {
+    plan.pipeline.rays_in_flight = static_cast<std::size_t>(config.integer("render.rays_in_flight"));
+  } else if (std::find(plan.stages.begin(), plan.stages.end(), "zsort") != plan.stages.end()) {
+    plan.pipeline.rays_in_flight = plan.reorder.buffer_rays;  // so that the buffer can fill
+  } else {
+    // Without a buffer to fill, rays in flight only keep the workers busy; more would cost
+    // memory (and first-touch page faults) for nothing.
+    const int workers = plan.pipeline.threads > 0 ? plan.pipeline.threads : tbb::info::default_concurrency();
+    plan.pipeline.rays_in_flight = 4 * std::size_t(workers) * plan.pipeline.batch_size;
+  }
   if (plan.pipeline.mode == PipelineMode::megakernel) check_megakernel_plan(plan);
   return plan;
 }

@@ -61,15 +61,16 @@ void SpawnStage::spawn(const Batch& batch, RayRange range, RayBatch& bounces, Ra
     const glm::vec3 albedo = world_.scene.materials[hits.material[i]].albedo;
     const glm::vec3 throughput(rays.throughput_r[i], rays.throughput_g[i], rays.throughput_b[i]);
     const std::uint32_t depth = rays.depth[i];
+    const std::uint64_t path = path_key(rays.pixel[i], rays.sample[i]);
 
     if (has_lights) {
-      const float choice = unit_float(random_bits(rays.pixel[i], rays.sample[i], depth, RandomPurpose::light_choice));
-      const UnitPair uv = unit_pair(random_bits(rays.pixel[i], rays.sample[i], depth, RandomPurpose::light_point));
+      const float choice = unit_float(path_random_bits(path, depth, RandomPurpose::light_choice));
+      const UnitPair uv = unit_pair(path_random_bits(path, depth, RandomPurpose::light_point));
       const LightSample light = world_.lights.sample(choice, uv.first, uv.second);
       const glm::vec3 to_light = light.point - origin;
       const float distance_squared = glm::dot(to_light, to_light);
       const float distance = std::sqrt(distance_squared);
-      const glm::vec3 toward = to_light / distance;
+      const glm::vec3 toward = to_light * (1.0f / distance);
       const float cos_surface = glm::dot(normal, toward);
       const float cos_light = -glm::dot(light.normal, toward);
       if (cos_surface > 0.0f && cos_light > 0.0f && distance_squared > 0.0f) {
@@ -82,7 +83,7 @@ void SpawnStage::spawn(const Batch& batch, RayRange range, RayBatch& bounces, Ra
     }
 
     if (rays.flags[i] & ray_flags::continues) {
-      const UnitPair uv = unit_pair(random_bits(rays.pixel[i], rays.sample[i], depth, RandomPurpose::bounce_direction));
+      const UnitPair uv = unit_pair(path_random_bits(path, depth, RandomPurpose::bounce_direction));
       const glm::vec3 bounce = cosine_hemisphere(normal, uv.first, uv.second);
       // Cosine-weighted sampling of a Lambertian surface: f cos / pdf = albedo.
       glm::vec3 next = throughput * albedo;
