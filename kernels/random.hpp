@@ -29,25 +29,53 @@ constexpr std::uint64_t mix64(std::uint64_t x) {
   return x;
 }
 
-// Every draw of one path starts from its (pixel, sample) key: a stage that makes several
-// draws for a ray hashes the pair once (path_key) and finishes each draw from it.
+// The path tracer's draws. Every draw of one path starts from its (pixel, sample) key,
+// 64 bits so that no two paths of an image share one; a stage hashes the pair once per ray
+// (path_key) and finishes each draw in 32-bit lanes (path_draw), which AVX2 multiplies
+// eight at a time, where it has no 64-bit multiply: the stages' loops over rays vectorize.
 constexpr std::uint64_t path_key(std::uint32_t pixel, std::uint32_t sample) {
   return mix64((std::uint64_t{pixel} << 32) | sample);
 }
 
-constexpr std::uint64_t path_random_bits(std::uint64_t path, std::uint32_t depth, RandomPurpose purpose,
-                                         std::uint32_t dimension = 0) {
-  return mix64(path ^ ((std::uint64_t{depth} << 40) | (std::uint64_t(purpose) << 24) | dimension));
+// A 32-bit finalizer (Wellons' lowbias32: two multiply-xorshift rounds, bias ~0.17).
+constexpr std::uint32_t hash32(std::uint32_t x) {
+  x ^= x >> 16;
+  x *= 0x7feb352du;
+  x ^= x >> 15;
+  x *= 0x846ca68bu;
+  x ^= x >> 16;
+  return x;
 }
 
+// 32 random bits of a path at a depth, for one purpose and dimension (depth < 2^16,
+// dimension < 2^8): the high half of the key, tagged, hashed, then the low half, hashed.
+// Loops keep the key's halves in two 32-bit columns, which vectorize where 64-bit ones do not.
+constexpr std::uint32_t path_draw(std::uint32_t key_high, std::uint32_t key_low, std::uint32_t depth,
+                                  RandomPurpose purpose, std::uint32_t dimension = 0) {
+  const std::uint32_t tag = (depth << 16) ^ (std::uint32_t(purpose) << 8) ^ dimension;
+  return hash32(key_low ^ hash32(key_high ^ (tag * 0x9e3779b9u)));
+}
+constexpr std::uint32_t path_draw(std::uint64_t path, std::uint32_t depth, RandomPurpose purpose,
+                                  std::uint32_t dimension = 0) {
+  return path_draw(std::uint32_t(path >> 32), std::uint32_t(path), depth, purpose, dimension);
+}
+
+// Uniform float in [0, 1) from a draw's top 24 bits.
+constexpr float unit_float32(std::uint32_t bits) {
+  return static_cast<float>(static_cast<std::int32_t>(bits >> 8)) * (1.0f / 16777216.0f);
+}
+
+// 64 random bits for everything else (scenes, proxies, benchmark rays), from the same keys.
 constexpr std::uint64_t random_bits(std::uint32_t pixel, std::uint32_t sample, std::uint32_t depth,
                                     RandomPurpose purpose, std::uint32_t dimension = 0) {
-  return path_random_bits(path_key(pixel, sample), depth, purpose, dimension);
+  std::uint64_t key = mix64((std::uint64_t{pixel} << 32) | sample);
+  return mix64(key ^ ((std::uint64_t{depth} << 40) | (std::uint64_t(purpose) << 24) | dimension));
 }
 
 // Uniform float in [0, 1) from the top 24 bits.
+// (Through a 32-bit int: a 64-bit integer to float conversion does not vectorize on AVX2.)
 constexpr float unit_float(std::uint64_t bits) {
-  return static_cast<float>(bits >> 40) * (1.0f / 16777216.0f);
+  return static_cast<float>(static_cast<std::int32_t>(bits >> 40)) * (1.0f / 16777216.0f);
 }
 
 // Two independent uniform floats in [0, 1) from one 64-bit draw.
@@ -56,8 +84,8 @@ struct UnitPair {
   float second;
 };
 constexpr UnitPair unit_pair(std::uint64_t bits) {
-  return {static_cast<float>(bits >> 40) * (1.0f / 16777216.0f),
-          static_cast<float>((bits >> 8) & 0xFFFFFFu) * (1.0f / 16777216.0f)};
+  return {static_cast<float>(static_cast<std::int32_t>(bits >> 40)) * (1.0f / 16777216.0f),
+          static_cast<float>(static_cast<std::int32_t>((bits >> 8) & 0xFFFFFFu)) * (1.0f / 16777216.0f)};
 }
 
 }  // namespace wavetrace

@@ -11,18 +11,21 @@
 
 namespace wavetrace {
 
-inline glm::vec3 offset_ray_origin(const glm::vec3& point, const glm::vec3& normal) {
+// One coordinate: branch-free, so loops over a batch's rays vectorize.
+inline float offset_coordinate(float point, float normal) {
   constexpr float kOrigin = 1.0f / 32.0f;
   constexpr float kFloatScale = 1.0f / 65536.0f;
   constexpr float kIntScale = 256.0f;
-  glm::vec3 result;
-  for (int axis = 0; axis < 3; ++axis) {
-    const auto offset = static_cast<std::int32_t>(kIntScale * normal[axis]);
-    const std::int32_t bits = std::bit_cast<std::int32_t>(point[axis]);
-    const float moved = std::bit_cast<float>(bits + (point[axis] < 0.0f ? -offset : offset));
-    result[axis] = std::fabs(point[axis]) < kOrigin ? point[axis] + kFloatScale * normal[axis] : moved;
-  }
-  return result;
+  const auto offset = static_cast<std::int32_t>(kIntScale * normal);
+  const std::int32_t bits = std::bit_cast<std::int32_t>(point);
+  const float moved = std::bit_cast<float>(bits + (point < 0.0f ? -offset : offset));
+  const float nudged = point + kFloatScale * normal;  // both computed: a select, not a branch
+  return std::fabs(point) < kOrigin ? nudged : moved;
+}
+
+inline glm::vec3 offset_ray_origin(const glm::vec3& point, const glm::vec3& normal) {
+  return {offset_coordinate(point.x, normal.x), offset_coordinate(point.y, normal.y),
+          offset_coordinate(point.z, normal.z)};
 }
 
 }  // namespace wavetrace

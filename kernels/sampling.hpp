@@ -38,23 +38,29 @@ inline SinCos sin_cos_turns(float turns) {
   const float x2 = x * x;
   const float s = x * (1.0f + x2 * (-1.0f / 6 + x2 * (1.0f / 120 + x2 * (-1.0f / 5040 + x2 * (1.0f / 362880)))));
   const float c = 1.0f + x2 * (-0.5f + x2 * (1.0f / 24 + x2 * (-1.0f / 720 + x2 * (1.0f / 40320))));
-  switch (quarter & 3) {
-    case 0: return {s, c};
-    case 1: return {c, -s};
-    case 2: return {-s, -c};
-    default: return {-c, s};
-  }
+  // Rotate by the quarter turns taken out, with selects rather than a switch so that loops
+  // over many samples vectorize: odd quarters swap sin and cos, and the signs follow.
+  const bool odd = (quarter & 1) != 0;
+  const float sine = odd ? c : s, cosine = odd ? s : c;
+  return {(quarter & 2) ? -sine : sine, ((quarter + 1) & 2) ? -cosine : cosine};
 }
 
-// Cosine-weighted direction in the hemisphere around n; pdf = cos(theta) / pi.
-inline glm::vec3 cosine_hemisphere(const glm::vec3& n, float u1, float u2) {
+// Cosine-weighted direction in the hemisphere around n; pdf = cos(theta) / pi. Written out
+// in floats (basis_around's frame, the same operations) so that loops over rays vectorize,
+// which the vec3 temporaries of the frame kept the compiler from doing.
+inline glm::vec3 cosine_hemisphere(glm::vec3 n, float u1, float u2) {
   const float radius = std::sqrt(u1);
   const SinCos phi = sin_cos_turns(u2);
   const float x = radius * phi.cos;
   const float y = radius * phi.sin;
-  const float z = std::sqrt(std::fmax(0.0f, 1.0f - u1));
-  const OrthonormalBasis basis = basis_around(n);
-  return basis.tangent * x + basis.bitangent * y + basis.normal * z;
+  const float z = std::sqrt(std::max(0.0f, 1.0f - u1));  // (fmax, with its NaN rule, does not vectorize)
+  const float sign = std::copysign(1.0f, n.z);
+  const float a = -1.0f / (sign + n.z);
+  const float b = n.x * n.y * a;
+  const float tangent_x = 1.0f + sign * n.x * n.x * a, tangent_y = sign * b, tangent_z = -sign * n.x;
+  const float bitangent_x = b, bitangent_y = sign + n.y * n.y * a, bitangent_z = -n.y;
+  return {tangent_x * x + bitangent_x * y + n.x * z, tangent_y * x + bitangent_y * y + n.y * z,
+          tangent_z * x + bitangent_z * y + n.z * z};
 }
 
 // A uniformly distributed unit vector (Archimedes: z uniform in [-1, 1], longitude uniform).

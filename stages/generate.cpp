@@ -58,9 +58,11 @@ std::size_t GenerateStage::fill(RayBatch& rays) {
 }
 
 void GenerateStage::write_camera_ray(RayBatch& rays, std::size_t slot, std::uint32_t pixel, std::uint32_t sample) const {
-  const UnitPair jitter = unit_pair(random_bits(pixel, sample, 0, RandomPurpose::pixel_jitter));
-  const float x = (float(pixel % image_.width) + jitter.first) * inverse_width_;
-  const float y = 1.0f - (float(pixel / image_.width) + jitter.second) * inverse_height_;
+  const std::uint64_t path = path_key(pixel, sample);
+  const float jitter_x = unit_float32(path_draw(path, 0, RandomPurpose::pixel_jitter, 0));
+  const float jitter_y = unit_float32(path_draw(path, 0, RandomPurpose::pixel_jitter, 1));
+  const float x = (float(pixel % image_.width) + jitter_x) * inverse_width_;
+  const float y = 1.0f - (float(pixel / image_.width) + jitter_y) * inverse_height_;
   const glm::vec3 direction = glm::normalize(frame_.direction(x, y));
   rays.set_geometry(slot, frame_.origin, direction, 0.0f, std::numeric_limits<float>::infinity());
   rays.pixel[slot] = pixel;

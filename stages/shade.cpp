@@ -48,7 +48,8 @@ std::size_t ShadeStage::shade(Batch& batch, RayRange range) const {
     }
     bool continues = rules_.may_bounce(rays.depth[i]);
     if (continues && rules_.roulette_applies(rays.depth[i])) {
-      const float u = unit_float(random_bits(rays.pixel[i], rays.sample[i], rays.depth[i], RandomPurpose::russian_roulette));
+      const float u = unit_float32(
+          path_draw(path_key(rays.pixel[i], rays.sample[i]), rays.depth[i], RandomPurpose::russian_roulette));
       continues = u < survival_probability(material.albedo);
     }
     rays.flags[i] = continues ? std::uint8_t(ray_flags::alive | ray_flags::continues) : ray_flags::alive;

@@ -1,4 +1,5 @@
 // Pure kernels: counter-based randomness, sample warps, Morton codes, ray origin offsets.
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -52,6 +53,45 @@ TEST(Sampling, CosineHemisphereStaysAboveTheNormalWithMeanCosineTwoThirds) {
     mean_cosine += glm::dot(direction, normal);
   }
   EXPECT_NEAR(mean_cosine / count, 2.0 / 3.0, 0.005);  // E[cos] under pdf cos/pi
+}
+
+TEST(Sampling, SinCosOfTurnsMatchesLibmToAFewUlps) {
+  float worst = 0.0f;
+  for (int i = 0; i <= 1 << 20; ++i) {
+    const float turns = float(i) / float(1 << 20);
+    const SinCos value = sin_cos_turns(turns);
+    const double angle = 2.0 * 3.14159265358979323846 * double(turns);
+    worst = std::max({worst, float(std::fabs(value.sin - std::sin(angle))), float(std::fabs(value.cos - std::cos(angle)))});
+  }
+  EXPECT_LT(worst, 3e-7f);
+  EXPECT_EQ(sin_cos_turns(0.0f).cos, 1.0f);
+  EXPECT_EQ(sin_cos_turns(0.25f).sin, 1.0f);
+  EXPECT_EQ(sin_cos_turns(0.5f).cos, -1.0f);
+}
+
+TEST(Random, PathDrawsDependOnEveryKeyPartAndAreUniform) {
+  const std::uint64_t path = path_key(10, 2);
+  EXPECT_EQ(path, path_key(10, 2));
+  const std::uint32_t base = path_draw(path, 1, RandomPurpose::bounce_direction);
+  const std::set<std::uint32_t> distinct = {base,
+                                            path_draw(path_key(11, 2), 1, RandomPurpose::bounce_direction),
+                                            path_draw(path_key(10, 3), 1, RandomPurpose::bounce_direction),
+                                            path_draw(path, 2, RandomPurpose::bounce_direction),
+                                            path_draw(path, 1, RandomPurpose::light_choice),
+                                            path_draw(path, 1, RandomPurpose::bounce_direction, 1)};
+  EXPECT_EQ(distinct.size(), 6u);
+  double sum = 0.0, sum_of_products = 0.0;
+  for (std::uint32_t pixel = 0; pixel < 100000; ++pixel) {
+    const std::uint64_t key = path_key(pixel, 0);
+    const float u = unit_float32(path_draw(key, 0, RandomPurpose::pixel_jitter, 0));
+    const float v = unit_float32(path_draw(key, 0, RandomPurpose::pixel_jitter, 1));
+    ASSERT_GE(u, 0.0f);
+    ASSERT_LT(u, 1.0f);
+    sum += u;
+    sum_of_products += double(u) * v;  // independent dimensions: E[uv] = 1/4
+  }
+  EXPECT_NEAR(sum / 100000.0, 0.5, 0.005);
+  EXPECT_NEAR(sum_of_products / 100000.0, 0.25, 0.005);
 }
 
 TEST(Sampling, BasisIsOrthonormalEvenAtThePoles) {
