@@ -3,6 +3,7 @@
 #include "bench/pipeline_bench.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 
 #include <fmt/format.h>
@@ -102,7 +103,19 @@ PipelineBenchReport run_pipeline_bench(const Config& config, const PipelineBench
   const int fewest = *std::min_element(request.threads.begin(), request.threads.end());
   for (Row& row : rows) {
     PipelineBenchResult result = summarize(row);
-    result.image_identical = row.runs.front().image == megakernel_image;
+    const std::vector<float>& image = row.runs.front().image;
+    result.image_identical = image == megakernel_image;
+    double difference = 0.0, total = 0.0;
+    for (std::size_t p = 0; p + 2 < image.size(); p += 3) {
+      bool differs = false;
+      for (std::size_t c = p; c < p + 3; ++c) {
+        differs = differs || image[c] != megakernel_image[c];
+        difference += std::fabs(double(image[c]) - double(megakernel_image[c]));
+        total += std::fabs(double(megakernel_image[c]));
+      }
+      result.pixels_differing += differs;
+    }
+    result.image_difference = total > 0.0 ? difference / total : 0.0;
     if (row.mode == PipelineMode::megakernel) megakernel_seconds[row.threads] = result.median_seconds;
     result.speed_vs_megakernel = megakernel_seconds[row.threads] / result.median_seconds;
     const std::string key = result.mode + "/" + result.heuristic;
@@ -137,7 +150,9 @@ nlohmann::json to_json(const PipelineBenchReport& report) {
                        {"outside_trace_share", optional(r.outside_trace_share)},
                        {"speed_vs_megakernel", r.speed_vs_megakernel},
                        {"thread_scaling", optional(r.thread_scaling)},
-                       {"image_identical", r.image_identical}});
+                       {"image_identical", r.image_identical},
+                       {"pixels_differing", r.pixels_differing},
+                       {"image_difference", r.image_difference}});
   }
   return {{"scene", {{"source", report.scene}, {"triangles", report.triangles}}},
           {"accel", report.accel},
@@ -152,7 +167,7 @@ std::string to_table(const PipelineBenchReport& report) {
   const std::vector<std::string> stage_names = {"generate", "approx_hit", "zsort", "trace", "shade", "spawn"};
   table += fmt::format("{:<11} {:<11} {:>3} {:>9} {:>8}", "mode", "heuristic", "thr", "render s", "Mrays/s");
   for (const std::string& name : stage_names) table += fmt::format(" {:>10}", name.substr(0, 10));
-  table += fmt::format(" {:>8} {:>8} {:>8} {:>9}\n", "outside", "vs mega", "scaling", "identical");
+  table += fmt::format(" {:>8} {:>8} {:>8}  {}\n", "outside", "vs mega", "scaling", "identical");
   for (const PipelineBenchResult& r : report.results) {
     table += fmt::format("{:<11} {:<11} {:>3} {:>9.3f} {:>8.2f}", r.mode, r.heuristic, r.threads, r.median_seconds,
                          r.mrays_per_s);
@@ -160,10 +175,12 @@ std::string to_table(const PipelineBenchReport& report) {
       const auto stage = std::find_if(r.stages.begin(), r.stages.end(), [&](const auto& s) { return s.name == name; });
       table += stage == r.stages.end() ? fmt::format(" {:>10}", "-") : fmt::format(" {:>10.1f}", stage->ns_per_ray());
     }
-    table += fmt::format(" {:>8} {:>7.2f}x {:>8} {:>9}\n",
+    table += fmt::format(" {:>8} {:>7.2f}x {:>8}  {}\n",
                          r.outside_trace_share ? fmt::format("{:.1f}%", 100.0 * *r.outside_trace_share) : "-",
                          r.speed_vs_megakernel, r.thread_scaling ? fmt::format("{:.2f}x", *r.thread_scaling) : "-",
-                         r.image_identical ? "yes" : "NO");
+                         r.image_identical ? std::string("yes")
+                                           : fmt::format("NO ({} px, {:.2g} of the light)", r.pixels_differing,
+                                                         r.image_difference));
   }
   table += "stage columns: nanoseconds per ray the stage saw (thread-seconds / rays in; generate: rays out)\n"
            "outside: 1 - trace thread-seconds / (render s x threads); vs mega: the megakernel's render s over this\n"

@@ -38,6 +38,10 @@ struct PipelineBenchResult {
   double speed_vs_megakernel = 0.0;  // the megakernel's median seconds (same threads) over this one's
   std::optional<double> thread_scaling;  // its median seconds at the fewest threads over this one's
   bool image_identical = false;           // to the megakernel's image
+  // Where it is not: pixels with any channel different, and the summed absolute difference
+  // over the megakernel image's sum. (Embree's stream kernels are not its rtcIntersect1's.)
+  std::uint64_t pixels_differing = 0;
+  double image_difference = 0.0;
 };
 
 struct PipelineBenchReport {

@@ -186,5 +186,39 @@ TEST(Cli, BenchReorderReportsEveryHeuristicWithTheIssuesKeys) {
   EXPECT_GT(json["results"][2]["approx_hit_seconds"].get<double>(), 0.0);
 }
 
+TEST(Cli, BenchPipelineComparesTheMegakernelWithEachHeuristic) {
+  const std::string json_path = testing::write_temp_file("pipeline.json", "");
+  const auto result = testing::run_wavetrace(
+      "bench pipeline --scene builtin:room:5000 --accel bvh:width=8 --size 16x12 --spp 1 --threads 1,2 --repeat 2 "
+      "--heuristics none,hph --json " + json_path);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const nlohmann::json json = nlohmann::json::parse(std::ifstream(json_path));
+  ASSERT_EQ(json["results"].size(), 6u);  // megakernel, none, hph at 1 and at 2 threads
+  for (const auto& entry : json["results"]) {
+    for (const char* key : {"mode", "heuristic", "threads", "render_seconds", "median_seconds", "rays_traced", "mrays_per_s",
+                            "stages", "outside_trace_share", "speed_vs_megakernel", "thread_scaling", "image_identical"}) {
+      EXPECT_TRUE(entry.contains(key)) << key;
+    }
+    EXPECT_EQ(entry["render_seconds"].size(), 2u);
+    EXPECT_TRUE(entry["image_identical"].get<bool>()) << entry["mode"] << " " << entry["heuristic"];
+    EXPECT_EQ(entry["rays_traced"], json["results"][0]["rays_traced"]);  // the same paths
+  }
+  EXPECT_EQ(json["results"][0]["mode"], "megakernel");
+  EXPECT_TRUE(json["results"][0]["outside_trace_share"].is_null());
+  EXPECT_EQ(json["results"][2]["heuristic"], "hph");
+  EXPECT_EQ(json["results"][2]["stages"].size(), 6u);  // generate, approx_hit, zsort, trace, shade, spawn
+  EXPECT_TRUE(json["results"][1]["thread_scaling"].is_null());
+  EXPECT_FALSE(json["results"][4]["thread_scaling"].is_null());
+}
+
+TEST(Cli, BenchPipelineRefusesWhatItCannotMeasure) {
+  for (const char* arguments : {"--threads 1,x", "--heuristics sideways", "--repeat 0", "--set memory.budget=50%"}) {
+    const auto result =
+        testing::run_wavetrace(std::string("bench pipeline --scene builtin:room:5000 --size 8x6 ") + arguments);
+    EXPECT_NE(result.exit_code, 0) << arguments;
+    EXPECT_EQ(result.output.find("terminate"), std::string::npos) << result.output;
+  }
+}
+
 }  // namespace
 }  // namespace wavetrace
