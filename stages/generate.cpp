@@ -40,7 +40,7 @@ std::size_t GenerateStage::fill(RayBatch& rays) {
   const std::uint64_t first = next_.load(std::memory_order_relaxed);
   const std::size_t count = static_cast<std::size_t>(std::min<std::uint64_t>(rays.capacity(), total_ - first));
   const std::uint32_t spp = image_.samples_per_pixel;
-  // Walk (pixel, sample) incrementally: one division per batch, not two per ray.
+  // Walk the (pixel, sample) pairs on from the batch's first ray: one division per batch.
   auto order_index = static_cast<std::uint32_t>(first / spp);
   auto sample = static_cast<std::uint32_t>(first % spp);
   std::uint32_t pixel = pixel_order_.empty() ? order_index : pixel_order_[order_index];

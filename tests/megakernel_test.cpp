@@ -2,26 +2,16 @@
 // accelerator, the same rays traced, and settings only the wavefront honours refused.
 #include <gtest/gtest.h>
 
-#include "accel/registry.hpp"
+#include "render_support.hpp"
 #include "scene/builtin_scenes.hpp"
-#include "scene/lights.hpp"
 #include "stages/render_setup.hpp"
 
 namespace wavetrace {
 namespace {
 
-RenderOutput render(const Scene& scene, const std::vector<std::string>& settings) {
-  Config config;
-  config.set("render.width=40");
-  config.set("render.height=30");
-  config.set("render.spp=2");
-  for (const std::string& setting : settings) config.set(setting);
-  const RenderPlan plan = plan_render(config);
-  const auto accelerator = make_accelerator(scene.mesh, plan.accelerator);
-  const LightSampler lights(scene);
-  const std::unique_ptr<Proxy> proxy = build_proxy(plan, scene, *accelerator);
-  const World world{scene, *accelerator, lights, proxy.get()};
-  return render_image(plan, world, resolve_camera(plan.camera, scene));
+RenderOutput render(const Scene& scene, std::vector<std::string> settings) {
+  settings.insert(settings.begin(), {"render.width=40", "render.height=30", "render.spp=2"});
+  return testing::render_scene(scene, settings);
 }
 
 const Scene& room() {

@@ -14,21 +14,15 @@
 #include "scene/mesh_report.hpp"
 #include "scene/shapes.hpp"
 #include "stages/render_setup.hpp"
+#include "render_support.hpp"
 #include "test_support.hpp"
 
 namespace wavetrace {
 namespace {
 
-RenderOutput render(const Scene& scene, const std::vector<std::string>& settings) {
-  Config config;
-  config.set("render.width=32");
-  config.set("render.height=24");
-  config.set("render.spp=2");
-  for (const std::string& setting : settings) config.set(setting);
-  const RenderPlan plan = plan_render(config);
-  const auto accelerator = make_accelerator(scene.mesh, plan.accelerator);
-  const LightSampler lights(scene);
-  return render_image(plan, World{scene, *accelerator, lights}, resolve_camera(plan.camera, scene));
+RenderOutput render(const Scene& scene, std::vector<std::string> settings) {
+  settings.insert(settings.begin(), {"render.width=32", "render.height=24", "render.spp=2"});
+  return testing::render_scene(scene, settings);
 }
 
 TEST(Room, ShellIsClosedManifoldFacesInwardAndNearItsCount) {
