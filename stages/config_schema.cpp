@@ -124,7 +124,7 @@ const std::vector<ConfigKey>& config_schema() {
        "zsort's sort: a stable LSD radix sort or tbb::parallel_sort"},
 
       {"pipeline.stages", T::text_list, std::vector<std::string>{"auto"}, 0, 0,
-       {"auto", "generate", "approx_hit", "zsort", "trace", "shade", "spawn"},
+       {"auto", "generate", "approx_hit", "zsort", "repack", "trace", "shade", "spawn"},
        "the stage chain; spawn at the end loops back. auto: the chain reorder.heuristic needs"},
       {"pipeline.mode", T::text, std::string("wavefront"), 0, 0, {"wavefront", "megakernel"},
        "wavefront: batches through the stage graph; megakernel: one path at a time per worker (the control)"},

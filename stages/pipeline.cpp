@@ -50,9 +50,9 @@ PipelineContext::PipelineContext(std::size_t batch_capacity, std::size_t rays_in
 
 void PipelineContext::retire_rays(std::size_t count) {
   const std::int64_t now = live_rays_.fetch_sub(std::int64_t(count), std::memory_order_seq_cst) - std::int64_t(count);
-  if (zsort_node_ != nullptr) {
-    const auto waiting = std::int64_t(zsort_stage_->buffered_rays());
-    if (waiting > 0 && now <= waiting) zsort_node_->try_put(nullptr);
+  if (buffer_node_ != nullptr) {
+    const auto waiting = std::int64_t(buffer_stage_->buffered_rays());
+    if (waiting > 0 && now <= waiting) buffer_node_->try_put(nullptr);
   }
   if (generator_node_ != nullptr && !generator_stage_->exhausted() &&
       now + std::int64_t(pool_.batch_capacity()) <= std::int64_t(budget_)) {
@@ -93,7 +93,7 @@ std::unique_ptr<BatchNode> make_stage_node(tbb::flow::graph& graph, const Stage&
 
 namespace {
 
-// zsort's output: its rays are already counted alive, so emitting adds nothing.
+// A buffering stage's output: its rays are already counted alive, so emitting adds nothing.
 class BufferedOutput final : public StageOutput {
  public:
   BufferedOutput(PipelineContext& context, BatchNode::output_ports_type& ports) : context_(context), ports_(ports) {}
@@ -108,22 +108,19 @@ class BufferedOutput final : public StageOutput {
 
 }  // namespace
 
-std::unique_ptr<BatchNode> make_zsort_node(tbb::flow::graph& graph, const ZSortStage& stage, PipelineContext& context,
-                                           StageCounters& counters) {
+std::unique_ptr<BatchNode> make_buffering_node(tbb::flow::graph& graph, const BufferingStage& stage,
+                                               PipelineContext& context, StageCounters& counters) {
   auto node = std::make_unique<BatchNode>(
       graph, tbb::flow::serial, [&stage, &context, &counters](Batch* batch, BatchNode::output_ports_type& ports) {
         const Clock::time_point start = Clock::now();
+        BufferedOutput out(context, ports);
         const std::size_t rays_in = batch != nullptr ? batch->rays.count : 0;
-        const bool full = batch != nullptr && stage.buffer(batch);
+        std::size_t rays_out = batch != nullptr ? stage.take(batch, out) : 0;
         const std::size_t waiting = stage.buffered_rays();
-        std::size_t rays_out = 0;
-        if (waiting > 0 && (full || std::int64_t(waiting) >= context.live_rays())) {
-          BufferedOutput out(context, ports);
-          rays_out = stage.flush(out);
-        }
+        if (waiting > 0 && std::int64_t(waiting) >= context.live_rays()) rays_out += stage.flush(out);
         if (rays_in > 0 || rays_out > 0) counters.record(rays_in, rays_out, nanoseconds_since(start));
       });
-  context.attach_zsort(node.get(), &stage);
+  context.attach_buffer(node.get(), &stage);
   return node;
 }
 
@@ -167,8 +164,8 @@ PipelineRun Pipeline::run(const std::function<void(const Progress&)>& on_progres
     auto generate_node = make_generate_node(graph, generate_, context, generate_counters);
     std::vector<std::unique_ptr<BatchNode>> nodes;
     for (std::size_t i = 0; i < chain_.size(); ++i) {
-      if (const auto* zsort = dynamic_cast<const ZSortStage*>(chain_[i])) {
-        nodes.push_back(make_zsort_node(graph, *zsort, context, *counters[i]));
+      if (const auto* buffering = dynamic_cast<const BufferingStage*>(chain_[i])) {
+        nodes.push_back(make_buffering_node(graph, *buffering, context, *counters[i]));
       } else {
         nodes.push_back(make_stage_node(graph, *chain_[i], context, *counters[i]));
       }

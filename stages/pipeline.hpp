@@ -5,8 +5,9 @@
 // Flow control: the context counts the rays alive in the graph. The generate node emits
 // camera batches only while that count stays under the in-flight budget, and every node
 // that retires rays wakes it, so memory stays bounded and the graph drains by itself. A
-// zsort buffer holds rays until it is full or holds every live ray; whoever sees the
-// latter last (the zsort node after buffering, or a node after retiring) makes it flush.
+// buffering stage (zsort, repack) holds rays until it is ready or holds every live ray;
+// whoever sees the latter last (its node after taking a batch, or a node after retiring)
+// makes it flush.
 #pragma once
 
 #include <atomic>
@@ -24,7 +25,7 @@
 #include "stages/progress_reporter.hpp"
 #include "stages/stage.hpp"
 #include "stages/stage_counters.hpp"
-#include "stages/zsort.hpp"
+#include "stages/buffering_stage.hpp"
 
 namespace wavetrace {
 
@@ -48,11 +49,11 @@ class PipelineContext {
     generator_node_ = node;
     generator_stage_ = stage;
   }
-  // The zsort node is poked (sent a null batch) when every live ray is waiting in its
-  // buffer, since then nothing else will arrive to make it flush.
-  void attach_zsort(BatchNode* node, const ZSortStage* stage) {
-    zsort_node_ = node;
-    zsort_stage_ = stage;
+  // The buffering node is poked (sent a null batch) when every live ray is waiting in its
+  // stage, since then nothing else will arrive to make it flush.
+  void attach_buffer(BatchNode* node, const BufferingStage* stage) {
+    buffer_node_ = node;
+    buffer_stage_ = stage;
   }
 
  private:
@@ -61,8 +62,8 @@ class PipelineContext {
   std::atomic<std::int64_t> live_rays_{0};
   GenerateNode* generator_node_ = nullptr;
   const GenerateStage* generator_stage_ = nullptr;
-  BatchNode* zsort_node_ = nullptr;
-  const ZSortStage* zsort_stage_ = nullptr;
+  BatchNode* buffer_node_ = nullptr;
+  const BufferingStage* buffer_stage_ = nullptr;
 };
 
 // A serial node that emits camera batches while the in-flight budget allows; start it
@@ -74,10 +75,10 @@ std::unique_ptr<GenerateNode> make_generate_node(tbb::flow::graph& graph, Genera
 std::unique_ptr<BatchNode> make_stage_node(tbb::flow::graph& graph, const Stage& stage, PipelineContext& context,
                                            StageCounters& counters);
 
-// The serial zsort node: buffers batches and flushes when the buffer is full or holds
-// every live ray; a null batch is a poke to re-check.
-std::unique_ptr<BatchNode> make_zsort_node(tbb::flow::graph& graph, const ZSortStage& stage, PipelineContext& context,
-                                           StageCounters& counters);
+// The serial node of a buffering stage (zsort, repack): hands it each batch and flushes it
+// when it holds every live ray; a null batch is a poke to re-check. One per pipeline.
+std::unique_ptr<BatchNode> make_buffering_node(tbb::flow::graph& graph, const BufferingStage& stage,
+                                               PipelineContext& context, StageCounters& counters);
 
 // A node that ends every batch it receives (for chains without spawn).
 std::unique_ptr<tbb::flow::function_node<Batch*>> make_retire_node(tbb::flow::graph& graph,

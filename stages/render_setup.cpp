@@ -11,6 +11,7 @@
 #include "scene/builtin_scenes.hpp"
 #include "stages/approx_hit.hpp"
 #include "stages/megakernel.hpp"
+#include "stages/repack.hpp"
 #include "stages/shade.hpp"
 #include "stages/spawn.hpp"
 #include "stages/trace.hpp"
@@ -42,6 +43,12 @@ void check_stage_order(const std::vector<std::string>& names, ReorderHeuristic h
   }
   if (present("zsort") && (!present("trace") || position("zsort") > position("trace"))) {
     throw ConfigError("pipeline.stages: 'zsort' needs 'trace' after it");
+  }
+  if (present("repack") && (!present("trace") || position("repack") > position("trace"))) {
+    throw ConfigError("pipeline.stages: 'repack' needs 'trace' after it");
+  }
+  if (present("repack") && present("zsort")) {
+    throw ConfigError("pipeline.stages: 'repack' and 'zsort' both buffer rays: use one (zsort's batches are full)");
   }
   if (present("zsort") && present("approx_hit") && position("approx_hit") > position("zsort")) {
     throw ConfigError("pipeline.stages: 'approx_hit' must come before 'zsort' (zsort sorts by its points)");
@@ -264,6 +271,7 @@ StageChain::StageChain(const RenderPlan& plan, const World& world, Film& film, c
       zsort_ = zsort.get();
       owned_.push_back(std::move(zsort));
     }
+    if (name == "repack") owned_.push_back(std::make_unique<RepackStage>(plan.pipeline.batch_size / 2));
     if (name == "trace") {
       owned_.push_back(std::make_unique<TraceStage>(world.accelerator, world.scene.material_runs,
                                                     TraceInstruments{&hit_rates_, observers, &trace_times_}));

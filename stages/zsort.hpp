@@ -1,7 +1,7 @@
 // zsort (the reordering paper, §4.3): a ray buffer that, when full or when the chain has
 // nothing more to give it, computes every buffered ray's key with the configured heuristic
-// and curve, sorts the rays by key in parallel and emits them in key order. The one
-// stateful, serial stage: its pipeline node (make_zsort_node) runs one call at a time.
+// and curve, sorts the rays by key in parallel and emits them in key order. A buffering
+// stage: its pipeline node (make_buffering_node) runs one call at a time.
 #pragma once
 
 #include <atomic>
@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "stages/reorder_keys.hpp"
-#include "stages/stage.hpp"
+#include "stages/buffering_stage.hpp"
 
 namespace wavetrace {
 
@@ -36,7 +36,7 @@ struct SortEntry {
   }
 };
 
-class ZSortStage final : public Stage {
+class ZSortStage final : public BufferingStage {
  public:
   // What one buffered ray holds: its RayBatch columns (origin, direction, tmin, tmax,
   // pixel, sample, throughput: 4 bytes each; depth 2, kind 1, flags 1), the approximate hit
@@ -48,13 +48,14 @@ class ZSortStage final : public Stage {
   // Outside the pipeline's zsort node (a hand-wired chain): sorts one batch on its own.
   void process(Batch* batch, StageOutput& out) const override;
 
-  // Called by the serial node: holds the batch; true when the buffer is full.
+  // Holds the batch; true when the buffer is full.
   bool buffer(Batch* batch) const;
+  // Holds the batch, and sorts and emits the buffer once it is full.
+  std::size_t take(Batch* batch, StageOutput& out) const override { return buffer(batch) ? flush(out) : 0; }
   // Sorts and emits every buffered ray in key order through `out` (acquiring batches from
   // it and releasing the buffered ones); returns the rays emitted.
-  std::size_t flush(StageOutput& out) const;
-  // Rays held now; read by the pipeline to decide that everything alive is waiting here.
-  std::size_t buffered_rays() const { return buffered_rays_.load(std::memory_order_seq_cst); }
+  std::size_t flush(StageOutput& out) const override;
+  std::size_t buffered_rays() const override { return buffered_rays_.load(std::memory_order_seq_cst); }
   double sort_seconds() const { return sort_seconds_; }  // sorting alone, summed over flushes
   std::size_t flushes() const { return flushes_; }
   const ZSortOptions& options() const { return options_; }

@@ -19,6 +19,7 @@
 #include "scene/lights.hpp"
 #include "stages/render_setup.hpp"
 #include "stages/zsort.hpp"
+#include "collecting_output.hpp"
 
 namespace wavetrace {
 namespace {
@@ -133,18 +134,7 @@ TEST(Proxy, StochasticPruningKeepsItsShareAndTheExpectedArea) {
   EXPECT_NEAR(area(pruned) / area(scene.mesh), 1.0, 0.1);
 }
 
-// Hand-wired use of zsort: everything StageOutput sees.
-class CollectingOutput final : public StageOutput {
- public:
-  explicit CollectingOutput(BatchPool& pool) : pool_(pool) {}
-  void emit(Batch* batch) override { emitted.push_back(batch); }
-  Batch* acquire() override { return pool_.acquire(); }
-  void release(Batch* batch) override { pool_.release(batch); }
-  std::vector<Batch*> emitted;
-
- private:
-  BatchPool& pool_;
-};
+using testing::CollectingOutput;
 
 TEST(ZSort, EmitsEveryRayOnceInKeyOrderWithShadowRaysLast) {
   BatchPool pool(64);

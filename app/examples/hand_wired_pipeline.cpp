@@ -38,7 +38,7 @@ int main(int argc, char** argv) {
   tbb::flow::graph graph;
   auto generate_node = make_generate_node(graph, generate, context, generate_counters);
   auto approx_node = make_stage_node(graph, approx_hit, context, approx_counters);
-  auto zsort_node = make_zsort_node(graph, zsort, context, zsort_counters);  // serial, buffering
+  auto zsort_node = make_buffering_node(graph, zsort, context, zsort_counters);  // serial
   auto trace_node = make_stage_node(graph, trace, context, trace_counters);
   // A hand-written final node: count hits, then end the batch's rays.
   tbb::flow::function_node<Batch*> count_hits(graph, tbb::flow::unlimited, [&](Batch* batch) {
