@@ -35,6 +35,8 @@ const std::vector<ConfigKey>& config_schema() {
       {"render.rays_in_flight", T::integer, std::nullopt, 1024, std::int64_t{1} << 30, {},
        "most rays alive at once (bounds memory); default: reorder.buffer_rays with zsort in the chain, else 4 "
        "batches per worker"},
+      {"render.film", T::text, std::string("shared"), 0, 0, {"shared", "per_thread"},
+       "shared: one film, atomic adds; per_thread: a film per worker, summed at the end (same image)"},
       {"render.pixel_order", T::text, std::string("scanline"), 0, 0, {"scanline", "zcurve"},
        "order in which camera rays are generated"},
 

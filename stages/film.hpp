@@ -12,7 +12,11 @@ namespace wavetrace {
 
 class Film {
  public:
-  Film(std::uint32_t width, std::uint32_t height);
+  // `per_thread_copies` > 0 gives each of that many worker threads (by their index in the
+  // TBB arena the render runs in) its own copy of the sums, added without atomics and summed
+  // by resolve; other threads, and every thread with 0 copies, add atomically to the shared
+  // sums. Integer sums, so the image is the same either way.
+  Film(std::uint32_t width, std::uint32_t height, std::uint32_t per_thread_copies = 0);
 
   std::uint32_t width() const { return width_; }
   std::uint32_t height() const { return height_; }
@@ -32,7 +36,9 @@ class Film {
 
  private:
   std::uint32_t width_, height_;
-  std::unique_ptr<std::int64_t[]> sums_;  // r, g, b per pixel
+  std::uint32_t copies_;
+  std::unique_ptr<std::int64_t[]> sums_;         // r, g, b per pixel, shared (atomic adds)
+  std::unique_ptr<std::int64_t[]> thread_sums_;  // copies_ more, one per worker thread
   std::atomic<std::uint64_t> rejected_{0};
 };
 

@@ -36,25 +36,33 @@ GenerateStage::GenerateStage(const Camera& camera, const ImageSpec& image, Pixel
   }
 }
 
-std::size_t GenerateStage::fill(RayBatch& rays) {
-  const std::uint64_t first = next_.load(std::memory_order_relaxed);
-  const std::size_t count = static_cast<std::size_t>(std::min<std::uint64_t>(rays.capacity(), total_ - first));
+GenerateStage::Claim GenerateStage::claim(std::size_t capacity) {
+  const std::uint64_t first = next_.fetch_add(capacity, std::memory_order_relaxed);
+  if (first >= total_) return {};
+  return {first, static_cast<std::size_t>(std::min<std::uint64_t>(capacity, total_ - first))};
+}
+
+void GenerateStage::fill_range(RayBatch& rays, const Claim& claimed) const {
   const std::uint32_t spp = image_.samples_per_pixel;
-  // Walk the (pixel, sample) pairs on from the batch's first ray: one division per batch.
-  auto order_index = static_cast<std::uint32_t>(first / spp);
-  auto sample = static_cast<std::uint32_t>(first % spp);
+  // Walk the (pixel, sample) pairs on from the claim's first ray: one division per batch.
+  auto order_index = static_cast<std::uint32_t>(claimed.first / spp);
+  auto sample = static_cast<std::uint32_t>(claimed.first % spp);
   std::uint32_t pixel = pixel_order_.empty() ? order_index : pixel_order_[order_index];
-  for (std::size_t i = 0; i < count; ++i) {
+  for (std::size_t i = 0; i < claimed.count; ++i) {
     write_camera_ray(rays, i, pixel, sample);
-    if (++sample == spp && i + 1 < count) {
+    if (++sample == spp && i + 1 < claimed.count) {
       sample = 0;
       ++order_index;
       pixel = pixel_order_.empty() ? order_index : pixel_order_[order_index];
     }
   }
-  rays.count = count;
-  next_.store(first + count, std::memory_order_relaxed);
-  return count;
+  rays.count = claimed.count;
+}
+
+std::size_t GenerateStage::fill(RayBatch& rays) {
+  const Claim claimed = claim(rays.capacity());
+  fill_range(rays, claimed);
+  return claimed.count;
 }
 
 void GenerateStage::write_camera_ray(RayBatch& rays, std::size_t slot, std::uint32_t pixel, std::uint32_t sample) const {

@@ -2,6 +2,7 @@
 // pixel order, a batch at a time.
 #pragma once
 
+#include <algorithm>
 #include <atomic>
 #include <cstdint>
 #include <string>
@@ -28,11 +29,19 @@ class GenerateStage {
 
   std::string name() const { return "generate"; }
   std::uint64_t total_rays() const { return total_; }
-  std::uint64_t generated() const { return next_.load(std::memory_order_relaxed); }
+  std::uint64_t generated() const { return std::min(next_.load(std::memory_order_relaxed), total_); }
   bool exhausted() const { return generated() >= total_; }
 
-  // Fills `rays` with the next camera rays (up to its capacity); returns how many.
-  // Not reentrant: the pipeline calls it from one serial node.
+  // Claims the next camera rays, up to `capacity`: their first index and count (0 when
+  // every ray is claimed). Thread-safe, so generate runs on any number of threads at once.
+  struct Claim {
+    std::uint64_t first = 0;
+    std::size_t count = 0;
+  };
+  Claim claim(std::size_t capacity);
+  // Writes the claimed rays into `rays` and sets its count: a pure function of the indices.
+  void fill_range(RayBatch& rays, const Claim& claimed) const;
+  // Both: fills `rays` with the next camera rays (up to its capacity); returns how many.
   std::size_t fill(RayBatch& rays);
 
   // The camera ray of (pixel, sample) into slot `slot`: a pure function of the two, so

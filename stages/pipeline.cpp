@@ -62,15 +62,19 @@ void PipelineContext::retire_rays(std::size_t count) {
 
 std::unique_ptr<GenerateNode> make_generate_node(tbb::flow::graph& graph, GenerateStage& stage,
                                                  PipelineContext& context, StageCounters& counters) {
+  // Any number of bodies at once: each claims its rays (counting them alive first, so the
+  // budget sees them) and fills its batch in parallel with the others.
   auto node = std::make_unique<GenerateNode>(
-      graph, tbb::flow::serial, [&stage, &context, &counters](tbb::flow::continue_msg, GenerateNode::output_ports_type& ports) {
-        const std::int64_t capacity = std::int64_t(context.pool().batch_capacity());
-        while (!stage.exhausted() && context.live_rays() + capacity <= std::int64_t(context.budget())) {
+      graph, tbb::flow::unlimited, [&stage, &context, &counters](tbb::flow::continue_msg, GenerateNode::output_ports_type& ports) {
+        const std::size_t capacity = context.pool().batch_capacity();
+        while (!stage.exhausted() && context.live_rays() + std::int64_t(capacity) <= std::int64_t(context.budget())) {
           const Clock::time_point start = Clock::now();
+          const GenerateStage::Claim claimed = stage.claim(capacity);
+          if (claimed.count == 0) return;
+          context.add_rays(claimed.count);
           Batch* batch = context.pool().acquire();
-          const std::size_t made = stage.fill(batch->rays);
-          counters.record(0, made, nanoseconds_since(start));
-          context.add_rays(made);
+          stage.fill_range(batch->rays, claimed);
+          counters.record(0, claimed.count, nanoseconds_since(start));
           std::get<0>(ports).try_put(batch);
         }
       });

@@ -3,11 +3,11 @@
 // Pipeline assembles the chain a config names.
 //
 // Flow control: the context counts the rays alive in the graph. The generate node emits
-// camera batches only while that count stays under the in-flight budget, and every node
-// that retires rays wakes it, so memory stays bounded and the graph drains by itself. A
-// buffering stage (zsort, repack) holds rays until it is ready or holds every live ray;
-// whoever sees the latter last (its node after taking a batch, or a node after retiring)
-// makes it flush.
+// camera batches only while that count stays under the in-flight budget (give or take a
+// batch per thread generating at once), and every node that retires rays wakes it, so
+// memory stays bounded and the graph drains by itself. A buffering stage (zsort, repack)
+// holds rays until it is ready or holds every live ray; whoever sees the latter last (its
+// node after taking a batch, or a node after retiring) makes it flush.
 #pragma once
 
 #include <atomic>
@@ -66,8 +66,8 @@ class PipelineContext {
   const BufferingStage* buffer_stage_ = nullptr;
 };
 
-// A serial node that emits camera batches while the in-flight budget allows; start it
-// with try_put(continue_msg()).
+// The node that emits camera batches while the in-flight budget allows, any number of
+// them filled at once; start it with try_put(continue_msg()).
 std::unique_ptr<GenerateNode> make_generate_node(tbb::flow::graph& graph, GenerateStage& stage,
                                                  PipelineContext& context, StageCounters& counters);
 

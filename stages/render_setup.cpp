@@ -62,6 +62,10 @@ void check_stage_order(const std::vector<std::string>& names, ReorderHeuristic h
   }
 }
 
+int worker_count(const PipelineOptions& options) {
+  return options.threads > 0 ? options.threads : tbb::info::default_concurrency();
+}
+
 // The megakernel runs generate, trace, shade and spawn one path at a time: settings that
 // only the wavefront can honour are refused rather than ignored.
 void check_megakernel_plan(const RenderPlan& plan) {
@@ -190,6 +194,7 @@ RenderPlan plan_render(const Config& config) {
     throw ConfigError("render: width x height x spp is over 2^40 rays");
   }
   plan.pixel_order = parse_pixel_order(config.text("render.pixel_order"));
+  plan.film_per_thread = config.text("render.film") == "per_thread";
   plan.rules.max_depth = static_cast<std::uint32_t>(config.integer("render.max_depth"));
   plan.rules.russian_roulette_depth = static_cast<std::uint32_t>(config.integer("render.russian_roulette_depth"));
   plan.pipeline.batch_size = static_cast<std::size_t>(config.integer("render.batch_size"));
@@ -226,8 +231,7 @@ RenderPlan plan_render(const Config& config) {
   } else {
     // Without a buffer to fill, rays in flight only keep the workers busy; more would cost
     // memory (and first-touch page faults) for nothing.
-    const int workers = plan.pipeline.threads > 0 ? plan.pipeline.threads : tbb::info::default_concurrency();
-    plan.pipeline.rays_in_flight = 4 * std::size_t(workers) * plan.pipeline.batch_size;
+    plan.pipeline.rays_in_flight = 4 * std::size_t(worker_count(plan.pipeline)) * plan.pipeline.batch_size;
   }
   if (plan.pipeline.mode == PipelineMode::megakernel) check_megakernel_plan(plan);
   return plan;
@@ -292,18 +296,18 @@ std::vector<const Stage*> StageChain::stages() const {
 
 RenderOutput render_image(const RenderPlan& plan, const World& world, const Camera& camera,
                           const std::function<void(const Progress&)>& on_progress) {
-  Film film(plan.image.width, plan.image.height);
+  const int workers = worker_count(plan.pipeline);
+  Film film(plan.image.width, plan.image.height, plan.film_per_thread ? std::uint32_t(workers) : 0);
   GenerateStage generate(camera, plan.image, plan.pixel_order);
   std::optional<MemoryObservation> observation;
   RenderOutput output;
   if (plan.memory.enabled()) {
     if (world.accelerator.probed()) {
-      const int threads = plan.pipeline.threads > 0 ? plan.pipeline.threads : tbb::info::default_concurrency();
       std::vector<std::span<const std::byte>> spans = world.accelerator.memory_spans();
       if (world.proxy != nullptr && plan.needs_proxy()) {
         for (const auto& span : world.proxy->accelerator().memory_spans()) spans.push_back(span);
       }
-      observation.emplace(plan.memory, std::move(spans), threads, plan.memory.file_backing ? world.pager : nullptr);
+      observation.emplace(plan.memory, std::move(spans), workers, plan.memory.file_backing ? world.pager : nullptr);
     } else {
       output.memory_unobserved = fmt::format("accelerator '{}' cannot report its memory reads: no pager or cache counters",
                                              world.accelerator.name());

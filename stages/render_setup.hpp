@@ -34,6 +34,7 @@ struct RenderPlan {
   CameraOverride camera;
   ImageSpec image;
   PixelOrder pixel_order = PixelOrder::scanline;
+  bool film_per_thread = false;  // render.film
   PathRules rules;
   PipelineOptions pipeline;
   AcceleratorOptions accelerator;

@@ -1,6 +1,8 @@
 // Rendering through the pipeline: exact answers where the physics gives one, and
-// bit-identical images across thread counts, batch sizes and pixel orders.
+// bit-identical images across thread counts, batch sizes, pixel orders, films and modes.
+#include <atomic>
 #include <cmath>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -37,13 +39,15 @@ const Scene& default_scene() {
   return scene;
 }
 
-TEST(Render, ImageIsIdenticalForThreadsBatchSizesAndPixelOrders) {
+TEST(Render, ImageIsIdenticalForThreadsBatchSizesPixelOrdersFilmsAndModes) {
   const Rendered reference = render(default_scene(), {"render.threads=1", "render.batch_size=4096"});
   const std::vector<std::vector<std::string>> variants = {
       {"render.threads=2", "render.batch_size=4096"},
       {"render.threads=2", "render.batch_size=64"},
       {"render.threads=1", "render.batch_size=17", "render.pixel_order=zcurve"},
       {"render.threads=2", "render.batch_size=1000", "render.rays_in_flight=2048"},
+      {"render.threads=2", "render.film=per_thread"},
+      {"render.threads=2", "render.film=per_thread", "pipeline.mode=megakernel"},
   };
   double sum = 0.0;
   for (float value : reference.output.image) sum += value;
@@ -53,6 +57,36 @@ TEST(Render, ImageIsIdenticalForThreadsBatchSizesAndPixelOrders) {
     ASSERT_EQ(other.output.image.size(), reference.output.image.size());
     EXPECT_TRUE(other.output.image == reference.output.image) << "differs with " << variant[0] << " " << variant[1];
   }
+}
+
+// Generate runs on several threads at once: every camera ray is claimed exactly once, and a
+// claimed batch holds the rays fill would have made in order.
+TEST(Generate, ClaimsEveryRayOnceFromManyThreads) {
+  const Scene& scene = default_scene();
+  ImageSpec image;
+  image.width = 37;
+  image.height = 11;
+  image.samples_per_pixel = 3;
+  GenerateStage generate(resolve_camera({}, scene), image, PixelOrder::zcurve);
+  std::vector<std::atomic<int>> claimed(generate.total_rays());
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 4; ++t) {
+    threads.emplace_back([&] {
+      RayBatch rays(7);
+      for (GenerateStage::Claim claim = generate.claim(7); claim.count > 0; claim = generate.claim(7)) {
+        generate.fill_range(rays, claim);
+        ASSERT_EQ(rays.count, claim.count);
+        for (std::size_t i = 0; i < claim.count; ++i) {
+          ++claimed[claim.first + i];
+          EXPECT_EQ(rays.sample[i], (claim.first + i) % 3);
+        }
+      }
+    });
+  }
+  for (std::thread& thread : threads) thread.join();
+  EXPECT_TRUE(generate.exhausted());
+  EXPECT_EQ(generate.generated(), generate.total_rays());
+  for (std::size_t i = 0; i < claimed.size(); ++i) ASSERT_EQ(claimed[i].load(), 1) << i;
 }
 
 TEST(Render, ConvexObjectUnderUniformSkyReflectsItsAlbedoExactly) {
