@@ -313,25 +313,26 @@ RenderOutput render_image(const RenderPlan& plan, const World& world, const Came
                                              world.accelerator.name());
     }
   }
-  const StageChain chain(plan, world, film, observation ? &observation->observers() : nullptr);
   if (plan.pipeline.mode == PipelineMode::megakernel) {
-    // The control experiment runs without the trace stage's per-run clocks and counters.
+    // The control experiment runs without the trace stage's per-run clocks and counters
+    // (and plan_render refused [memory] observation for it).
     const TraceStage trace(world.accelerator, world.scene.material_runs);
     const ShadeStage shade(world, film, plan.rules);
     const SpawnStage spawn(world, plan.rules);
     output.run = run_megakernel(generate, trace, shade, &spawn, {plan.pipeline.threads, plan.pipeline.tile_side},
                                 on_progress);
   } else {
+    const StageChain chain(plan, world, film, observation ? &observation->observers() : nullptr);
     Pipeline pipeline(generate, chain.stages(), chain.loops(), plan.pipeline);
     output.run = pipeline.run(on_progress);
+    if (observation) observation->report(output.run.stages);
+    if (chain.zsort() != nullptr) output.sort_seconds = chain.zsort()->sort_seconds();
+    output.closest_mrays_per_s = chain.trace_times().closest_mrays_per_s();
+    output.any_mrays_per_s = chain.trace_times().any_mrays_per_s();
+    output.hit_rates = chain.hit_rates().snapshot();
   }
-  if (observation) observation->report(output.run.stages);
-  if (chain.zsort() != nullptr) output.sort_seconds = chain.zsort()->sort_seconds();
-  output.closest_mrays_per_s = chain.trace_times().closest_mrays_per_s();
-  output.any_mrays_per_s = chain.trace_times().any_mrays_per_s();
   output.image = film.resolve(plan.image.samples_per_pixel);
   output.rejected_contributions = film.rejected_contributions();
-  output.hit_rates = chain.hit_rates().snapshot();
   return output;
 }
 
