@@ -226,6 +226,13 @@ int run_image(const ImageArguments& args) {
   return 0;
 }
 
+// --set KEY=VALUE, repeatable: config overrides applied over each benchmark's defaults.
+void add_set_option(CLI::App* command, std::vector<std::string>& assignments, const std::string& example) {
+  command->add_option("--set", assignments, "config override section.key=value (e.g. " + example + ")")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+}
+
 void add_common_options(CLI::App* command, BenchArguments& args) {
   command->add_option("--scene", args.scene, "mesh file, scene file (.toml) or builtin:NAME[:TRIANGLES]");
   command->add_option("--accel", args.accel,
@@ -233,9 +240,7 @@ void add_common_options(CLI::App* command, BenchArguments& args) {
   command->add_option("--count", args.count, "number of rays");
   command->add_option("--threads", args.threads, "worker threads (0: all cores)");
   command->add_option("--json", args.json, "write results as JSON (and CSV beside it for bench accel)");
-  command->add_option("--set", args.assignments, "config override section.key=value (e.g. scene.subdivide=2)")
-      ->expected(1)
-      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  add_set_option(command, args.assignments, "scene.subdivide=2");
 }
 
 }  // namespace
@@ -275,9 +280,7 @@ void add_bench_command(CLI::App& app, int& exit_code) {
   reorder->add_option("--size", reorder_args->size, "image size as WIDTHxHEIGHT");
   reorder->add_option("--threads", reorder_args->threads, "worker threads (0: all cores)");
   reorder->add_option("--json", reorder_args->json, "write results as JSON");
-  reorder->add_option("--set", reorder_args->assignments, "config override section.key=value (e.g. memory.budget=20%)")
-      ->expected(1)
-      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  add_set_option(reorder, reorder_args->assignments, "memory.budget=20%");
   reorder->callback([reorder_args, &exit_code] { exit_code = run_reorder(*reorder_args); });
 
   auto pipeline_args = std::make_shared<PipelineArguments>();
@@ -292,9 +295,7 @@ void add_bench_command(CLI::App& app, int& exit_code) {
   pipeline->add_option("--size", pipeline_args->size, "image size as WIDTHxHEIGHT");
   pipeline->add_option("--repeat", pipeline_args->repeat, "renders per row, interleaved (the median is reported)");
   pipeline->add_option("--json", pipeline_args->json, "write results as JSON");
-  pipeline->add_option("--set", pipeline_args->assignments, "config override section.key=value (e.g. render.max_depth=8)")
-      ->expected(1)
-      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  add_set_option(pipeline, pipeline_args->assignments, "render.max_depth=8");
   pipeline->callback([pipeline_args, &exit_code] { exit_code = run_pipeline(*pipeline_args); });
 
   auto image_args = std::make_shared<ImageArguments>();
@@ -306,9 +307,7 @@ void add_bench_command(CLI::App& app, int& exit_code) {
   image->add_option("--size", image_args->size, "image size as WIDTHxHEIGHT");
   image->add_option("--threads", image_args->threads, "worker threads (0: all cores)");
   image->add_option("--json", image_args->json, "write results as JSON");
-  image->add_option("--set", image_args->assignments, "config override section.key=value (e.g. render.max_depth=2)")
-      ->expected(1)
-      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  add_set_option(image, image_args->assignments, "render.max_depth=2");
   image->callback([image_args, &exit_code] { exit_code = run_image(*image_args); });
 }
 

@@ -36,14 +36,15 @@ PipelineRun run_megakernel(const GenerateStage& generate, const TraceStage& trac
   const RayRange one{0, 1};
 
   tbb::enumerable_thread_specific<PathScratch> scratch;
-  std::atomic<std::uint64_t> camera_rays_done{0};
+  std::atomic<std::uint64_t> camera_rays_done{0}, rays_traced{0};  // for progress reports
   const Clock::time_point start = Clock::now();
   std::optional<ProgressReporter> reporter;
   reporter.emplace(
       on_progress,
       [&] {
         const std::uint64_t done = camera_rays_done.load(std::memory_order_relaxed);
-        return Progress{done, total, 0, std::chrono::duration<double>(Clock::now() - start).count()};
+        return Progress{done, total, rays_traced.load(std::memory_order_relaxed),
+                        std::chrono::duration<double>(Clock::now() - start).count()};
       },
       interval);
 
@@ -51,6 +52,7 @@ PipelineRun run_megakernel(const GenerateStage& generate, const TraceStage& trac
     tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, tiles_x * tiles_y, 1), [&](const auto& tiles) {
       const Clock::time_point busy_since = Clock::now();
       PathScratch& s = scratch.local();
+      const std::uint64_t traced_before = s.rays_traced;
       std::uint64_t paths = 0;
       for (std::uint32_t tile = tiles.begin(); tile != tiles.end(); ++tile) {
         const std::uint32_t x0 = tile % tiles_x * side, y0 = tile / tiles_x * side;
@@ -82,6 +84,7 @@ PipelineRun run_megakernel(const GenerateStage& generate, const TraceStage& trac
         }
       }
       camera_rays_done.fetch_add(paths, std::memory_order_relaxed);
+      rays_traced.fetch_add(s.rays_traced - traced_before, std::memory_order_relaxed);
       s.nanoseconds += static_cast<std::uint64_t>(
           std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - busy_since).count());
     });
