@@ -105,6 +105,8 @@ struct BadInput {
   std::string arguments;
   std::string message;
 };
+// ctest shows each case's arguments rather than the struct's bytes.
+void PrintTo(const BadInput& input, std::ostream* out) { *out << input.arguments; }
 
 class CliBadInput : public ::testing::TestWithParam<BadInput> {};
 

@@ -10,6 +10,11 @@
 #include "scene/builtin_scenes.hpp"
 
 namespace wavetrace {
+
+// ctest names the parameters rather than printing their bytes (found by ADL in wavetrace).
+void PrintTo(EmbreeMode mode, std::ostream* out) { *out << to_string(mode); }
+void PrintTo(EmbreeQueries queries, std::ostream* out) { *out << to_string(queries); }
+
 namespace {
 
 // Two triangles forming the unit square [0,1]^2 at z = 0.

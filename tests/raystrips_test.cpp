@@ -23,6 +23,10 @@
 #include "accel_agreement.hpp"
 
 namespace wavetrace {
+
+// ctest names the stripifier rather than printing its bytes (found by ADL in wavetrace).
+void PrintTo(StripifierKind kind, std::ostream* out) { *out << to_string(kind); }
+
 namespace {
 
 using namespace ray_strip;

@@ -145,6 +145,8 @@ struct BadScene {
   std::string body;
   std::string message;
 };
+// ctest shows the message each case expects rather than the struct's bytes.
+void PrintTo(const BadScene& scene, std::ostream* out) { *out << scene.message; }
 
 class SceneFileErrors : public ::testing::TestWithParam<BadScene> {};
 
