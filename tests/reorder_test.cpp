@@ -12,6 +12,7 @@
 #include "accel/proxy/proxy.hpp"
 #include "accel/proxy/stochastic_simplify.hpp"
 #include "accel/registry.hpp"
+#include "bench/reorder_bench.hpp"
 #include "kernels/radix_sort.hpp"
 #include "kernels/random.hpp"
 #include "kernels/space_filling_curve.hpp"
@@ -178,6 +179,94 @@ TEST(ZSort, EmitsEveryRayOnceInKeyOrderWithShadowRaysLast) {
     }
   }
   EXPECT_EQ(pixels.size(), 250u);
+}
+
+// Every heuristic changes the order zsort emits rays in (none keeps their arrival order),
+// and emits them in non-decreasing key order: the image tests above cannot tell a sort that
+// does nothing from one that works.
+TEST(ZSort, EveryHeuristicReordersWhatNoneKeepsInArrivalOrder) {
+  Bounds3 box;
+  box.extend(glm::vec3(-1.0f));
+  box.extend(glm::vec3(1.0f));
+  constexpr std::uint32_t kRays = 400;
+  const auto arrivals = [&](BatchPool& pool) {
+    std::vector<Batch*> batches;
+    for (std::uint32_t pixel = 0; pixel < kRays; ++pixel) {
+      if (pixel % 100 == 0) batches.push_back(pool.acquire());
+      RayBatch& rays = batches.back()->rays;
+      rays.enable_approx_hit();
+      const std::size_t i = rays.count++;
+      const UnitPair xy = unit_pair(random_bits(pixel, 0, 0, RandomPurpose::benchmark));
+      const UnitPair zd = unit_pair(random_bits(pixel, 0, 1, RandomPurpose::benchmark));
+      const UnitPair hit = unit_pair(random_bits(pixel, 0, 2, RandomPurpose::benchmark));
+      const glm::vec3 direction = glm::normalize(glm::vec3(zd.second - 0.5f, xy.first - 0.5f, 0.3f));
+      rays.set_geometry(i, glm::vec3(xy.first, xy.second, zd.first) * 2.0f - 1.0f, direction, 0.0f, 10.0f);
+      rays.approx_hit_x[i] = hit.first * 2 - 1;
+      rays.approx_hit_y[i] = hit.second * 2 - 1;
+      rays.approx_hit_z[i] = zd.second * 2 - 1;
+      rays.pixel[i] = pixel;
+      rays.kind[i] = RayKind::bounce;
+      rays.flags[i] = ray_flags::alive;
+    }
+    return batches;
+  };
+  std::map<std::string, std::vector<std::uint32_t>> orders;
+  for (ReorderHeuristic heuristic : {ReorderHeuristic::none, ReorderHeuristic::origin, ReorderHeuristic::origin_dir,
+                                    ReorderHeuristic::hph, ReorderHeuristic::hph_origin, ReorderHeuristic::hph_dir}) {
+    for (CurveKind curve : {CurveKind::morton, CurveKind::hilbert}) {
+      BatchPool pool(128);
+      ZSortOptions options;
+      options.heuristic = heuristic;
+      options.curve = curve;
+      options.buffer_rays = 100000;
+      const ZSortStage zsort(options, box);
+      for (Batch* batch : arrivals(pool)) zsort.buffer(batch);
+      CollectingOutput out(pool);
+      ASSERT_EQ(zsort.flush(out), kRays);
+      std::vector<std::uint32_t>& order = orders[to_string(heuristic) + "/" + to_string(curve)];
+      std::uint64_t previous = 0;
+      for (const Batch* batch : out.emitted) {
+        for (std::size_t i = 0; i < batch->rays.count; ++i) {
+          order.push_back(batch->rays.pixel[i]);
+          if (heuristic == ReorderHeuristic::none) continue;
+          EXPECT_GE(batch->rays.sort_key[i], previous) << to_string(heuristic);
+          previous = batch->rays.sort_key[i];
+        }
+      }
+      ASSERT_EQ(order.size(), kRays);
+    }
+  }
+  std::vector<std::uint32_t> arrival(kRays);
+  for (std::uint32_t i = 0; i < kRays; ++i) arrival[i] = i;
+  for (const auto& [name, order] : orders) {
+    if (name.starts_with("none/")) {
+      EXPECT_EQ(order, arrival) << name;
+    } else {
+      EXPECT_NE(order, arrival) << name;
+      EXPECT_NE(order, orders.at(name.starts_with("hph") ? "origin/morton" : "hph/morton")) << name;
+    }
+  }
+  // The two curves order the same keys' cells differently.
+  EXPECT_NE(orders.at("hph/morton"), orders.at("hph/hilbert"));
+}
+
+// At a fixed budget on a fixed scene, hph cuts the simulated page faults of trace against
+// none by a clear margin (1.86x when this test was written), single-threaded, so exact.
+TEST(Reordering, HitPointHeuristicCutsPageFaultsAgainstNone) {
+  Config config;
+  for (const char* setting : {"scene.source=builtin:room:100k", "accel.type=bvh", "render.width=64", "render.height=48",
+                              "render.spp=2", "render.threads=1", "memory.budget=10%", "memory.page_bytes=4096",
+                              "proxy.accel=bvh"}) {
+    config.set(setting);
+  }
+  const ReorderBenchReport report = run_reorder_bench(config, {ReorderHeuristic::none, ReorderHeuristic::hph});
+  ASSERT_EQ(report.results.size(), 2u);
+  const auto& none = report.results[0];
+  const auto& hph = report.results[1];
+  ASSERT_TRUE(none.page_faults.has_value() && hph.page_faults.has_value());
+  EXPECT_GT(*none.page_faults, 0u);
+  EXPECT_LT(double(*hph.page_faults), 0.75 * double(*none.page_faults));
+  EXPECT_TRUE(hph.image_identical);
 }
 
 struct Rendered {
