@@ -250,6 +250,40 @@ TEST(ZSort, EveryHeuristicReordersWhatNoneKeepsInArrivalOrder) {
   EXPECT_NE(orders.at("hph/morton"), orders.at("hph/hilbert"));
 }
 
+// A ray's key is its curve's index of the cell its point falls in (origin for `origin`,
+// approximate hit for `hph`, 20 bits per axis), with bit 63 set for shadow rays.
+TEST(ReorderKeys, AreTheCurveIndexOfTheQuantizedPoint) {
+  Bounds3 box;
+  box.extend(glm::vec3(-1.0f));
+  box.extend(glm::vec3(1.0f));
+  const std::vector<std::array<std::uint32_t, 3>> cells = {{3, 1000, 77}, {524287, 0, 1048575}, {1048575, 1, 65536}};
+  RayBatch rays(4);
+  rays.enable_approx_hit();
+  rays.enable_sort_key();
+  for (std::size_t i = 0; i < cells.size(); ++i) {
+    glm::vec3 point;  // the cell's centre: exact in float at 20 bits over [-1, 1]
+    for (int axis = 0; axis < 3; ++axis) point[axis] = -1.0f + (float(cells[i][axis]) + 0.5f) * (2.0f / 1048576.0f);
+    rays.set_geometry(i, point, glm::vec3(0, 0, 1), 0.0f, 1.0f);
+    rays.approx_hit_x[i] = point.x;
+    rays.approx_hit_y[i] = point.y;
+    rays.approx_hit_z[i] = point.z;
+    rays.kind[i] = i == 2 ? RayKind::shadow : RayKind::bounce;
+    rays.flags[i] = ray_flags::alive;
+  }
+  rays.count = cells.size();
+  for (ReorderHeuristic heuristic : {ReorderHeuristic::origin, ReorderHeuristic::hph}) {
+    for (CurveKind curve : {CurveKind::morton, CurveKind::hilbert}) {
+      compute_sort_keys(rays, heuristic, curve, box);
+      for (std::size_t i = 0; i < cells.size(); ++i) {
+        const std::uint64_t index =
+            curve == CurveKind::morton ? morton_key<3, 20>(cells[i]) : hilbert_key<3, 20>(cells[i]);
+        const std::uint64_t shadow = rays.kind[i] == RayKind::shadow ? std::uint64_t{1} << 63 : 0;
+        EXPECT_EQ(rays.sort_key[i], index | shadow) << to_string(heuristic) << " " << to_string(curve) << " " << i;
+      }
+    }
+  }
+}
+
 // At a fixed budget on a fixed scene, hph cuts the simulated page faults of trace against
 // none by a clear margin (1.86x when this test was written), single-threaded, so exact.
 TEST(Reordering, HitPointHeuristicCutsPageFaultsAgainstNone) {
