@@ -2,6 +2,7 @@
 // bit-identical images across thread counts, batch sizes, pixel orders, films and modes.
 #include <atomic>
 #include <cmath>
+#include <stdexcept>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -87,6 +88,39 @@ TEST(Generate, ClaimsEveryRayOnceFromManyThreads) {
   EXPECT_TRUE(generate.exhausted());
   EXPECT_EQ(generate.generated(), generate.total_rays());
   for (std::size_t i = 0; i < claimed.size(); ++i) ASSERT_EQ(claimed[i].load(), 1) << i;
+}
+
+// An error inside a stage while progress is being reported reaches the caller as that
+// error (the reporting thread is stopped and joined on the way out, not left to terminate).
+TEST(Render, AStageErrorDuringProgressReportsReachesTheCaller) {
+  class FailingStage final : public Stage {
+   public:
+    std::string name() const override { return "failing"; }
+    void process(Batch* batch, StageOutput& out) const override {
+      if (seen_.fetch_add(1) == 3) throw std::runtime_error("the fourth batch fails");
+      out.release(batch);
+    }
+
+   private:
+    mutable std::atomic<int> seen_{0};
+  };
+  const Scene& scene = default_scene();
+  ImageSpec image;
+  image.width = 64;
+  image.height = 64;
+  image.samples_per_pixel = 4;
+  GenerateStage generate(resolve_camera({}, scene), image, PixelOrder::scanline);
+  const FailingStage failing;
+  PipelineOptions options;
+  options.batch_size = 256;
+  options.threads = 2;
+  Pipeline pipeline(generate, {&failing}, false, options);
+  try {
+    pipeline.run([](const Progress&) {}, std::chrono::milliseconds(1));
+    FAIL() << "no error";
+  } catch (const std::runtime_error& error) {
+    EXPECT_STREQ(error.what(), "the fourth batch fails");
+  }
 }
 
 TEST(Render, ConvexObjectUnderUniformSkyReflectsItsAlbedoExactly) {
