@@ -139,7 +139,9 @@ INSTANTIATE_TEST_SUITE_P(
                       // Refused from its size before anything is allocated: no out-of-memory kill.
                       BadInput{"render builtin:room:4G --accel embree", "GB of memory is available"},
                       BadInput{"render builtin:room:4G --accel hmq --set build.chunk_triangles=1073741824",
-                               "GB of memory is available"}),
+                               "GB of memory is available"},
+                      // Subdivision's output is sized before OpenMesh allocates it.
+                      BadInput{"render builtin:sphere:200k --set scene.subdivide=6", "OpenMesh's 32-bit handles"}),
     [](const ::testing::TestParamInfo<BadInput>& info) { return "case" + std::to_string(info.index); });
 
 TEST(Cli, InfoReportsTopology) {
