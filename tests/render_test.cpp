@@ -63,12 +63,8 @@ TEST(Render, ImageIsIdenticalForThreadsBatchSizesPixelOrdersFilmsAndModes) {
 // Generate runs on several threads at once: every camera ray is claimed exactly once, and a
 // claimed batch holds the rays fill would have made in order.
 TEST(Generate, ClaimsEveryRayOnceFromManyThreads) {
-  const Scene& scene = default_scene();
-  ImageSpec image;
-  image.width = 37;
-  image.height = 11;
-  image.samples_per_pixel = 3;
-  GenerateStage generate(resolve_camera({}, scene), image, PixelOrder::zcurve);
+  const ImageSpec image{.width = 37, .height = 11, .samples_per_pixel = 3};
+  GenerateStage generate(resolve_camera({}, default_scene()), image, PixelOrder::zcurve);
   std::vector<std::atomic<int>> claimed(generate.total_rays());
   std::vector<std::thread> threads;
   for (int t = 0; t < 4; ++t) {
@@ -104,12 +100,8 @@ TEST(Render, AStageErrorDuringProgressReportsReachesTheCaller) {
    private:
     mutable std::atomic<int> seen_{0};
   };
-  const Scene& scene = default_scene();
-  ImageSpec image;
-  image.width = 64;
-  image.height = 64;
-  image.samples_per_pixel = 4;
-  GenerateStage generate(resolve_camera({}, scene), image, PixelOrder::scanline);
+  const ImageSpec image{.width = 64, .height = 64, .samples_per_pixel = 4};
+  GenerateStage generate(resolve_camera({}, default_scene()), image, PixelOrder::scanline);
   const FailingStage failing;
   PipelineOptions options;
   options.batch_size = 256;
