@@ -1,6 +1,7 @@
 // The builtin scenes, composed from the procedural shapes.
 #include "scene/builtin_scenes.hpp"
 
+#include <algorithm>
 #include <charconv>
 
 #include <fmt/format.h>
@@ -137,22 +138,50 @@ std::optional<std::size_t> requested_triangle_count(std::string_view source) {
   return parse_triangle_count(spec.substr(colon + 1), source);
 }
 
-Scene make_builtin_scene(std::string_view source, bool streamed) {
+namespace {
+
+// Each builtin's triangles when no count is given, and the fewest its structure can make.
+struct BuiltinCount {
+  std::string_view name;
+  std::size_t fallback, least;
+};
+constexpr BuiltinCount kBuiltinCounts[] = {{"sphere", 1000000, 0}, {"soup", 1000000, 0},    {"terrain", 1000000, 0},
+                                           {"stadium", 1000000, 32}, {"fur", 1000000, 200}, {"default", 200000, 0},
+                                           {"room", 1000000, 2000}};
+
+std::string_view builtin_name(std::string_view source) {
   const std::string_view spec = source.substr(kPrefix.size());
-  const std::string_view name = spec.substr(0, spec.find(':'));
+  return spec.substr(0, spec.find(':'));
+}
+
+}  // namespace
+
+std::optional<std::size_t> builtin_triangle_count(std::string_view source) {
+  const std::string_view name = builtin_name(source);
+  for (const BuiltinCount& count : kBuiltinCounts) {
+    if (count.name == name) return std::max(requested_triangle_count(source).value_or(count.fallback), count.least);
+  }
+  return std::nullopt;
+}
+
+Scene make_builtin_scene(std::string_view source, bool streamed) {
+  const std::string_view name = builtin_name(source);
   const std::string label(source);
-  const std::optional<std::size_t> requested = requested_triangle_count(source);
-  const auto count_or = [&](std::size_t fallback) { return requested.value_or(fallback); };
+  // The requested count or the builtin's default; each structure's floor is applied below.
+  const BuiltinCount* const counted = std::find_if(std::begin(kBuiltinCounts), std::end(kBuiltinCounts),
+                                                 [&](const BuiltinCount& count) { return count.name == name; });
+  const std::size_t count =
+      counted == std::end(kBuiltinCounts) ? 0 : requested_triangle_count(source).value_or(counted->fallback);
   if (name == "sphere") {
-    return single_object(label, displaced_sphere_shape(count_or(1000000), glm::vec3(0.0f), 1.0f, kSeed),
+    return single_object(label, displaced_sphere_shape(count, glm::vec3(0.0f), 1.0f, kSeed),
                          Material{glm::vec3(0.7f)}, streamed);
   }
-  if (name == "soup") return single_object(label, soup_shape(count_or(1000000), kSeed), Material{glm::vec3(0.7f)}, streamed);
+  if (name == "soup") return single_object(label, soup_shape(count, kSeed), Material{glm::vec3(0.7f)}, streamed);
   if (name == "terrain") {
-    return single_object(label, terrain_shape(count_or(1000000), 4.0f, 0.6f, kSeed), Material{glm::vec3(0.6f)}, streamed);
+    return single_object(label, terrain_shape(count, 4.0f, 0.6f, kSeed), Material{glm::vec3(0.6f)}, streamed);
   }
   if (name == "stadium") {
-    const std::size_t total = std::max<std::size_t>(count_or(1000000), 32);
+    const std::size_t total = std::max<std::size_t>(count, 32);
     ObjectList objects;
     objects.add(displaced_sphere_shape(total - 12, glm::vec3(0.0f), 1.0f, kSeed), objects.add_material(Material{glm::vec3(0.7f)}));
     objects.add(inward_box_shape(glm::vec3(-500.0f), glm::vec3(500.0f)), objects.add_material(Material{glm::vec3(0.5f)}));
@@ -161,7 +190,7 @@ Scene make_builtin_scene(std::string_view source, bool streamed) {
     return scene;
   }
   if (name == "fur") {
-    const std::size_t total = std::max<std::size_t>(count_or(1000000), 200);
+    const std::size_t total = std::max<std::size_t>(count, 200);
     ObjectList objects;
     objects.add(displaced_sphere_shape(total / 10, glm::vec3(0.0f), 0.8f, kSeed), objects.add_material(Material{glm::vec3(0.6f)}));
     objects.add(strands_shape(total - objects.triangle_count(), 0.8f, 0.35f, 0.004f, kSeed),
@@ -170,7 +199,7 @@ Scene make_builtin_scene(std::string_view source, bool streamed) {
   }
   if (name == "default") {
     ObjectList objects;
-    objects.add(displaced_sphere_shape(count_or(200000), glm::vec3(0.0f, 1.15f, 0.0f), 1.0f, kSeed),
+    objects.add(displaced_sphere_shape(count, glm::vec3(0.0f, 1.15f, 0.0f), 1.0f, kSeed),
                 objects.add_material(Material{glm::vec3(0.80f, 0.45f, 0.25f)}));
     objects.add(quad_shape(glm::vec3(-10.0f, 0.0f, 10.0f), glm::vec3(20.0f, 0.0f, 0.0f), glm::vec3(0.0f, 0.0f, -20.0f)),
                 objects.add_material(Material{glm::vec3(0.65f)}));
@@ -180,7 +209,7 @@ Scene make_builtin_scene(std::string_view source, bool streamed) {
     scene.camera = Camera{glm::vec3(0.0f, 2.4f, 5.8f), glm::vec3(0.0f, 1.0f, 0.0f), glm::vec3(0.0f, 1.0f, 0.0f), 40.0f};
     return scene;
   }
-  if (name == "room") return make_room(label, std::max<std::size_t>(count_or(1000000), 2000), streamed);
+  if (name == "room") return make_room(label, std::max<std::size_t>(count, 2000), streamed);
   std::string known;
   for (const std::string& builtin : builtin_scene_names()) known += (known.empty() ? "" : ", ") + builtin;
   throw SceneError(fmt::format("{}: unknown builtin scene '{}' (known: {})", label, name, known));

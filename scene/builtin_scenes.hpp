@@ -31,6 +31,11 @@ Scene make_builtin_scene(std::string_view source, bool streamed = false);
 // names no count; throws SceneError for a malformed count.
 std::optional<std::size_t> requested_triangle_count(std::string_view source);
 
+// About the triangles make_builtin_scene makes for `source` (the requested count, or the
+// builtin's default, raised to what its structure needs), known before anything is built;
+// none for an unknown builtin. Throws SceneError for a malformed count.
+std::optional<std::size_t> builtin_triangle_count(std::string_view source);
+
 // Parses a count such as "8M", "250k" or "1000"; throws SceneError naming `what`.
 std::size_t parse_triangle_count(std::string_view text, std::string_view what);
 

@@ -11,36 +11,18 @@
 #include <limits>
 #include <memory>
 #include <mutex>
-#include <sstream>
 #include <unordered_map>
 
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
 
+#include "scene/ply_header.hpp"
+
 namespace wavetrace {
 
-enum class PlyType { int8, uint8, int16, uint16, int32, uint32, float32, float64 };
-
-struct PlyProperty {
-  std::string name;
-  PlyType type = PlyType::float32;
-  bool list = false;
-  PlyType count_type = PlyType::uint8;
-};
-
-struct PlyElement {
-  std::string name;
-  std::size_t count = 0;
-  std::vector<PlyProperty> properties;
-  bool fixed_size() const {
-    return std::none_of(properties.begin(), properties.end(), [](const PlyProperty& p) { return p.list; });
-  }
-};
-
 struct PlyTriangleSource::Layout {
+  PlyHeader header;
   bool little_endian = true;
-  std::vector<PlyElement> elements;
-  std::size_t vertex_element = 0, face_element = 0;
   std::uint64_t vertex_offset = 0, face_offset = 0;  // file offsets of the first records
 };
 
@@ -49,34 +31,6 @@ namespace {
 // Faces are read in chunks of this many bytes.
 constexpr std::size_t kReadBuffer = std::size_t{1} << 20;
 
-std::size_t type_bytes(PlyType type) {
-  switch (type) {
-    case PlyType::int8: case PlyType::uint8: return 1;
-    case PlyType::int16: case PlyType::uint16: return 2;
-    case PlyType::int32: case PlyType::uint32: case PlyType::float32: return 4;
-    case PlyType::float64: return 8;
-  }
-  return 0;
-}
-
-bool parse_type(const std::string& name, PlyType& type) {
-  static const std::unordered_map<std::string, PlyType> types = {
-      {"char", PlyType::int8},     {"int8", PlyType::int8},       {"uchar", PlyType::uint8},    {"uint8", PlyType::uint8},
-      {"short", PlyType::int16},   {"int16", PlyType::int16},     {"ushort", PlyType::uint16},  {"uint16", PlyType::uint16},
-      {"int", PlyType::int32},     {"int32", PlyType::int32},     {"uint", PlyType::uint32},    {"uint32", PlyType::uint32},
-      {"float", PlyType::float32}, {"float32", PlyType::float32}, {"double", PlyType::float64}, {"float64", PlyType::float64}};
-  const auto found = types.find(name);
-  if (found == types.end()) return false;
-  type = found->second;
-  return true;
-}
-
-std::size_t record_bytes(const PlyElement& element) {
-  std::size_t bytes = 0;
-  for (const PlyProperty& property : element.properties) bytes += type_bytes(property.type);
-  return bytes;
-}
-
 // Sequential reads of one file through a buffer, with the file's byte order.
 class RecordReader {
  public:
@@ -84,7 +38,9 @@ class RecordReader {
       : path_(path), file_(std::fopen(path.c_str(), "rb")), swap_(little_endian != (std::endian::native == std::endian::little)) {
     if (file_ == nullptr) throw SceneError(fmt::format("{}: cannot open the file", path));
     if (std::fseek(file_, static_cast<long>(offset), SEEK_SET) != 0) throw SceneError(fmt::format("{}: cannot seek", path));
-    buffer_.resize(kReadBuffer);
+    std::error_code status;
+    const std::uintmax_t size = std::filesystem::file_size(path, status);
+    buffer_.resize(status || size <= offset ? 1 : std::min<std::uintmax_t>(kReadBuffer, size - offset));
   }
   ~RecordReader() { std::fclose(file_); }
   RecordReader(const RecordReader&) = delete;
@@ -115,7 +71,7 @@ class RecordReader {
   // One scalar of `type`, as a double (exact for every PLY type).
   double read_scalar(PlyType type) {
     std::byte raw[8];
-    const std::size_t bytes = type_bytes(type);
+    const std::size_t bytes = ply_type_bytes(type);
     read_bytes(raw, bytes);
     if (swap_) std::reverse(raw, raw + bytes);
     switch (type) {
@@ -151,106 +107,25 @@ class RecordReader {
   std::uint64_t consumed_ = 0;
 };
 
-std::shared_ptr<PlyTriangleSource::Layout> read_header(const std::string& path) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) throw SceneError(fmt::format("{}: no such mesh file", path));
+std::shared_ptr<PlyTriangleSource::Layout> read_layout(const std::string& path) {
   auto layout = std::make_shared<PlyTriangleSource::Layout>();
-  std::string line;
-  std::size_t number = 0;
-  bool format_seen = false;
-  const auto fail = [&](const std::string& problem) {
-    throw SceneError(fmt::format("{}: PLY header line {}: {}", path, number, problem));
-  };
-  while (true) {
-    if (!std::getline(file, line)) fail("the header has no end_header");
-    ++number;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    std::istringstream words(line);
-    std::string keyword;
-    words >> keyword;
-    if (number == 1) {
-      if (keyword != "ply") fail("not a PLY file (it must start with 'ply')");
-      continue;
-    }
-    if (keyword == "end_header") break;
-    if (keyword == "comment" || keyword == "obj_info" || keyword.empty()) continue;
-    if (keyword == "format") {
-      std::string format, version;
-      words >> format >> version;
-      if (format == "binary_little_endian") layout->little_endian = true;
-      else if (format == "binary_big_endian") layout->little_endian = false;
-      else fail(fmt::format("format '{}' is not binary", format));
-      format_seen = true;
-    } else if (keyword == "element") {
-      PlyElement element;
-      long long count = -1;
-      words >> element.name >> count;
-      if (!words || count < 0) fail("an element needs a name and a count of 0 or more");
-      element.count = static_cast<std::size_t>(count);
-      layout->elements.push_back(element);
-    } else if (keyword == "property") {
-      if (layout->elements.empty()) fail("a property before any element");
-      PlyProperty property;
-      std::string type;
-      words >> type;
-      if (type == "list") {
-        std::string count_type, item_type;
-        words >> count_type >> item_type >> property.name;
-        property.list = true;
-        if (!parse_type(count_type, property.count_type) || !parse_type(item_type, property.type)) {
-          fail(fmt::format("unknown list types '{} {}'", count_type, item_type));
-        }
-      } else {
-        words >> property.name;
-        if (!parse_type(type, property.type)) fail(fmt::format("unknown property type '{}'", type));
-      }
-      if (property.name.empty()) fail("a property without a name");
-      layout->elements.back().properties.push_back(property);
-    } else {
-      fail(fmt::format("unknown keyword '{}'", keyword));
-    }
+  layout->header = read_ply_header(path);
+  const PlyHeader& header = layout->header;
+  if (header.format == PlyFormat::ascii) throw SceneError(fmt::format("{}: an ASCII PLY file, not binary", path));
+  layout->little_endian = header.format == PlyFormat::binary_little_endian;
+  if (header.face_element < header.vertex_element) {
+    throw SceneError(fmt::format("{}: binary PLY faces before vertices are not supported", path));
   }
-  if (!format_seen) throw SceneError(fmt::format("{}: PLY header without a format line", path));
-  const auto find = [&](const char* name) {
-    for (std::size_t e = 0; e < layout->elements.size(); ++e) {
-      if (layout->elements[e].name == name) return e;
-    }
-    throw SceneError(fmt::format("{}: PLY file without a '{}' element", path, name));
-  };
-  layout->vertex_element = find("vertex");
-  layout->face_element = find("face");
-  if (layout->face_element < layout->vertex_element) {
-    throw SceneError(fmt::format("{}: PLY faces before vertices are not supported", path));
-  }
-  std::uint64_t offset = static_cast<std::uint64_t>(file.tellg());
-  for (std::size_t e = 0; e < layout->face_element; ++e) {
-    const PlyElement& element = layout->elements[e];
+  std::uint64_t offset = header.body_offset;
+  for (std::size_t e = 0; e < header.face_element; ++e) {
+    const PlyElement& element = header.elements[e];
     if (!element.fixed_size()) {
       throw SceneError(fmt::format("{}: PLY element '{}' before the faces has list properties", path, element.name));
     }
-    if (e == layout->vertex_element) layout->vertex_offset = offset;
-    offset += std::uint64_t(element.count) * record_bytes(element);
+    if (e == header.vertex_element) layout->vertex_offset = offset;
+    offset += element.count * element.record_bytes();
   }
   layout->face_offset = offset;
-  const PlyElement& vertex = layout->elements[layout->vertex_element];
-  for (const char* axis : {"x", "y", "z"}) {
-    if (std::none_of(vertex.properties.begin(), vertex.properties.end(), [&](const PlyProperty& p) { return p.name == axis; })) {
-      throw SceneError(fmt::format("{}: PLY vertices have no '{}' property", path, axis));
-    }
-  }
-  const PlyElement& face = layout->elements[layout->face_element];
-  const auto lists = std::count_if(face.properties.begin(), face.properties.end(), [](const PlyProperty& p) {
-    return p.list && (p.name == "vertex_indices" || p.name == "vertex_index");
-  });
-  if (lists != 1) throw SceneError(fmt::format("{}: PLY faces need one 'vertex_indices' list", path));
-  for (const PlyProperty& property : face.properties) {
-    if (property.list && property.name != "vertex_indices" && property.name != "vertex_index") {
-      throw SceneError(fmt::format("{}: PLY face list '{}' is not supported", path, property.name));
-    }
-    if (property.list && (property.type == PlyType::float32 || property.type == PlyType::float64)) {
-      throw SceneError(fmt::format("{}: PLY vertex indices must be integers", path));
-    }
-  }
   return layout;
 }
 
@@ -266,7 +141,7 @@ class FaceReader {
  public:
   FaceReader(const std::string& path, const PlyTriangleSource::Layout& layout, const std::vector<glm::vec3>& positions)
       : path_(path),
-        face_(layout.elements[layout.face_element]),
+        face_(layout.header.elements[layout.header.face_element]),
         reader_(path, layout.face_offset, layout.little_endian),
         positions_(positions) {}
 
@@ -279,10 +154,13 @@ class FaceReader {
     corners_.clear();
     for (const PlyProperty& property : face_.properties) {
       if (!property.list) {
-        reader_.skip(type_bytes(property.type));
+        reader_.skip(ply_type_bytes(property.type));
         continue;
       }
       const double count = reader_.read_scalar(property.count_type);
+      if (count < 3) {
+        throw SceneError(fmt::format("{}: face {} has {} corners (at least 3 needed)", path_, faces_read_, count));
+      }
       for (double k = 0; k < count; ++k) {
         const double index = reader_.read_scalar(property.type);
         if (!(index >= 0.0 && index < double(positions_.size()))) {
@@ -323,12 +201,12 @@ bool is_binary_ply(const std::string& path) {
   return (first == "ply" || first == "ply\r") && second.starts_with("format binary_");
 }
 
-PlyTriangleSource::PlyTriangleSource(const std::string& path) : path_(path), layout_(read_header(path)) {
-  const PlyElement& vertex = layout_->elements[layout_->vertex_element];
+PlyTriangleSource::PlyTriangleSource(const std::string& path) : path_(path), layout_(read_layout(path)) {
+  const PlyElement& vertex = layout_->header.elements[layout_->header.vertex_element];
   if (vertex.count > std::numeric_limits<std::uint32_t>::max()) {
     throw SceneError(fmt::format("{}: {} vertices, beyond 32-bit indices", path, vertex.count));
   }
-  const std::uint64_t needed = layout_->face_offset + layout_->elements[layout_->face_element].count;
+  const std::uint64_t needed = layout_->face_offset + layout_->header.elements[layout_->header.face_element].count;
   if (std::filesystem::file_size(path) < needed) {
     throw SceneError(fmt::format("{}: truncated ({} bytes, its header promises at least {})", path,
                                  std::filesystem::file_size(path), needed));

@@ -1,25 +1,12 @@
 // Binary PLY without an in-memory polygon mesh: a streaming reader (a TriangleSource: the
 // vertex positions are held, 12 bytes each, and faces are read a range at a time as a
 // chunked build asks for them) and a writer that exports any scene a piece at a time.
-// ASCII PLY stays with OpenMesh (mesh_io.hpp). No PLY library is packaged for Debian 12, so
-// this reader is ours; it reads what the format allows of meshes:
+// ASCII PLY is read whole (mesh_io.hpp). No PLY library is packaged for Debian 12, so this
+// reader is ours; it reads the header of ply_header.hpp in binary_little_endian or
+// binary_big_endian form, with the vertices before the faces and only elements of
+// fixed-size scalar records before the faces (others after them are never read).
 //
-//   ply
-//   format binary_little_endian 1.0          (or binary_big_endian)
-//   comment ...                              (any, also obj_info)
-//   element vertex N
-//   property float x                         (float or double; x, y, z in any position)
-//   property float y                         (other scalar properties are skipped)
-//   property float z
-//   element face M
-//   property list uchar int vertex_indices   (count: uchar/ushort/uint; index: int/uint,
-//                                             also named vertex_index; other scalar
-//                                             face properties are skipped)
-//   end_header
-//   N vertex records, then M face records, as declared; other elements of fixed-size
-//   scalar records may come before or after and are skipped.
-//
-// Written files use exactly the form above with float coordinates and uchar/uint lists,
+// Written files use that form, binary_little_endian, with float coordinates and uchar/uint lists,
 // little-endian. Polygons are fanned into triangles (v0, vk, vk+1); triangles with a
 // repeated corner or zero area are dropped and counted, as validate_and_clean does.
 #pragma once

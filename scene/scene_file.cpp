@@ -1,6 +1,7 @@
 // Scene file reading (toml++): each object is loaded, transformed and appended in file order.
 #include "scene/scene_file.hpp"
 
+#include <cmath>
 #include <filesystem>
 #include <set>
 
@@ -8,6 +9,7 @@
 #include <glm/geometric.hpp>
 #include <toml++/toml.h>
 
+#include "memory/process_memory.hpp"
 #include "scene/builtin_scenes.hpp"
 #include "scene/mesh_io.hpp"
 #include "scene/object_transform.hpp"
@@ -126,7 +128,35 @@ ObjectGeometry load_object_geometry(const std::string& source, const std::filesy
   }
 }
 
-void add_object(SceneAssembly& assembly, const TableReader& object, const std::filesystem::path& directory) {
+// The triangles the objects may still make: each is charged before it is built.
+class TriangleBudget {
+ public:
+  explicit TriangleBudget(const SceneFileLimits& limits) {
+    constexpr double kBytesPerTriangle = 100.0;
+    const std::size_t available = available_memory_bytes();
+    left_ = limits.max_triangles > 0 ? double(limits.max_triangles)
+            : available > 0         ? double(available) / kBytesPerTriangle
+                                    : 1e300;
+    total_ = left_;
+  }
+  // `triangles` of `what` (before `levels` of subdivision) fit, or SceneError.
+  void charge(std::size_t triangles, int levels, const std::string& what) {
+    const double made = double(triangles) * std::pow(4.0, levels);
+    if (made > left_) {
+      throw SceneError(fmt::format("{}: makes {:.4g} triangles{}, past what the scene may hold ({:.4g} in all, "
+                                   "{:.4g} left{})",
+                                   what, made, levels > 0 ? fmt::format(" subdivided {} times", levels) : "", total_,
+                                   left_, total_ >= 1e300 ? "" : " for the memory available"));
+    }
+    left_ -= made;
+  }
+
+ private:
+  double left_, total_;
+};
+
+void add_object(SceneAssembly& assembly, const TableReader& object, const std::filesystem::path& directory,
+                TriangleBudget& budget) {
   if (!object.has("mesh")) throw SceneError(fmt::format("{}: 'mesh' is required", object.what()));
   ObjectTransform transform;
   if (object.has("fit")) transform.fit = static_cast<float>(object.number("fit"));
@@ -140,7 +170,17 @@ void add_object(SceneAssembly& assembly, const TableReader& object, const std::f
   if (object.has("albedo")) material.albedo = object.color("albedo", kMaxAlbedo);
   if (object.has("emission")) material.emission = object.color("emission", kMaxEmission);
 
-  ObjectGeometry geometry = load_object_geometry(object.text("mesh"), directory, object.what());
+  const std::string source = object.text("mesh");
+  // A builtin is charged before it is generated, a mesh file once read (its size bounds it).
+  std::optional<std::size_t> builtin_triangles;
+  try {
+    if (is_builtin_scene(source)) builtin_triangles = builtin_triangle_count(source);
+  } catch (const SceneError& error) {
+    throw SceneError(fmt::format("{}: {}", object.what(), error.what()));
+  }
+  if (builtin_triangles) budget.charge(*builtin_triangles, subdivide, object.what());
+  ObjectGeometry geometry = load_object_geometry(source, directory, object.what());
+  if (!builtin_triangles) budget.charge(geometry.mesh.triangle_count(), subdivide, object.what());
   if (subdivide > 0) geometry.mesh = loop_subdivide(geometry.mesh, subdivide).mesh;
   apply_transform(geometry.mesh, transform, object.what());
   if (own_material) {
@@ -174,7 +214,7 @@ std::string object_label(const char* kind, std::size_t index, const toml::table&
 
 bool is_scene_file(std::string_view source) { return source.ends_with(".toml"); }
 
-Scene load_scene_file(const std::string& path) {
+Scene load_scene_file(const std::string& path, const SceneFileLimits& limits) {
   toml::table root;
   try {
     root = toml::parse_file(path);
@@ -187,13 +227,14 @@ Scene load_scene_file(const std::string& path) {
   const std::filesystem::path directory = std::filesystem::path(path).parent_path();
 
   SceneAssembly assembly;
+  TriangleBudget budget(limits);
   const auto objects = tables_of(root, "object", path);
   const auto lights = tables_of(root, "light", path);
   if (objects.empty() && lights.empty()) throw SceneError(fmt::format("{}: the scene has no [[object]]", path));
   for (std::size_t i = 0; i < objects.size(); ++i) {
     const TableReader object(*objects[i], object_label("object", i, *objects[i], path),
                              {"name", "mesh", "fit", "scale", "rotate", "translate", "subdivide", "albedo", "emission"});
-    add_object(assembly, object, directory);
+    add_object(assembly, object, directory, budget);
   }
   for (std::size_t i = 0; i < lights.size(); ++i) {
     const TableReader light(*lights[i], object_label("light", i, *lights[i], path),

@@ -32,8 +32,16 @@ namespace wavetrace {
 
 bool is_scene_file(std::string_view source);  // by its .toml extension
 
+struct SceneFileLimits {
+  // The most triangles all objects may make together, after subdivision; an object past it
+  // is refused before it is built. 0: what available memory holds at 100 bytes a triangle
+  // (what subdivided scenes were measured to need, subdivide.cpp).
+  std::size_t max_triangles = 0;
+};
+
 // Throws SceneError naming the file and the object (by name and number) for a syntax error,
-// an unknown key, a value of the wrong type or range, a missing mesh or a degenerate transform.
-Scene load_scene_file(const std::string& path);
+// an unknown key, a value of the wrong type or range, a missing mesh, a degenerate
+// transform, or objects that make more triangles than `limits` allow.
+Scene load_scene_file(const std::string& path, const SceneFileLimits& limits = {});
 
 }  // namespace wavetrace

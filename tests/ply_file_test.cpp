@@ -152,7 +152,7 @@ TEST(PlyFile, BadFilesNameTheProblem) {
   expect_bad("nan.ply", nan, "vertex 0 has a coordinate that is not finite");
   std::string no_z = head;
   no_z.replace(no_z.find("property float z\n"), 17, "property float w\n");
-  expect_bad("noz.ply", no_z + good.data, "no 'z' property");
+  expect_bad("noz.ply", no_z + good.data, "need one 'z' property");
   expect_bad("words.ply", "ply\nformat binary_little_endian 1.0\nelement vertex x\nend_header\n", "header line 3");
   expect_bad("noend.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 3\n", "no end_header");
 }

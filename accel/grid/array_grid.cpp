@@ -22,8 +22,6 @@
 namespace wavetrace {
 namespace {
 
-constexpr float kInfinity = std::numeric_limits<float>::infinity();
-
 struct ArrayGridNode {
   glm::vec3 lower;
   glm::vec3 cell_size;

@@ -142,7 +142,7 @@ class BlockEncoder {
       const auto offset = static_cast<std::uint16_t>(table_end + record_offset[l]);
       std::memcpy(block + kBlockHeaderBytes + 4 * (node_slots + forward_slots) + 2 * l, &offset, 2);
     }
-    std::memcpy(block + table_end, records.data(), records.size());
+    if (!records.empty()) std::memcpy(block + table_end, records.data(), records.size());  // data() may be null
 
     // Child blocks after this one; their offsets patched into the forward slots.
     for (std::uint32_t f = 0; f < forward_slots; ++f) {

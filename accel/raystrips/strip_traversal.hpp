@@ -145,8 +145,8 @@ class StripRay {
   using LaneMask = std::int32_t __attribute__((vector_size(32)));
 
   // Lane j takes lane j + 1 (j + 2); the last lanes repeat lane 7.
-  static Lanes next(Lanes v) { return __builtin_shuffle(v, LaneMask{1, 2, 3, 4, 5, 6, 7, 7}); }
-  static Lanes after_next(Lanes v) { return __builtin_shuffle(v, LaneMask{2, 3, 4, 5, 6, 7, 7, 7}); }
+  static Lanes next(Lanes v) { return __builtin_shufflevector(v, v, 1, 2, 3, 4, 5, 6, 7, 7); }
+  static Lanes after_next(Lanes v) { return __builtin_shufflevector(v, v, 2, 3, 4, 5, 6, 7, 7, 7); }
 
   static float edge_in_double(float px, float py, float qx, float qy) {
     return static_cast<float>(double(qx) * double(py) - double(qy) * double(px));

@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# Runs every fuzz target of a WAVETRACE_FUZZ build from the committed seed corpus, two at a
+# time (FUZZ_JOBS sets how many), and prints each target's executions and findings; exits
+# non-zero if any target found one.
+#   fuzz/run_fuzzers.sh BUILD_DIR 60s          # a minute each (CI's smoke run)
+#   fuzz/run_fuzzers.sh BUILD_DIR 10000000     # ten million executions each
+# New inputs go to BUILD_DIR/fuzz-corpus/TARGET, findings to BUILD_DIR/fuzz-findings/.
+set -uo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+build=${1:?usage: run_fuzzers.sh BUILD_DIR SECONDSs|RUNS [TARGET...]}
+limit=${2:?usage: run_fuzzers.sh BUILD_DIR SECONDSs|RUNS [TARGET...]}
+shift 2
+targets=("$@")
+((${#targets[@]})) || targets=(mesh_off mesh_ply mesh_obj mesh_stl scene_file config)
+if [[ $limit == *s ]]; then budget="-max_total_time=${limit%s}"; else budget="-runs=$limit"; fi
+mkdir -p "$build/fuzz-findings" "$build/fuzz-logs"
+
+run_one() {
+  local target=$1 seeds
+  seeds="$root/fuzz/corpus/${target#mesh_}"
+  mkdir -p "$build/fuzz-corpus/$target"
+  # -timeout: an input taking 10 s is a hang; -rss_limit_mb: one using 2 GB is a leak or
+  # an unbounded allocation; both are findings, as crashes and sanitizer reports are.
+  "$build/fuzz/fuzz_$target" "$build/fuzz-corpus/$target" "$seeds" "$budget" -timeout=10 -rss_limit_mb=2048 \
+    -max_len=8192 -print_final_stats=1 -artifact_prefix="$build/fuzz-findings/$target-" \
+    > "$build/fuzz-logs/$target.log" 2>&1
+  local status=$?
+  local runs seconds
+  runs=$(grep -o 'stat::number_of_executed_units: [0-9]*' "$build/fuzz-logs/$target.log" | grep -o '[0-9]*$')
+  seconds=$(grep -o 'Done [0-9]* runs in [0-9]* second' "$build/fuzz-logs/$target.log" | grep -o 'in [0-9]*' | grep -o '[0-9]*')
+  if ((status == 0)); then
+    echo "fuzz_$target: ${runs:-?} executions in ${seconds:-?} s, no findings"
+  else
+    echo "fuzz_$target: FINDING (exit $status) after ${runs:-?} executions; see $build/fuzz-logs/$target.log"
+    grep -m3 -E 'ERROR|runtime error|SUMMARY|Test unit written' "$build/fuzz-logs/$target.log" | sed 's/^/  /'
+  fi
+  return $status
+}
+export -f run_one
+export root build budget
+printf '%s\n' "${targets[@]}" | xargs -P "${FUZZ_JOBS:-2}" -I{} bash -c 'run_one {}'
