@@ -1,6 +1,7 @@
 // The `wavetrace` command line: render, build, info, bench, export.
 #include <cstdio>
 #include <exception>
+#include <new>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -20,6 +21,10 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
     return app.exit(error);
+  } catch (const std::bad_alloc&) {
+    // Commands that know what they were allocating say so (render); this is the rest.
+    fmt::print(stderr, "wavetrace: error: out of memory\n");
+    return 1;
   } catch (const std::exception& error) {
     fmt::print(stderr, "wavetrace: error: {}\n", error.what());
     return 1;

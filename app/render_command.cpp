@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <new>
 
 #include <fmt/format.h>
 
@@ -95,33 +96,48 @@ int render_world(const RenderArguments& args, RenderPlan plan) {
   return finish_render(args, plan, loaded.scene, world, camera, measured);
 }
 
-int run_render(const RenderArguments& args) {
-  const Config config = build_config(args);
-  const RenderPlan plan = plan_render(config);
-  if (is_world_file(plan.scene.source)) return render_world(args, plan);
-  if (plan.memory.file_backing) {
-    throw ConfigError(fmt::format("memory.backing = file pages a world file; {} is not one (make one with wavetrace build)",
-                                  plan.scene.source));
-  }
-
+int render_scene(const RenderPlan& plan, const RenderArguments& args, std::string& activity) {
   RenderPhases measured;
   // An accelerator that holds its own geometry never needs the whole mesh: a builtin scene
   // is then generated a chunk at a time as it is built. The proxy is simplified from the mesh.
   RenderPlan load_plan = plan;
   load_plan.scene.streamed = holds_own_geometry(plan.accelerator.type) && !plan.needs_proxy();
   check_scene_fits(load_plan);
+  activity = fmt::format("loading {}", plan.scene.source);
   const auto load_start = std::chrono::steady_clock::now();
   Scene scene = load_scene(load_plan.scene);
   measured.load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
   measured.after_load_bytes = read_resident_memory().current_bytes;
   const Camera camera = resolve_camera(plan.camera, scene);
+  activity = fmt::format("building '{}' over {} triangles", plan.accelerator.type, scene.triangle_count);
   const std::unique_ptr<Accelerator> accelerator = build_world_accelerator(scene, plan.accelerator);
   const LightSampler lights(scene);
+  activity = fmt::format("building the proxy of {} triangles", scene.triangle_count);
   const std::unique_ptr<Proxy> proxy = build_proxy(plan, scene, *accelerator);
   if (holds_own_geometry(plan.accelerator.type)) scene.release_mesh();
   measured.after_build_bytes = read_resident_memory().current_bytes;
   const World world{scene, *accelerator, lights, proxy.get()};
+  activity = fmt::format("rendering {}x{} at {} spp", plan.image.width, plan.image.height, plan.image.samples_per_pixel);
   return finish_render(args, plan, scene, world, camera, measured);
+}
+
+int run_render(const RenderArguments& args) {
+  const Config config = build_config(args);
+  const RenderPlan plan = plan_render(config);
+  // What was being done, so that running out of memory says where (and not "bad_alloc").
+  std::string activity = fmt::format("loading the world {}", plan.scene.source);
+  try {
+    if (is_world_file(plan.scene.source)) return render_world(args, plan);
+    if (plan.memory.file_backing) {
+      throw ConfigError(fmt::format(
+          "memory.backing = file pages a world file; {} is not one (make one with wavetrace build)", plan.scene.source));
+    }
+    return render_scene(plan, args, activity);
+  } catch (const std::bad_alloc&) {
+    throw std::runtime_error(fmt::format("out of memory {} ({:.2f} GB resident at most, {:.2f} GB available now)",
+                                         activity, double(read_resident_memory().peak_bytes) * 1e-9,
+                                         double(available_memory_bytes()) * 1e-9));
+  }
 }
 
 }  // namespace

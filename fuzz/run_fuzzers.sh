@@ -11,18 +11,37 @@ build=${1:?usage: run_fuzzers.sh BUILD_DIR SECONDSs|RUNS [TARGET...]}
 limit=${2:?usage: run_fuzzers.sh BUILD_DIR SECONDSs|RUNS [TARGET...]}
 shift 2
 targets=("$@")
-((${#targets[@]})) || targets=(mesh_off mesh_ply mesh_obj mesh_stl scene_file config)
+((${#targets[@]})) || targets=(mesh_off mesh_ply mesh_obj mesh_stl scene_file config world_file)
 if [[ $limit == *s ]]; then budget="-max_total_time=${limit%s}"; else budget="-runs=$limit"; fi
 mkdir -p "$build/fuzz-findings" "$build/fuzz-logs"
+
+# World files are build outputs (and 100 KB each), so their seeds are built here rather
+# than committed: one small world per saved layout, and one rebuilt from its mesh (embree).
+make_world_seeds() {
+  local seeds="$build/fuzz-seeds/world_file" accel
+  mkdir -p "$seeds"
+  for accel in bvh bvh:width=8 hmq hmq:width=8 hmq:epsilon=0.01 raystrips raystrips:width=8 embree chunked proxy; do
+    local name=${accel//[:=]/_} options=()
+    case $accel in
+      *:*) options=(--accel "${accel%%:*}" --set "accel.${accel%%:*}.${accel#*:}") ;;
+      chunked) options=(--accel hmq --set build.chunk_triangles=256) ;;
+      proxy) options=(--accel bvh --proxy) ;;
+      *) options=(--accel "$accel") ;;
+    esac
+    [[ -f $seeds/$name.wtw ]] ||
+      "$build/wavetrace" build builtin:sphere:600 "${options[@]}" --out "$seeds/$name.wtw" >/dev/null
+  done
+}
 
 run_one() {
   local target=$1 seeds
   seeds="$root/fuzz/corpus/${target#mesh_}"
+  [[ $target == world_file ]] && seeds="$build/fuzz-seeds/world_file"
   mkdir -p "$build/fuzz-corpus/$target"
   # -timeout: an input taking 10 s is a hang; -rss_limit_mb: one using 2 GB is a leak or
   # an unbounded allocation; both are findings, as crashes and sanitizer reports are.
   "$build/fuzz/fuzz_$target" "$build/fuzz-corpus/$target" "$seeds" "$budget" -timeout=10 -rss_limit_mb=2048 \
-    -max_len=8192 -print_final_stats=1 -artifact_prefix="$build/fuzz-findings/$target-" \
+    -max_len=$([[ $target == world_file ]] && echo 262144 || echo 8192) -print_final_stats=1 -artifact_prefix="$build/fuzz-findings/$target-" \
     > "$build/fuzz-logs/$target.log" 2>&1
   local status=$?
   local runs seconds
@@ -36,6 +55,7 @@ run_one() {
   fi
   return $status
 }
+[[ " ${targets[*]} " == *" world_file "* ]] && make_world_seeds
 export -f run_one
 export root build budget
 printf '%s\n' "${targets[@]}" | xargs -P "${FUZZ_JOBS:-2}" -I{} bash -c 'run_one {}'

@@ -223,13 +223,18 @@ void Config::load_string(std::string_view toml_text, std::string_view origin) {
   }
 }
 
-void Config::set(std::string_view assignment) {
+void Config::set(std::string_view assignment) { assign(assignment, true); }
+
+void Config::restore(std::string_view assignment) { assign(assignment, false); }
+
+void Config::assign(std::string_view assignment, bool given) {
   const std::size_t equals = assignment.find('=');
   if (equals == std::string_view::npos) {
     throw ConfigError(fmt::format("--set '{}': expected section.key=value", assignment));
   }
   const std::string key = trim(assignment.substr(0, equals));
   set_value(key, parse_text_value(require_key(key), std::string(assignment.substr(equals + 1))));
+  if (!given) given_.erase(key);
 }
 
 void Config::set_value(std::string_view name, ConfigValue value) {
@@ -242,6 +247,7 @@ void Config::set_value(std::string_view name, ConfigValue value) {
   }
   check_limits(key, value);
   values_.insert_or_assign(key.name, std::move(value));
+  given_.insert(key.name);
 }
 
 std::string Config::assignment(std::string_view name) const {

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -47,8 +48,14 @@ class Config {
   // "section.key=value"; the value is parsed as the key's type.
   void set(std::string_view assignment);
   void set_value(std::string_view key, ConfigValue value);
+  // As `set`, for a value an earlier run recorded (a world file's build settings): it does
+  // not count as given, since the user did not choose it now.
+  void restore(std::string_view assignment);
 
   bool has(std::string_view key) const;
+  // Whether the user gave the key (file, --set or set_value), not only its default; two keys
+  // that would override each other are an error only when both were given.
+  bool given(std::string_view key) const { return given_.contains(key); }
   // The key's value as `set` reads it back ("section.key=value"), exactly (reals to 17 digits).
   std::string assignment(std::string_view key) const;
   bool boolean(std::string_view key) const;
@@ -58,12 +65,14 @@ class Config {
   glm::vec3 vector3(std::string_view key) const;
   const std::vector<std::string>& text_list(std::string_view key) const;
 
-  // The keys that were given explicitly (file or --set), for reports.
+  // Every key that has a value, default or given (world files record them all).
   const std::map<std::string, ConfigValue, std::less<>>& values() const { return values_; }
 
  private:
   const ConfigValue& value(std::string_view key, ConfigType type) const;
+  void assign(std::string_view assignment, bool given);
   std::map<std::string, ConfigValue, std::less<>> values_;
+  std::set<std::string, std::less<>> given_;
 };
 
 std::string to_string(const ConfigValue& value);

@@ -119,8 +119,11 @@ AcceleratorOptions accelerator_options(const Config& config) {
   options.hmq.top_fraction = config.real("accel.hmq.top_fraction");
   options.hmq.width = static_cast<std::uint32_t>(config.integer("accel.hmq.width"));
   options.hmq.bins = options.bvh.bins;
-  if (options.hmq.epsilon > 0.0 && options.hmq.bits != 16) {
-    throw ConfigError(fmt::format("accel.hmq.bits = {} and accel.hmq.epsilon = {}: set one of them",
+  // epsilon chooses the bits: both given (even bits = 16, the default) is a conflict.
+  if ((config.given("accel.hmq.bits") && config.given("accel.hmq.epsilon")) ||
+      (options.hmq.epsilon > 0.0 && options.hmq.bits != HmqOptions{}.bits)) {
+    throw ConfigError(fmt::format("accel.hmq.bits = {} and accel.hmq.epsilon = {}: set one of them (epsilon "
+                                  "chooses the bits)",
                                   options.hmq.bits, options.hmq.epsilon));
   }
   options.chunk_triangles = static_cast<std::size_t>(config.integer("build.chunk_triangles"));
@@ -137,7 +140,8 @@ AcceleratorOptions accelerator_options(const Config& config) {
     throw ConfigError(fmt::format("accel.hmq.width = {}: must be 2 or 8", options.hmq.width));
   }
   // A top share set for the wide layout, which has no float top, is refused, not ignored.
-  if (options.hmq.width == 8 && options.hmq.top_fraction != HmqOptions{}.top_fraction) {
+  if (options.hmq.width == 8 &&
+      (config.given("accel.hmq.top_fraction") || options.hmq.top_fraction != HmqOptions{}.top_fraction)) {
     throw ConfigError(fmt::format("accel.hmq.top_fraction = {} applies to the binary layout (width 2): width 8 "
                                   "quantizes every node",
                                   options.hmq.top_fraction));
@@ -212,6 +216,9 @@ RenderPlan plan_render(const Config& config) {
   plan.reorder.heuristic = parse_reorder_heuristic(config.text("reorder.heuristic"));
   plan.reorder.curve = parse_curve_kind(config.text("reorder.curve"));
   plan.reorder.buffer_rays = static_cast<std::size_t>(config.integer("reorder.buffer_rays"));
+  if (config.given("reorder.buffer_rays") && config.has("reorder.buffer_bytes")) {
+    throw ConfigError("reorder.buffer_rays and reorder.buffer_bytes both size the reorder buffer: set one of them");
+  }
   if (config.has("reorder.buffer_bytes")) {
     plan.reorder.buffer_rays = std::max<std::size_t>(
         1, static_cast<std::size_t>(config.integer("reorder.buffer_bytes")) / ZSortStage::kBytesPerBufferedRay);

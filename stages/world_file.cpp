@@ -196,7 +196,7 @@ std::unique_ptr<LoadedWorld> load_world(const std::string& path, const std::opti
   for (std::string line; std::getline(settings, line);) {
     if (line.empty()) continue;
     try {
-      world.settings.set(line);
+      world.settings.restore(line);
     } catch (const ConfigError& error) {
       file.fail("build.settings", fmt::format("holds a setting this build does not know: {}", error.what()));
     }

@@ -110,5 +110,44 @@ TEST(Config, StageListsThatCannotRunAreRejected) {
   expect_config_error([&] { plan_with("generate,trace,shade,spawn,shade"); }, "more than once");
 }
 
+TEST(Config, KeysThatOverrideEachOtherAreAConflictWhenBothAreGiven) {
+  const auto plan_with = [](const std::vector<std::string>& assignments) {
+    Config config;
+    for (const std::string& assignment : assignments) config.set(assignment);
+    plan_render(config);
+  };
+  // Each alone is fine; together one would silently win.
+  plan_with({"accel.hmq.epsilon=0.001"});
+  plan_with({"accel.hmq.bits=16"});
+  expect_config_error([&] { plan_with({"accel.hmq.bits=16", "accel.hmq.epsilon=0.001"}); }, "set one of them");
+  expect_config_error([&] { plan_with({"accel.hmq.epsilon=0.001", "accel.hmq.bits=12"}); }, "set one of them");
+  plan_with({"reorder.buffer_bytes=1048576"});
+  expect_config_error([&] { plan_with({"reorder.buffer_rays=4096", "reorder.buffer_bytes=1048576"}); },
+                      "both size the reorder buffer");
+  plan_with({"accel.hmq.width=8"});
+  expect_config_error([&] { plan_with({"accel.hmq.width=8", "accel.hmq.top_fraction=0.05"}); },
+                      "applies to the binary layout");
+  // The same keys from a file count as given too.
+  expect_config_error(
+      [&] {
+        Config config;
+        config.load_string("[accel.hmq]\nbits = 16\nepsilon = 0.5\n");
+        plan_render(config);
+      },
+      "set one of them");
+}
+
+TEST(Config, RestoredSettingsAreNotGiven) {
+  // A world file records every setting, defaults included; restoring them must not turn
+  // a default into a choice that conflicts with the user's.
+  Config config;
+  config.restore("accel.hmq.bits=16");
+  EXPECT_FALSE(config.given("accel.hmq.bits"));
+  config.set("accel.hmq.epsilon=0.01");
+  EXPECT_TRUE(config.given("accel.hmq.epsilon"));
+  EXPECT_NO_THROW(plan_render(config));
+  EXPECT_FALSE(Config().given("accel.type")) << "a default is not given";
+}
+
 }  // namespace
 }  // namespace wavetrace

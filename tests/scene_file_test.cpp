@@ -192,6 +192,27 @@ TEST(SceneFile, MissingFileIsAnError) {
   EXPECT_THROW(load_scene({"/nonexistent/scene.toml", 0}), SceneError);
 }
 
+TEST(SceneFile, ObjectsPastTheTriangleBudgetAreRefusedBeforeTheyAreBuilt) {
+  const std::string path = testing::write_temp_file(
+      "budget.toml",
+      "[[object]]\nmesh = \"builtin:sphere:1000\"\n[[object]]\nname = \"big\"\nmesh = \"builtin:sphere:2G\"\nsubdivide = 6\n");
+  try {
+    load_scene_file(path, SceneFileLimits{.max_triangles = 5000});
+    FAIL() << "a 2G-triangle object subdivided 6 times was built";
+  } catch (const SceneError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("object 'big' (#2): makes 8.192e+12 triangles subdivided 6 times"), std::string::npos) << message;
+    EXPECT_NE(message.find("past what the scene may hold (5000 in all, 4000 left"), std::string::npos) << message;
+  }
+  // The default budget is the machine's memory: the same file is refused without a limit.
+  EXPECT_THROW(load_scene_file(path), SceneError);
+  // A default-sized builtin is charged its default count (200k for default) before it is made.
+  const std::string small = testing::write_temp_file("small_budget.toml", "[[object]]\nmesh = \"builtin:default\"\n");
+  EXPECT_THROW(load_scene_file(small, SceneFileLimits{.max_triangles = 1000}), SceneError);
+  EXPECT_EQ(builtin_triangle_count("builtin:default"), std::optional<std::size_t>(200000));
+  EXPECT_EQ(builtin_triangle_count("builtin:room:10"), std::optional<std::size_t>(2000)) << "the room's floor";
+}
+
 TEST(SceneFile, SubdivisionKeepsEachTrianglesMaterial) {
   const Scene scene = load_scene({"builtin:default:80", 1});
   ASSERT_EQ(scene.mesh.material_of_triangle.size(), scene.mesh.triangle_count());
