@@ -168,6 +168,33 @@ TEST(Cli, InfoCountsDroppedDegenerates) {
 namespace wavetrace {
 namespace {
 
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kAddressSanitizer = true;
+#elif defined(__has_feature)
+constexpr bool kAddressSanitizer = __has_feature(address_sanitizer);
+#else
+constexpr bool kAddressSanitizer = false;
+#endif
+
+TEST(Cli, OutOfMemoryIsReportedWithWhatWasBeingBuilt) {
+  // AddressSanitizer reserves terabytes of shadow memory, which no address-space limit allows.
+  if (kAddressSanitizer) GTEST_SKIP() << "an address-space limit cannot hold AddressSanitizer's shadow";
+  // 300 MB of address space: the scene loads, its BVH build runs out.
+  const std::string command = "ulimit -v 300000; exec " + std::string(WAVETRACE_BINARY) +
+                              " render builtin:sphere:2M --accel bvh --size 8x8 --spp 1 --threads 1 --out " +
+                              testing::write_temp_file("oom.exr", "") + " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string output;
+  char buffer[4096];
+  while (std::size_t read = std::fread(buffer, 1, sizeof buffer, pipe)) output.append(buffer, read);
+  const int status = pclose(pipe);
+  ASSERT_TRUE(WIFEXITED(status)) << "killed, not an error: " << output;
+  EXPECT_EQ(WEXITSTATUS(status), 1) << output;
+  EXPECT_NE(output.find("wavetrace: error: out of memory building 'bvh' over 1997120 triangles"), std::string::npos)
+      << output;
+}
+
 TEST(Cli, BenchReorderReportsEveryHeuristicWithTheIssuesKeys) {
   const std::string json_path = testing::write_temp_file("reorder.json", "");
   const auto result = testing::run_wavetrace(
