@@ -44,16 +44,19 @@ class SectionSaver {
   static constexpr bool kLoading = false;
   template <typename T>
   void array(std::string_view name, const StoredArray<T>& items) {
-    out_.add_array<T>(prefix_ + std::string(name), items.span());
+    out_.add_array<T>(named(name), items.span());
   }
   template <typename T>
   void value(std::string_view name, const T& item) {
-    out_.add_value(prefix_ + std::string(name), item);
+    out_.add_value(named(name), item);
   }
   const std::string& prefix() const { return prefix_; }
   SectionWriter& writer() const { return out_; }
 
  private:
+  // prefix + name, appended rather than `prefix_ + std::string(name)`, whose inlined insert
+  // GCC 12 misreads as an overlapping memcpy (-Wrestrict, GCC bug 105651).
+  std::string named(std::string_view name) const { return std::string(prefix_).append(name); }
   SectionWriter& out_;
   std::string prefix_;
 };
@@ -65,11 +68,11 @@ class SectionLoader {
   static constexpr bool kLoading = true;
   template <typename T>
   void array(std::string_view name, StoredArray<T>& items) {
-    items = StoredArray<T>(file_->array<T>(prefix_ + std::string(name)), file_);
+    items = StoredArray<T>(file_->array<T>(named(name)), file_);
   }
   template <typename T>
   void value(std::string_view name, T& item) {
-    item = file_->value<T>(prefix_ + std::string(name));
+    item = file_->value<T>(named(name));
   }
   // Checks the saved kind against what this build writes; throws SectionFileError.
   void expect_kind(std::string_view type, std::uint32_t version) const {
@@ -82,12 +85,13 @@ class SectionLoader {
     }
   }
   [[noreturn]] void fail(std::string_view name, const std::string& problem) const {
-    file_->fail(prefix_ + std::string(name), problem);
+    file_->fail(named(name), problem);
   }
   const std::shared_ptr<const SectionFile>& file() const { return file_; }
   const std::string& prefix() const { return prefix_; }
 
  private:
+  std::string named(std::string_view name) const { return std::string(prefix_).append(name); }  // as SectionSaver's
   std::shared_ptr<const SectionFile> file_;
   std::string prefix_;
 };

@@ -21,15 +21,14 @@ make_world_seeds() {
   local seeds="$build/fuzz-seeds/world_file" accel
   mkdir -p "$seeds"
   for accel in bvh bvh:width=8 hmq hmq:width=8 hmq:epsilon=0.01 raystrips raystrips:width=8 embree chunked proxy; do
-    local name=${accel//[:=]/_} options=()
+    local name=${accel//[:=]/_} scene=builtin:sphere:600 options=()
     case $accel in
       *:*) options=(--accel "${accel%%:*}" --set "accel.${accel%%:*}.${accel#*:}") ;;
-      chunked) options=(--accel hmq --set build.chunk_triangles=256) ;;
+      chunked) scene=builtin:sphere:2500 options=(--accel hmq --set build.chunk_triangles=1024) ;;
       proxy) options=(--accel bvh --proxy) ;;
       *) options=(--accel "$accel") ;;
     esac
-    [[ -f $seeds/$name.wtw ]] ||
-      "$build/wavetrace" build builtin:sphere:600 "${options[@]}" --out "$seeds/$name.wtw" >/dev/null
+    [[ -f $seeds/$name.wtw ]] || "$build/wavetrace" build "$scene" "${options[@]}" --out "$seeds/$name.wtw" >/dev/null
   done
 }
 

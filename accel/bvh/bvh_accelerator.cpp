@@ -24,7 +24,7 @@ class BvhAccelerator final : public ProbedAccelerator<BvhAccelerator> {
   friend class ProbedAccelerator<BvhAccelerator>;
 
  public:
-  explicit BvhAccelerator(SectionLoader& in) : geometry_(in) { load_bvh(in, "bvh.nodes", nodes_, leaf_triangles_, build_); }
+  explicit BvhAccelerator(SectionLoader& in) : geometry_(in) { load_bvh(in, geometry_, "bvh.nodes", nodes_, leaf_triangles_, build_); }
 
   void save(SectionWriter& out, const std::string& prefix) const override {
     save_bvh(out, prefix, geometry_, "bvh.nodes", nodes_, leaf_triangles_, build_);

@@ -4,10 +4,13 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <span>
+#include <type_traits>
 
 #include "accel/bvh/bvh_accelerator.hpp"
 #include "accel/bvh/indexed_face_set.hpp"
 #include "accel/bvh/sah_builder.hpp"
+#include "accel/bvh/tree_check.hpp"
 #include "accel/section_archive.hpp"
 
 namespace wavetrace {
@@ -49,16 +52,31 @@ void save_bvh(SectionWriter& out, const std::string& prefix, const IndexedFaceSe
   archive_common_state(saver, triangles, report);
 }
 
-// The face set is loaded by the accelerator's constructor (a member); this reads the rest.
+// The face set is loaded by the accelerator's constructor (a member); this reads the rest
+// and checks every index a walk follows (tree_check.hpp).
 template <typename Node>
-void load_bvh(SectionLoader& in, std::string_view nodes_section, StoredArray<Node>& nodes,
-              StoredArray<std::uint32_t>& leaf_triangles, BuildReport& build) {
+void load_bvh(SectionLoader& in, const IndexedFaceSet& geometry, std::string_view nodes_section,
+              StoredArray<Node>& nodes, StoredArray<std::uint32_t>& leaf_triangles, BuildReport& build) {
   in.expect_kind("bvh", kBvhSavedVersion);
   in.array(nodes_section, nodes);
   in.array("bvh.leaf_triangles", leaf_triangles);
   std::size_t triangles = 0;
   archive_common_state(in, triangles, build);
   if (nodes.empty()) in.fail(nodes_section, "is empty: no bvh was saved");
+  for (const std::uint32_t triangle : leaf_triangles) {
+    if (triangle >= geometry.triangle_count()) in.fail("bvh.leaf_triangles", "names a triangle that does not exist");
+  }
+  // Without leaf_triangles (triangle_order = leaf) a leaf's slots are the triangles themselves.
+  const std::size_t slots = leaf_triangles.empty() ? geometry.triangle_count() : leaf_triangles.size();
+  const auto check_slots = [&](std::uint64_t first, std::uint64_t count) {
+    check_leaf_slots(first, count, slots, in, nodes_section);
+  };
+  if constexpr (std::is_same_v<Node, BvhNode>) {
+    check_tree(std::span<const BvhNode>(nodes.data(), nodes.size()), in, nodes_section,
+               [&](const BvhNode& leaf) { check_slots(leaf.first, leaf.triangle_count()); });
+  } else {
+    check_tree(std::span<const Node>(nodes.data(), nodes.size()), in, nodes_section, check_slots);
+  }
 }
 
 // Peak build memory: the larger of the tree build's and the face-set copy's working sets,

@@ -1,6 +1,7 @@
 // Morton reordering of an indexed face set and per-triangle bounds.
 #include "accel/bvh/indexed_face_set.hpp"
 
+#include <algorithm>
 #include <limits>
 #include <stdexcept>
 
@@ -101,6 +102,11 @@ IndexedFaceSet::IndexedFaceSet(SectionLoader& in) {
   if (!input_id_.empty() && input_id_.size() != triangle_count_) {
     in.fail("faces.input_id", "does not have one id per triangle");
   }
+  const glm::uvec3* const end = triangles_ + triangle_count_;
+  const glm::uvec3* const bad = std::find_if(triangles_, end, [&](const glm::uvec3& corners) {
+    return corners.x >= vertex_count_ || corners.y >= vertex_count_ || corners.z >= vertex_count_;
+  });
+  if (bad != end) in.fail("faces.triangles", "names a vertex that does not exist");
 }
 
 LargeArray<Bounds3> IndexedFaceSet::triangle_bounds() const {

@@ -89,7 +89,7 @@ struct WideRay {
 class WideBvhAccelerator final : public Accelerator {
  public:
   explicit WideBvhAccelerator(SectionLoader& in) : geometry_(in) {
-    load_bvh(in, "bvh8.nodes", nodes_, leaf_triangles_, build_);
+    load_bvh(in, geometry_, "bvh8.nodes", nodes_, leaf_triangles_, build_);
   }
 
   void save(SectionWriter& out, const std::string& prefix) const override {

@@ -16,6 +16,7 @@
 
 #include "accel/bvh/bvh_node.hpp"
 #include "accel/bvh/bvh_walk.hpp"
+#include "accel/bvh/tree_check.hpp"
 #include "accel/bvh/node_layout.hpp"
 #include "accel/bvh/sah_builder.hpp"
 #include "accel/section_archive.hpp"
@@ -93,11 +94,9 @@ class ChunkedAccelerator final : public Accelerator {
     std::size_t triangles = 0;
     archive_common_state(in, triangles, build_);
     if (saved.empty() || top_.empty()) in.fail("chunked.chunks", "is empty: no chunk was saved");
-    for (const BvhNode& node : top_) {
-      if (node.leaf() ? node.first >= saved.size() : (node.left() >= top_.size() || node.right() >= top_.size())) {
-        in.fail("chunked.top", "names a node or chunk that does not exist");
-      }
-    }
+    check_tree(std::span<const BvhNode>(top_.data(), top_.size()), in, "chunked.top", [&](const BvhNode& leaf) {
+      if (leaf.first >= saved.size()) in.fail("chunked.top", "names a chunk that does not exist");
+    });
     chunks_.resize(saved.size());
     for (std::size_t c = 0; c < saved.size(); ++c) {
       SectionLoader chunk_in(in.file(), in.prefix() + fmt::format("chunk.{}/", c));

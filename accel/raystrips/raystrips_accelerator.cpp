@@ -15,6 +15,7 @@
 #include "accel/bvh/bvh_node.hpp"
 #include "accel/hit_surface.hpp"
 #include "accel/bvh/bvh_walk.hpp"
+#include "accel/bvh/tree_check.hpp"
 #include "accel/bvh/leaf_query.hpp"
 #include "accel/bvh/node_layout.hpp"
 #include "accel/bvh/quantized_wide_tree.hpp"
@@ -165,6 +166,16 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
       self.stats_ = state.stats;
       if (state.options.width != 2 && state.options.width != 8) a.fail("raystrips.state", "holds a top width other than 2 or 8");
       if (state.options.width == 2 && self.nodes_.empty()) a.fail("raystrips.nodes", "is empty: no raystrips structure was saved");
+      // The binary top is checked whole; the strips under it only where each leaf starts
+      // (their own decoding trusts the checksums: see tree_check.hpp).
+      if (state.options.width == 2) {
+        check_tree(std::span<const BvhNode>(self.nodes_.data(), self.nodes_.size()), a, "raystrips.nodes",
+                   [&](const BvhNode& leaf) {
+                     if (std::uint64_t(leaf.first) * 4 >= self.strip_bytes_.size()) {
+                       a.fail("raystrips.nodes", "has a leaf naming strips that do not exist");
+                     }
+                   });
+      }
       if (state.options.width == 8 && (self.wide_nodes_.empty() || self.leaf_words_.size() < 2)) {
         a.fail("raystrips.wide_nodes", "is empty: no raystrips structure was saved");
       }
