@@ -13,6 +13,10 @@ shift 2
 targets=("$@")
 ((${#targets[@]})) || targets=(mesh_off mesh_ply mesh_obj mesh_stl scene_file config world_file)
 if [[ $limit == *s ]]; then budget="-max_total_time=${limit%s}"; else budget="-runs=$limit"; fi
+# FUZZ_MAX_SECONDS caps a run of RUNS executions; FUZZ_MAX_LEN bounds the inputs of the text
+# targets (a world file is ~100 KB and gets 256 KiB).
+[[ -n ${FUZZ_MAX_SECONDS:-} && $limit != *s ]] && budget="$budget -max_total_time=$FUZZ_MAX_SECONDS"
+text_max_len=${FUZZ_MAX_LEN:-4096}
 mkdir -p "$build/fuzz-findings" "$build/fuzz-logs"
 
 # World files are build outputs (and 100 KB each), so their seeds are built here rather
@@ -39,8 +43,9 @@ run_one() {
   mkdir -p "$build/fuzz-corpus/$target"
   # -timeout: an input taking 10 s is a hang; -rss_limit_mb: one using 2 GB is a leak or
   # an unbounded allocation; both are findings, as crashes and sanitizer reports are.
-  "$build/fuzz/fuzz_$target" "$build/fuzz-corpus/$target" "$seeds" "$budget" -timeout=10 -rss_limit_mb=2048 \
-    -max_len=$([[ $target == world_file ]] && echo 262144 || echo 8192) -print_final_stats=1 -artifact_prefix="$build/fuzz-findings/$target-" \
+  # shellcheck disable=SC2086  # $budget is one or two flags
+  "$build/fuzz/fuzz_$target" "$build/fuzz-corpus/$target" "$seeds" $budget -timeout=10 -rss_limit_mb=2048 \
+    -max_len=$([[ $target == world_file ]] && echo 262144 || echo "$text_max_len") -print_final_stats=1 -artifact_prefix="$build/fuzz-findings/$target-" \
     > "$build/fuzz-logs/$target.log" 2>&1
   local status=$?
   local runs seconds
@@ -56,5 +61,5 @@ run_one() {
 }
 [[ " ${targets[*]} " == *" world_file "* ]] && make_world_seeds
 export -f run_one
-export root build budget
+export root build budget text_max_len
 printf '%s\n' "${targets[@]}" | xargs -P "${FUZZ_JOBS:-2}" -I{} bash -c 'run_one {}'

@@ -7,10 +7,9 @@
 // parents first, and the wide and quantized layouts inherit their order), so every walk ends;
 // depth is counted from the root and must stay under kMaxTreeDepth, which sizes every stack.
 //
-// Checked so: bvh (binary and 8-wide), the chunked top, the float tops of hmq and raystrips
-// and where their leaves start. Not yet: the insides of HMQ's blocks, Ray-Strips' strips and
-// the quantized 8-wide nodes, which are decoded trusting the file's checksums; a crafted
-// file can still crash their traversal (issue 20's closing note has the fuzzer's findings).
+// Checked so: bvh (binary and 8-wide), the chunked top, hmq's float top and quantized 8-wide
+// tree with their leaf records (hmq/block_check.hpp), raystrips' tops (binary and quantized)
+// with their strips (raystrips/strip_check.hpp).
 #pragma once
 
 #include <cstdint>
@@ -22,6 +21,7 @@
 #include <fmt/format.h>
 
 #include "accel/bvh/bvh_node.hpp"
+#include "accel/bvh/quantized_wide_node.hpp"
 #include "accel/bvh/sah_builder.hpp"
 #include "accel/bvh/wide_bvh_node.hpp"
 #include "accel/section_archive.hpp"
@@ -80,6 +80,31 @@ void check_tree(std::span<const WideBvhNode> nodes, const SectionLoader& in, std
       if (unused) continue;
       if (node.count[k] == 0) depths.link(i, node.child[k]);
       else check_leaf(node.child[k], node.count[k]);
+    }
+  }
+}
+
+// A quantized 8-wide tree (quantized_wide_node.hpp); `check_leaf(reference, weight)` fails
+// for a leaf child naming what does not exist. Empty slots (meta 0) are never entered.
+template <typename CheckLeaf>
+void check_tree(std::span<const QuantizedWideNode> nodes, const SectionLoader& in, std::string_view section,
+                CheckLeaf&& check_leaf) {
+  TreeDepths depths(nodes.size(), in, section);
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    const QuantizedWideNode& node = nodes[i];
+    std::uint64_t inner = 0, weight = 0;
+    for (int k = 0; k < QuantizedWideNode::kWidth; ++k) {
+      const std::uint8_t meta = node.meta[k];
+      if (meta == 0) continue;
+      if (meta == QuantizedWideNode::kInnerMeta) {
+        depths.link(i, node.child_base + inner++);
+      } else {
+        const std::uint64_t reference = node.leaf_base + weight;
+        // The walk marks leaf references with bit 31 (kWideLeafReference).
+        if (reference >= (std::uint64_t{1} << 31)) in.fail(section, fmt::format("node {} has a leaf reference past 2^31", i));
+        check_leaf(static_cast<std::uint32_t>(reference), meta);
+        weight += meta;
+      }
     }
   }
 }

@@ -36,11 +36,16 @@ struct GlobalGrid {
   }
   // The grid lines at or below / at or above a coordinate (for re-snapping leaf boxes).
   // The encoder and the decoder both re-snap through these, so their rounding is shared.
-  int floor_line(float value, int axis) const {
-    return static_cast<int>(std::floor((value - origin[axis]) * inverse_cell[axis]));
-  }
-  int ceil_line(float value, int axis) const {
-    return static_cast<int>(std::ceil((value - origin[axis]) * inverse_cell[axis]));
+  int floor_line(float value, int axis) const { return to_line(std::floor((value - origin[axis]) * inverse_cell[axis])); }
+  int ceil_line(float value, int axis) const { return to_line(std::ceil((value - origin[axis]) * inverse_cell[axis])); }
+
+ private:
+  // Lines of boxes the encoder writes lie inside the grid (< 2^24) and pass unchanged; a box
+  // from a crafted world file may lie far outside it, or be NaN, and is clamped so that the
+  // conversion to int is defined.
+  static int to_line(float line) {
+    constexpr float kLimit = 1073741824.0f;  // 2^30
+    return static_cast<int>(std::fmin(std::fmax(line, -kLimit), kLimit));
   }
 };
 

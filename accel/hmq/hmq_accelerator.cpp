@@ -14,6 +14,7 @@
 #include "accel/bvh/bvh_node.hpp"
 #include "accel/bvh/bvh_walk.hpp"
 #include "accel/bvh/tree_check.hpp"
+#include "accel/hmq/block_check.hpp"
 #include "accel/bvh/leaf_query.hpp"
 #include "accel/bvh/sah_builder.hpp"
 #include "accel/hit_surface.hpp"
@@ -210,14 +211,11 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
       self.nodes_ = state.nodes;
       self.leaves_ = state.leaves;
       if (self.top_.empty() || self.blocks_.size() < 8) a.fail("hmq.top", "is empty: no hmq structure was saved");
-      // The top tree is checked whole; the blocks under it only where each top leaf starts
-      // (their own decoding trusts the checksums: see tree_check.hpp).
-      check_tree(std::span<const BvhNode>(self.top_.data(), self.top_.size()), a, "hmq.top", [&](const BvhNode& leaf) {
-        const std::uint32_t roots = leaf.triangle_count();
-        if ((roots != 1 && roots != 2) || std::uint64_t(leaf.first) * 4 + kBlockHeaderBytes > self.blocks_.size()) {
-          a.fail("hmq.top", "has a leaf naming a block that does not exist");
-        }
+      const std::span<const BvhNode> top(self.top_.data(), self.top_.size());
+      check_tree(top, a, "hmq.top", [&](const BvhNode& leaf) {
+        if (leaf.triangle_count() != 1 && leaf.triangle_count() != 2) a.fail("hmq.top", "has a leaf of other than 1 or 2 roots");
       });
+      check_blocks(top, std::span<const std::byte>(self.blocks_.data(), self.blocks_.size()), self.triangles_, a);
     }
   }
 

@@ -81,8 +81,10 @@ inline void decode_leaf(const std::byte* record, const GlobalGrid& grid, const G
     const float origin = grid.origin[axis], cell = grid.cell[axis];
     float* position = leaf.position[axis];
     for (std::uint32_t i = 0; i < vertices; ++i) {
-      const int offset = static_cast<int>(values[i] >> 1);
-      const int line = (values[i] & 1u) ? upper - offset : lower + offset;
+      // In unsigned arithmetic (C++20 converts back modulo 2^32): the same lines for every
+      // record the encoder writes, and no signed overflow for one a crafted file holds.
+      const std::uint32_t offset = values[i] >> 1;
+      const int line = static_cast<int>((values[i] & 1u) ? std::uint32_t(upper) - offset : std::uint32_t(lower) + offset);
       position[i] = origin + float(line) * cell;
     }
   }

@@ -10,6 +10,8 @@
 
 #include "accel/bvh/quantized_wide_tree.hpp"
 #include "accel/bvh/quantized_wide_walk.hpp"
+#include "accel/bvh/tree_check.hpp"
+#include "accel/hmq/block_check.hpp"
 #include "accel/hmq/hmq_accelerator.hpp"
 #include "accel/hmq/leaf_hit.hpp"
 #include "accel/hmq/snapped_tree.hpp"
@@ -114,6 +116,11 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
       self.children_ = state.children;
       self.leaf_count_ = state.leaves;
       if (self.nodes_.empty() || self.leaves_.size() < 8) a.fail("hmq8.nodes", "is empty: no hmq8 structure was saved");
+      const std::span<const std::byte> leaves(self.leaves_.data(), self.leaves_.size());
+      check_tree(std::span<const QuantizedWideNode>(self.nodes_.data(), self.nodes_.size()), a, "hmq8.nodes",
+                 [&](std::uint32_t units, std::uint8_t) {
+                   check_leaf_record(leaves, std::uint64_t(units) * kUnit, self.triangles_, a, "hmq8.leaves");
+                 });
     }
   }
 

@@ -16,6 +16,7 @@
 #include "accel/hit_surface.hpp"
 #include "accel/bvh/bvh_walk.hpp"
 #include "accel/bvh/tree_check.hpp"
+#include "accel/raystrips/strip_check.hpp"
 #include "accel/bvh/leaf_query.hpp"
 #include "accel/bvh/node_layout.hpp"
 #include "accel/bvh/quantized_wide_tree.hpp"
@@ -168,16 +169,40 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
       if (state.options.width == 2 && self.nodes_.empty()) a.fail("raystrips.nodes", "is empty: no raystrips structure was saved");
       // The binary top is checked whole; the strips under it only where each leaf starts
       // (their own decoding trusts the checksums: see tree_check.hpp).
+      const std::span<const std::byte> strip_bytes(self.strip_bytes_.data(), self.strip_bytes_.size());
+      // Each strip from `at`: `count` of them, or those starting before byte `end`.
+      const auto check_strips = [&](std::uint64_t at, std::uint64_t count, std::uint64_t end) {
+        for (std::uint64_t s = 0; s < count && at < end; ++s) {
+          std::size_t size = 0;
+          const auto problem = ray_strip::strip_problem(strip_bytes, at, self.positions_.size(), self.triangles_, size);
+          if (problem) a.fail("raystrips.strips", *problem);
+          at += size;
+        }
+      };
       if (state.options.width == 2) {
         check_tree(std::span<const BvhNode>(self.nodes_.data(), self.nodes_.size()), a, "raystrips.nodes",
                    [&](const BvhNode& leaf) {
-                     if (std::uint64_t(leaf.first) * 4 >= self.strip_bytes_.size()) {
-                       a.fail("raystrips.nodes", "has a leaf naming strips that do not exist");
-                     }
+                     check_strips(std::uint64_t(leaf.first) * 4, leaf.triangle_count(), strip_bytes.size() + 1);
                    });
       }
       if (state.options.width == 8 && (self.wide_nodes_.empty() || self.leaf_words_.size() < 2)) {
         a.fail("raystrips.wide_nodes", "is empty: no raystrips structure was saved");
+      }
+      // Leaf l's strips are the words [leaf_words[l], leaf_words[l + 1]) of the strip bytes.
+      if (state.options.width == 8) {
+        check_tree(std::span<const QuantizedWideNode>(self.wide_nodes_.data(), self.wide_nodes_.size()), a,
+                   "raystrips.wide_nodes", [&](std::uint32_t leaf, std::uint8_t) {
+                     if (std::uint64_t(leaf) + 1 >= self.leaf_words_.size()) {
+                       a.fail("raystrips.wide_nodes", "has a leaf that does not exist");
+                     }
+                   });
+        for (std::size_t l = 0; l + 1 < self.leaf_words_.size(); ++l) {
+          if (self.leaf_words_[l] > self.leaf_words_[l + 1] ||
+              std::uint64_t(self.leaf_words_[l + 1]) * 4 > self.strip_bytes_.size()) {
+            a.fail("raystrips.leaf_words", "names strips out of order or past the strip bytes");
+          }
+          check_strips(std::uint64_t(self.leaf_words_[l]) * 4, ~std::uint64_t{0}, std::uint64_t(self.leaf_words_[l + 1]) * 4);
+        }
       }
       if (state.options.run_triangles < 2 || state.options.run_triangles > 64 || state.options.packet_min_active < 1 ||
           state.options.packet_min_active > kPacketRays) {
