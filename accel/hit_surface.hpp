@@ -44,7 +44,9 @@ inline void set_surfaces_from_mesh(HitBatch& hits, RayRange range, const Triangl
 // the first the remaining one), the same code that maps the barycentrics back.
 inline void set_surface_from_strip(HitBatch& hits, std::size_t ray, const glm::vec3 (&strip_corner)[3], std::uint32_t code) {
   const std::uint32_t second = code / 3, third = code % 3;
-  hits.set_surface(ray, strip_corner[3 - second - third], strip_corner[second], strip_corner[third]);
+  // The first corner is the one left, 3 - second - third; taken modulo 3 so that a code of
+  // two equal corners (a strip's repeated triangle, or a crafted world file) stays in range.
+  hits.set_surface(ray, strip_corner[(3 - second - third) % 3], strip_corner[second], strip_corner[third]);
 }
 
 }  // namespace wavetrace

@@ -46,6 +46,12 @@ std::optional<std::string> leaf_record_problem(std::span<const std::byte> bytes,
   for (std::uint32_t k = 0; k < layout.triangles; ++k) {
     if (std::uint64_t(header.id_base) + values[k] >= triangles) return "has a leaf naming a triangle that does not exist";
   }
+  stream += stream_bytes(header.id_bits, layout.triangles);
+  // Corner codes 3 c1 + c2 name the mesh triangle's second and third corner: two different ones.
+  read_stream(stream, 3, layout.triangles, values);
+  for (std::uint32_t k = 0; k < layout.triangles; ++k) {
+    if (values[k] / 3 == values[k] % 3) return "has a leaf triangle whose corners repeat";
+  }
   return std::nullopt;
 }
 

@@ -18,7 +18,8 @@ namespace wavetrace::hmq {
 // are later slots of its block, or the first two slots of a later block; the treelets are
 // shallower than the traversal's stack; a leaf names one of its block's records, whose
 // strip table entry exists, whose streams end inside the array, whose vertex slots name
-// decoded vertices, and whose triangle ids are below `triangles`.
+// decoded vertices, whose triangle ids are below `triangles` and whose corner codes name two
+// different corners.
 void check_blocks(std::span<const BvhNode> top, std::span<const std::byte> blocks, std::size_t triangles,
                   const SectionLoader& in);
 
