@@ -6,11 +6,14 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <random>
 
 #include <xxhash.h>
 
 #include "accel/registry.hpp"
+#include "accel/hmq/global_grid.hpp"
+#include "accel/hit_surface.hpp"
 #include "accel/section_archive.hpp"
 #include "memory/section_file.hpp"
 #include "memory/section_writer.hpp"
@@ -291,6 +294,97 @@ TEST_F(DamagedWorld, FlippedBytesAnywhereAreRefusedOrHarmless) {
   }
   EXPECT_GT(refused, 0u);
   EXPECT_EQ(refused + harmless, 300u);
+}
+
+// The world-file fuzz target's findings, each a file whose checksums were re-sealed after a
+// change: before its structure was checked on load, each was a crash or a hang at the first
+// ray. Now each is an error naming the file and the section.
+struct CraftedCase {
+  std::string name;  // the test's
+  std::vector<std::string> settings;
+  std::string section;                      // under accel/
+  std::function<void(char* data)> damage;  // what the crafted file changes in it
+  std::string problem;                      // expected in the error
+};
+
+void PrintTo(const CraftedCase& c, std::ostream* out) { *out << c.name; }
+
+class CraftedWorld : public ::testing::TestWithParam<CraftedCase> {};
+
+template <typename T>
+void poke(char* at, T value) {
+  std::memcpy(at, &value, sizeof value);
+}
+
+TEST_P(CraftedWorld, IsRefusedOnLoadNamingTheSection) {
+  const CraftedCase& c = GetParam();
+  const std::string good = temp_path("crafted_good.wtw"), crafted = temp_path("crafted.wtw");
+  build_and_save(c.settings, good);
+  Resealer world(good);
+  c.damage(world.data("accel/" + c.section));
+  world.seal(crafted);
+  const std::string error = open_error(crafted);
+  EXPECT_NE(error.find(crafted), std::string::npos) << error;
+  EXPECT_NE(error.find("'accel/" + c.section + "'"), std::string::npos) << error;
+  EXPECT_NE(error.find(c.problem), std::string::npos) << "expected '" << c.problem << "' in: " << error;
+  fs::remove(good);
+  fs::remove(crafted);
+}
+
+// Offsets from the formats' comments: BvhNode first at 24 (bvh_node.hpp), WideBvhNode child[0]
+// at 192 and count[0] at 224 (wide_bvh_node.hpp), QuantizedWideNode child_base at 48 and
+// leaf_base at 52 (quantized_wide_node.hpp), an HMQ block's node_slots at 0 (hmq_format.hpp),
+// a strip's triangle count at 0 (ray_strip_format.hpp).
+INSTANTIATE_TEST_SUITE_P(
+    FuzzFindings, CraftedWorld,
+    ::testing::Values(
+        CraftedCase{"BvhChildBeforeItsParent", {"accel.type=bvh"}, "bvh.nodes", [](char* d) { poke<std::uint32_t>(d + 24, 0); },
+                    "node 0 names child 0, which does not lie after it"},
+        CraftedCase{"WideBvhChildPastTheNodes", {"accel.type=bvh", "accel.bvh.width=8"}, "bvh8.nodes",
+                    [](char* d) {
+                      poke<std::uint32_t>(d + 192, 1u << 30);
+                      poke<std::uint8_t>(d + 224, 0);
+                    },
+                    "which does not lie after it"},
+        CraftedCase{"ChunkedTopChildBeforeItsParent", {"accel.type=bvh", "build.chunk_triangles=4096"}, "chunked.top",
+                    [](char* d) { poke<std::uint32_t>(d + 24, 0); }, "does not lie after it"},
+        CraftedCase{"HmqBlockWithoutNodes", {"accel.type=hmq"}, "hmq.blocks", [](char* d) { poke<std::uint8_t>(d, 0); },
+                    "block at word 0: has 0 node and"},
+        CraftedCase{"WideHmqChildAndLeafPastTheirArrays", {"accel.type=hmq", "accel.hmq.width=8"}, "hmq8.nodes",
+                    [](char* d) {
+                      poke<std::uint32_t>(d + 48, 0);
+                      poke<std::uint32_t>(d + 52, 1u << 30);
+                    },
+                    "node 0"},
+        CraftedCase{"StripOfNoTriangles", {"accel.type=raystrips"}, "raystrips.strips", [](char* d) { poke<std::uint16_t>(d, 0); },
+                    "the strip at byte 0 has no triangles"},
+        CraftedCase{"WideRayStripsChildAndLeafPastTheirArrays", {"accel.type=raystrips", "accel.raystrips.width=8"}, "raystrips.wide_nodes",
+                    [](char* d) {
+                      poke<std::uint32_t>(d + 48, 0);
+                      poke<std::uint32_t>(d + 52, 1u << 30);
+                    },
+                    "node 0"}),
+    [](const ::testing::TestParamInfo<CraftedCase>& info) { return info.param.name; });
+
+TEST(CraftedLeaves, GridLinesAndStripCornersStayInRangeForAnyInput) {
+  // A crafted box decoded to NaN or far outside the grid: the line conversion is defined;
+  // a box inside the grid gets the lines it always got.
+  const GlobalGrid grid = grid_from_bits(Bounds3{glm::vec3(0.0f), glm::vec3(1.0f)}, 8);
+  EXPECT_EQ(grid.floor_line(std::numeric_limits<float>::quiet_NaN(), 0), -(1 << 30));
+  EXPECT_EQ(grid.ceil_line(1e30f, 1), 1 << 30);
+  EXPECT_EQ(grid.floor_line(0.5f, 2), int(std::floor((0.5f - grid.origin.z) * grid.inverse_cell.z)));
+  // A corner code of two equal corners (a strip's repeat, or a crafted record) reads corners
+  // of the triangle, not past them (AddressSanitizer, in the sanitizer build, would report
+  // the read past the array); a code of two different corners gives the triangle's plane.
+  const glm::vec3 corners[3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  for (std::uint32_t code = 0; code < 8; ++code) {
+    HitBatch hits(1);
+    hits.set_hit(0, 1.0f, 0, 0.25f, 0.25f);
+    set_surface_from_strip(hits, 0, corners, code);
+    if (code / 3 != code % 3) {
+      EXPECT_FLOAT_EQ(std::fabs(hits.normal_z[0]), 1.0f) << code;
+    }
+  }
 }
 
 TEST(WorldFileCli, BuildRenderAndInfo) {
