@@ -5,8 +5,6 @@
 #include <cstring>
 #include <optional>
 #include <string>
-#include <unordered_map>
-#include <unordered_set>
 
 #include <fmt/format.h>
 
@@ -55,16 +53,20 @@ std::optional<std::string> leaf_record_problem(std::span<const std::byte> bytes,
   return std::nullopt;
 }
 
+// Follows every node once, as a walk from the top leaves would: in a tree each node is
+// reached once, so more visits than the blocks have slots means nodes are shared (a crafted
+// file) and is refused, which also bounds the work. No table of visited nodes is kept: the
+// walk costs one visit of every node and one decode of every leaf record.
 class BlockChecker {
  public:
   BlockChecker(std::span<const std::byte> blocks, std::size_t triangles, const SectionLoader& in)
-      : blocks_(blocks), triangles_(triangles), in_(in) {}
+      : blocks_(blocks), triangles_(triangles), in_(in), visits_left_(blocks.size() / 4) {}
 
   // The treelet of a top leaf: its block's first `roots` slots.
   void check_treelet(std::uint64_t block_word, std::uint32_t roots) {
     const Block block = check_block(block_word);
     if (roots > block.node_slots) fail(block_word, fmt::format("has {} node slots under a top leaf of {} roots", block.node_slots, roots));
-    for (std::uint32_t slot = 0; slot < roots; ++slot) check_node(block_word, slot, 0);
+    for (std::uint32_t slot = 0; slot < roots; ++slot) check_node(block_word, block, slot, 0);
   }
 
  private:
@@ -82,31 +84,24 @@ class BlockChecker {
     return word;
   }
 
-  Block check_block(std::uint64_t block_word) {
+  Block check_block(std::uint64_t block_word) const {
     const std::uint64_t start = block_word * 4;
     if (start + kBlockHeaderBytes > blocks_.size()) fail(block_word, "lies past the blocks");
     const Block block{static_cast<std::uint8_t>(blocks_[start]), static_cast<std::uint8_t>(blocks_[start + 1]),
                       static_cast<std::uint8_t>(blocks_[start + 2])};
-    if (!checked_blocks_.contains(block_word)) {
-      if (block.node_slots == 0 || block.node_slots + block.forward_slots > kMaxBlockSlots) {
-        fail(block_word, fmt::format("has {} node and {} forward slots", block.node_slots, block.forward_slots));
-      }
-      const std::uint64_t tables = kBlockHeaderBytes + 4 * std::uint64_t(block.node_slots + block.forward_slots) +
-                                   2 * std::uint64_t(block.leaves);
-      if (start + tables > blocks_.size()) fail(block_word, "has slots or leaf offsets past the blocks");
-      checked_blocks_.insert(block_word);
+    if (block.node_slots == 0 || block.node_slots + block.forward_slots > kMaxBlockSlots) {
+      fail(block_word, fmt::format("has {} node and {} forward slots", block.node_slots, block.forward_slots));
     }
+    const std::uint64_t tables =
+        kBlockHeaderBytes + 4 * std::uint64_t(block.node_slots + block.forward_slots) + 2 * std::uint64_t(block.leaves);
+    if (start + tables > blocks_.size()) fail(block_word, "has slots or leaf offsets past the blocks");
     return block;
   }
 
-  // A node at `depth` below its treelet's roots; each (node, depth) is followed once, and a
-  // node seen before at this depth or deeper needs nothing more.
-  void check_node(std::uint64_t block_word, std::uint32_t slot, std::uint32_t depth) {
+  // A node `depth` levels below its treelet's roots.
+  void check_node(std::uint64_t block_word, const Block& block, std::uint32_t slot, std::uint32_t depth) {
     if (depth >= kMaxTreeDepth) fail(block_word, fmt::format("holds a treelet deeper than {} levels", kMaxTreeDepth));
-    const std::uint64_t key = block_word << 6 | slot;
-    if (const auto seen = deepest_.find(key); seen != deepest_.end() && seen->second >= depth) return;
-    deepest_[key] = depth;
-    const Block block = check_block(block_word);
+    if (visits_left_-- == 0) fail(block_word, "shares nodes between treelets (more nodes reached than it holds)");
     if (slot >= block.node_slots) fail(block_word, fmt::format("names node slot {} of its {}", slot, block.node_slots));
     const std::uint64_t start = block_word * 4;
     const std::uint32_t word = word_at(start + kBlockHeaderBytes + 4 * slot);
@@ -114,17 +109,19 @@ class BlockChecker {
     if (!is_inner(word)) {
       if (index >= block.leaves) fail(block_word, fmt::format("slot {} names leaf {} of its {}", slot, index, block.leaves));
       std::uint16_t offset;
-      std::memcpy(&offset, blocks_.data() + start + kBlockHeaderBytes + 4 * (block.node_slots + block.forward_slots) + 2 * index,
-                  2);
-      check_record(block_word, start + offset);
+      std::memcpy(&offset,
+                  blocks_.data() + start + kBlockHeaderBytes + 4 * (block.node_slots + block.forward_slots) + 2 * index, 2);
+      if (const std::optional<std::string> problem = leaf_record_problem(blocks_, start + offset, triangles_)) {
+        fail(block_word, *problem);
+      }
       return;
     }
     if (index < block.node_slots) {
       if (index <= slot || index + 1 >= block.node_slots) {
         fail(block_word, fmt::format("slot {} names children at slot {}, not later slots of the block", slot, index));
       }
-      check_node(block_word, index, depth + 1);
-      check_node(block_word, index + 1, depth + 1);
+      check_node(block_word, block, index, depth + 1);
+      check_node(block_word, block, index + 1, depth + 1);
       return;
     }
     if (index - block.node_slots >= block.forward_slots) {
@@ -134,20 +131,14 @@ class BlockChecker {
     if (forward <= block_word) fail(block_word, fmt::format("forwards to block word {}, not a later block", forward));
     const Block child = check_block(forward);
     if (child.node_slots < 2) fail(forward, "holds fewer than the two children forwarded to it");
-    check_node(forward, 0, depth + 1);
-    check_node(forward, 1, depth + 1);
-  }
-
-  void check_record(std::uint64_t block_word, std::uint64_t record) {
-    if (!checked_records_.insert(record).second) return;
-    if (const std::optional<std::string> problem = leaf_record_problem(blocks_, record, triangles_)) fail(block_word, *problem);
+    check_node(forward, child, 0, depth + 1);
+    check_node(forward, child, 1, depth + 1);
   }
 
   std::span<const std::byte> blocks_;
   std::size_t triangles_;
   const SectionLoader& in_;
-  std::unordered_set<std::uint64_t> checked_blocks_, checked_records_;
-  std::unordered_map<std::uint64_t, std::uint32_t> deepest_;
+  std::size_t visits_left_;
 };
 
 }  // namespace
