@@ -8,16 +8,7 @@ cd "$root"
 packages=(build-essential cmake pkg-config libembree-dev libtbb-dev libopenmesh-dev libglm-dev
   libopenexr-dev libimath-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev libgtest-dev
   libbenchmark-dev libpng-dev libfmt-dev libxxhash-dev python3-matplotlib libcgal-demo)
-missing=()
-for package in "${packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" || missing+=("$package")
-done
-if ((${#missing[@]})); then
-  echo "setup: installing ${missing[*]}"
-  export DEBIAN_FRONTEND=noninteractive
-  apt-get update -qq
-  apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
-fi
+bash scripts/install_missing.sh "${packages[@]}"
 
 # Real scanned and CAD meshes (OFF/PLY) from CGAL's demo data, e.g. data/bunny00.off.
 if [[ ! -f data/bunny00.off ]]; then
