@@ -132,10 +132,9 @@ ObjectGeometry load_object_geometry(const std::string& source, const std::filesy
 class TriangleBudget {
  public:
   explicit TriangleBudget(const SceneFileLimits& limits) {
-    constexpr double kBytesPerTriangle = 100.0;
     const std::size_t available = available_memory_bytes();
     left_ = limits.max_triangles > 0 ? double(limits.max_triangles)
-            : available > 0         ? double(available) / kBytesPerTriangle
+            : available > 0         ? double(available) / kSubdividedBytesPerTriangle
                                     : 1e300;
     total_ = left_;
   }

@@ -34,8 +34,8 @@ bool is_scene_file(std::string_view source);  // by its .toml extension
 
 struct SceneFileLimits {
   // The most triangles all objects may make together, after subdivision; an object past it
-  // is refused before it is built. 0: what available memory holds at 100 bytes a triangle
-  // (what subdivided scenes were measured to need, subdivide.cpp).
+  // is refused before it is built. 0: what available memory holds at
+  // kSubdividedBytesPerTriangle (subdivide.hpp).
   std::size_t max_triangles = 0;
 };
 

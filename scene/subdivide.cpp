@@ -81,10 +81,8 @@ TriangleMesh triangles_of_material(const TriangleMesh& mesh, std::uint32_t mater
 }
 
 // Refuses, before anything is allocated, a subdivision whose result cannot be held: OpenMesh
-// numbers its half-edges (three per triangle) with 32-bit ints, and a render of a subdivided
-// mesh peaked at 106-212 bytes per resulting triangle (data/bunny00.off, 2 to 4 levels, hmq,
-// measured by the OS): 100 bytes is taken as the least it needs.
-constexpr double kSubdivisionBytesPerTriangle = 100.0;
+// numbers its half-edges (three per triangle) with 32-bit ints, and the result needs at least
+// kSubdividedBytesPerTriangle a triangle (subdivide.hpp).
 
 void check_subdivision_fits(const TriangleMesh& mesh, int levels) {
   const double triangles = double(mesh.triangle_count()) * std::pow(4.0, levels);
@@ -95,11 +93,11 @@ void check_subdivision_fits(const TriangleMesh& mesh, int levels) {
                                  mesh.triangle_count(), levels, triangles, kMostTriangles));
   }
   const std::size_t available = available_memory_bytes();
-  if (available > 0 && triangles * kSubdivisionBytesPerTriangle > double(available)) {
+  if (available > 0 && triangles * kSubdividedBytesPerTriangle > double(available)) {
     throw SceneError(fmt::format("subdividing {} triangles {} times makes {:.3g} triangles: at least {:.1f} GB, but "
                                  "{:.1f} GB of memory is available; subdivide fewer times",
                                  mesh.triangle_count(), levels, triangles,
-                                 triangles * kSubdivisionBytesPerTriangle * 1e-9, double(available) * 1e-9));
+                                 triangles * kSubdividedBytesPerTriangle * 1e-9, double(available) * 1e-9));
   }
 }
 

@@ -5,6 +5,11 @@
 
 namespace wavetrace {
 
+// The least a subdivided triangle costs to hold and render: a render of a subdivided mesh
+// peaked at 106-212 bytes per resulting triangle (data/bunny00.off, 2 to 4 levels, hmq,
+// measured by the OS). Subdivision and scene files refuse what memory cannot hold at this.
+inline constexpr double kSubdividedBytesPerTriangle = 100.0;
+
 struct SubdivisionResult {
   TriangleMesh mesh;
   std::size_t non_manifold_faces_dropped = 0;  // Loop needs a manifold; these could not enter it
