@@ -356,6 +356,15 @@ INSTANTIATE_TEST_SUITE_P(
                       poke<std::uint32_t>(d + 52, 1u << 30);
                     },
                     "node 0"},
+        CraftedCase{"LeafOfMoreStripsThanFollowIt", {"accel.type=raystrips"}, "raystrips.nodes",
+                    [](char* d) {
+                      for (char* node = d;; node += 32) {  // the first leaf: count with bit 31
+                        std::uint32_t count;
+                        std::memcpy(&count, node + 28, 4);
+                        if (count & 0x80000000u) return poke<std::uint32_t>(node + 28, 0xffffffffu);
+                      }
+                    },
+                    "has a leaf of more strips than follow it"},
         CraftedCase{"StripOfNoTriangles", {"accel.type=raystrips"}, "raystrips.strips", [](char* d) { poke<std::uint16_t>(d, 0); },
                     "the strip at byte 0 has no triangles"},
         CraftedCase{"WideRayStripsChildAndLeafPastTheirArrays", {"accel.type=raystrips", "accel.raystrips.width=8"}, "raystrips.wide_nodes",

@@ -167,22 +167,25 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
       self.stats_ = state.stats;
       if (state.options.width != 2 && state.options.width != 8) a.fail("raystrips.state", "holds a top width other than 2 or 8");
       if (state.options.width == 2 && self.nodes_.empty()) a.fail("raystrips.nodes", "is empty: no raystrips structure was saved");
-      // The binary top is checked whole; the strips under it only where each leaf starts
-      // (their own decoding trusts the checksums: see tree_check.hpp).
+      // Every top and every strip a traversal reads is checked (tree_check.hpp, strip_check.hpp).
       const std::span<const std::byte> strip_bytes(self.strip_bytes_.data(), self.strip_bytes_.size());
-      // Each strip from `at`: `count` of them, or those starting before byte `end`.
+      // The strips a leaf's traversal reads from byte `at`: `count` of them (binary top), or
+      // those starting before byte `end` (8-wide top, count kUntilEnd).
+      constexpr std::uint64_t kUntilEnd = ~std::uint64_t{0};
       const auto check_strips = [&](std::uint64_t at, std::uint64_t count, std::uint64_t end) {
-        for (std::uint64_t s = 0; s < count && at < end; ++s) {
+        std::uint64_t s = 0;
+        for (; s < count && at < end; ++s) {
           std::size_t size = 0;
           const auto problem = ray_strip::strip_problem(strip_bytes, at, self.positions_.size(), self.triangles_, size);
           if (problem) a.fail("raystrips.strips", *problem);
           at += size;
         }
+        if (count != kUntilEnd && s < count) a.fail("raystrips.nodes", "has a leaf of more strips than follow it");
       };
       if (state.options.width == 2) {
         check_tree(std::span<const BvhNode>(self.nodes_.data(), self.nodes_.size()), a, "raystrips.nodes",
                    [&](const BvhNode& leaf) {
-                     check_strips(std::uint64_t(leaf.first) * 4, leaf.triangle_count(), strip_bytes.size() + 1);
+                     check_strips(std::uint64_t(leaf.first) * 4, leaf.triangle_count(), strip_bytes.size());
                    });
       }
       if (state.options.width == 8 && (self.wide_nodes_.empty() || self.leaf_words_.size() < 2)) {
@@ -201,7 +204,7 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
               std::uint64_t(self.leaf_words_[l + 1]) * 4 > self.strip_bytes_.size()) {
             a.fail("raystrips.leaf_words", "names strips out of order or past the strip bytes");
           }
-          check_strips(std::uint64_t(self.leaf_words_[l]) * 4, ~std::uint64_t{0}, std::uint64_t(self.leaf_words_[l + 1]) * 4);
+          check_strips(std::uint64_t(self.leaf_words_[l]) * 4, kUntilEnd, std::uint64_t(self.leaf_words_[l + 1]) * 4);
         }
       }
       if (state.options.run_triangles < 2 || state.options.run_triangles > 64 || state.options.packet_min_active < 1 ||
