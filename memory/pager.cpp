@@ -36,6 +36,9 @@ MemoryBudget parse_memory_budget(std::string_view text) {
                                                        {"MB", 1e6},      {"GB", 1e9}};
   for (const auto& [name, scale] : units) {
     if (unit == name) {
+      // Past 2^62 bytes no machine has it, and the conversion below would be undefined
+      // (a fuzz finding: "1888...888B").
+      if (value * scale > 0x1p62) return fail();
       budget.is_share = false;
       budget.bytes = static_cast<std::size_t>(value * scale);
       return budget.bytes > 0 ? budget : fail();
