@@ -331,6 +331,13 @@ TEST_P(CraftedWorld, IsRefusedOnLoadNamingTheSection) {
   fs::remove(crafted);
 }
 
+// The quantized 8-wide root's first inner child made itself and its leaves past 2^30: the same
+// damage for HMQ's and Ray-Strips' wide tops, which share the node.
+void point_wide_node_past_its_arrays(char* node) {
+  poke<std::uint32_t>(node + 48, 0);        // child_base
+  poke<std::uint32_t>(node + 52, 1u << 30);  // leaf_base
+}
+
 // Offsets from the formats' comments: BvhNode first at 24 (bvh_node.hpp), WideBvhNode child[0]
 // at 192 and count[0] at 224 (wide_bvh_node.hpp), QuantizedWideNode child_base at 48 and
 // leaf_base at 52 (quantized_wide_node.hpp), an HMQ block's node_slots at 0 (hmq_format.hpp),
@@ -351,10 +358,7 @@ INSTANTIATE_TEST_SUITE_P(
         CraftedCase{"HmqBlockWithoutNodes", {"accel.type=hmq"}, "hmq.blocks", [](char* d) { poke<std::uint8_t>(d, 0); },
                     "block at word 0: has 0 node and"},
         CraftedCase{"WideHmqChildAndLeafPastTheirArrays", {"accel.type=hmq", "accel.hmq.width=8"}, "hmq8.nodes",
-                    [](char* d) {
-                      poke<std::uint32_t>(d + 48, 0);
-                      poke<std::uint32_t>(d + 52, 1u << 30);
-                    },
+                    point_wide_node_past_its_arrays,
                     "node 0"},
         CraftedCase{"LeafOfMoreStripsThanFollowIt", {"accel.type=raystrips"}, "raystrips.nodes",
                     [](char* d) {
@@ -368,10 +372,7 @@ INSTANTIATE_TEST_SUITE_P(
         CraftedCase{"StripOfNoTriangles", {"accel.type=raystrips"}, "raystrips.strips", [](char* d) { poke<std::uint16_t>(d, 0); },
                     "the strip at byte 0 has no triangles"},
         CraftedCase{"WideRayStripsChildAndLeafPastTheirArrays", {"accel.type=raystrips", "accel.raystrips.width=8"}, "raystrips.wide_nodes",
-                    [](char* d) {
-                      poke<std::uint32_t>(d + 48, 0);
-                      poke<std::uint32_t>(d + 52, 1u << 30);
-                    },
+                    point_wide_node_past_its_arrays,
                     "node 0"}),
     [](const ::testing::TestParamInfo<CraftedCase>& info) { return info.param.name; });
 
