@@ -13,17 +13,23 @@ namespace wavetrace {
 
 std::vector<std::string> accelerator_names() { return {"embree", "bvh", "raystrips", "hmq", "grid", "mlgrid", "arraygrid"}; }
 
-double estimated_bytes_per_triangle(const std::string& type) {
-  if (type == "embree") return 83.0;
-  if (type == "bvh") return 56.0;
-  if (type == "raystrips") return 26.0;  // measured 22.1 on room:8M, 23.5 on 64M, 25.7 on 256M
-  if (type == "hmq") return 10.0;
-  return 60.0;  // the grids: cells and lists vary with the scene; about the bvh's
+double estimated_bytes_per_triangle(const AcceleratorOptions& options) {
+  const std::string& type = options.type;
+  // The largest of the README's tables (room, subdivided scans; chunked room up to 256M).
+  if (type == "embree") return options.embree.mode == EmbreeMode::compact ? 78.0 : 87.0;
+  if (type == "bvh") return options.bvh.width == 8 ? 74.0 : 60.0;
+  if (type == "raystrips") return options.raystrips.width == 8 ? 22.0 : 26.0;  // binary: 22.1 on room:8M, 25.7 on 256M
+  if (type == "hmq") return 12.5;
+  if (type == "arraygrid") return 230.0;  // 224 on builtin:sphere:1M
+  return 48.0;  // grid, mlgrid: cells and lists vary with the scene; 44 on builtin:sphere:1M
 }
 
 double estimated_build_bytes_per_triangle(const std::string& type) {
   // Embree's builder (its allocation monitor and VmHWM agree: ~15 B/tri on room:64M); ours
   // are the binned SAH build's arrays (165 B/tri measured on a monolithic room:64M).
+  // The grids' counting build holds a count per cell and the lists' positions (bench accel
+  // saw no VmHWM rise above its start on builtin:sphere:1M): bounded here by a cell count.
+  if (type == "grid" || type == "mlgrid") return 24.0;
   return type == "embree" ? 15.0 : 170.0;
 }
 

@@ -43,11 +43,11 @@ std::unique_ptr<Accelerator> load_accelerator(SectionLoader& in);
 // others (embree, the grids) are rebuilt from the world's saved geometry when it is loaded.
 bool saves_structure(const std::string& type);
 
-// What a type's finished structure costs per triangle on builtin:room, and what its build
-// holds beyond it per triangle built at once (a chunk, where the type builds in chunks),
-// both measured (README, "Memory at scale"): for refusing a scene that will not fit before
-// building it.
-double estimated_bytes_per_triangle(const std::string& type);
+// What an accelerator's finished structure costs per triangle (the most measured on the
+// README's scenes), and what its build holds beyond it per triangle built at once (a chunk,
+// where the type builds in chunks; README, "Memory at scale"): for refusing a scene that will
+// not fit, and for accel.type = auto, before building it.
+double estimated_bytes_per_triangle(const AcceleratorOptions& options);
 double estimated_build_bytes_per_triangle(const std::string& type);
 
 // Types that can be built chunk by chunk under a top-level BVH.

@@ -62,6 +62,7 @@ BenchSetup prepare(const BenchArguments& args) {
     return setup;
   }
   setup.loaded_scene = load_scene(plan_render(setup.config).scene);
+  for (AcceleratorSpec& spec : setup.accelerators) resolve_accelerator_spec(spec, setup.loaded_scene, setup.config);
   return setup;
 }
 
@@ -212,6 +213,7 @@ struct ImageArguments {
   std::string size = "320x240";
   int spp = 4;
   int threads = 0;
+  bool noise = false;
   std::string json;
   std::vector<std::string> assignments;
 };
@@ -220,7 +222,7 @@ int run_image(const ImageArguments& args) {
   const Config config = render_bench_config({}, args.assignments, args.scene, args.spp, args.threads, args.size);
   std::vector<AcceleratorSpec> accelerators;
   for (const std::string& text : split_commas(args.accel)) accelerators.push_back(parse_accelerator_spec(text, config));
-  const ImageBenchReport report = run_image_bench(config, accelerators);
+  const ImageBenchReport report = run_image_bench(config, accelerators, args.noise);
   fmt::print("{}", to_table(report));
   if (!args.json.empty()) write_text(args.json, to_json(report).dump(2) + "\n");
   return 0;
@@ -306,6 +308,8 @@ void add_bench_command(CLI::App& app, int& exit_code) {
   image->add_option("--spp", image_args->spp, "samples per pixel");
   image->add_option("--size", image_args->size, "image size as WIDTHxHEIGHT");
   image->add_option("--threads", image_args->threads, "worker threads (0: all cores)");
+  image->add_flag("--noise", image_args->noise,
+                  "also render the first accelerator with render.seed + 1: its RMSE is the Monte Carlo noise");
   image->add_option("--json", image_args->json, "write results as JSON");
   add_set_option(image, image_args->assignments, "render.max_depth=2");
   image->callback([image_args, &exit_code] { exit_code = run_image(*image_args); });

@@ -43,15 +43,24 @@ int run_build(const BuildArguments& args) {
   if (!is_world_file(args.out)) throw ConfigError(fmt::format("--out {}: a world file is named *.wtw", args.out));
   RenderPlan plan = plan_render(config);
   if (is_world_file(plan.scene.source)) throw ConfigError(fmt::format("{} is already a world", plan.scene.source));
-  const std::string& type = plan.accelerator.type;
   const bool with_proxy = args.proxy || plan.needs_proxy();
 
   // As render does: an accelerator holding its own geometry is built from a streamed scene
   // (never whole) unless the proxy, simplified from the whole mesh, is wanted.
-  plan.scene.streamed = holds_own_geometry(type) && !with_proxy;
-  check_scene_fits(plan);
   const auto load_start = std::chrono::steady_clock::now();
-  Scene scene = load_scene(plan.scene);
+  SceneForWorld loaded = load_scene_for_world(plan, with_proxy);
+  Scene& scene = loaded.scene;
+  plan.accelerator = loaded.accelerator.options;
+  const std::string& type = plan.accelerator.type;
+  if (const std::string line = resolution_summary(loaded.accelerator); !line.empty()) fmt::print("{}\n", line);
+  // The world records what was built, not what chose it.
+  const AcceleratorOptions& built = plan.accelerator;
+  config.set_value("accel.type", type);
+  if (type == "hmq" && built.hmq.epsilon > 0.0) config.set_value("accel.hmq.epsilon", built.hmq.epsilon);
+  if (type == "hmq") config.set_value("accel.hmq.width", std::int64_t{built.hmq.width});
+  if (type == "bvh") config.set_value("accel.bvh.width", std::int64_t{built.bvh.width});
+  if (type == "raystrips") config.set_value("accel.raystrips.width", std::int64_t{built.raystrips.width});
+  if (type == "embree") config.set_value("accel.embree.mode", to_string(built.embree.mode));
   WorldBuildInfo info;
   info.scene_seconds = seconds_since(load_start);
   const auto build_start = std::chrono::steady_clock::now();

@@ -51,7 +51,7 @@ Config build_config(const RenderArguments& args) {
 
 // Renders through the pipeline and writes the image, the report and the stats.
 int finish_render(const RenderArguments& args, const RenderPlan& plan, const Scene& scene, const World& world,
-                  const Camera& camera, RenderPhases measured) {
+                  const Camera& camera, RenderPhases measured, const AccelChoice* choice = nullptr) {
   ProgressLine progress(stderr);
   const RenderOutput output =
       render_image(plan, world, camera, progress.enabled() ? [&](const Progress& p) { progress.update(p); }
@@ -64,7 +64,7 @@ int finish_render(const RenderArguments& args, const RenderPlan& plan, const Sce
   const std::string preview = preview_path_for(args.out);
   write_png_preview(preview, plan.image.width, plan.image.height, output.image);
 
-  const RenderFacts facts{scene, world.accelerator, plan, output, args.out, world.proxy, measured};
+  const RenderFacts facts{scene, world.accelerator, plan, output, args.out, world.proxy, measured, choice};
   fmt::print("{}: {} triangles, {} vertices{}\n", scene.name, scene.triangle_count, scene.vertex_count,
              scene.cleanup.degenerate_dropped ? fmt::format(", {} degenerate dropped", scene.cleanup.degenerate_dropped)
                                               : std::string());
@@ -96,19 +96,19 @@ int render_world(const RenderArguments& args, RenderPlan plan) {
   return finish_render(args, plan, loaded.scene, world, camera, measured);
 }
 
-int render_scene(const RenderPlan& plan, const RenderArguments& args, std::string& activity) {
+int render_scene(const RenderPlan& requested, const RenderArguments& args, std::string& activity) {
   RenderPhases measured;
-  // An accelerator that holds its own geometry never needs the whole mesh: a builtin scene
-  // is then generated a chunk at a time as it is built. The proxy is simplified from the mesh.
-  RenderPlan load_plan = plan;
-  load_plan.scene.streamed = holds_own_geometry(plan.accelerator.type) && !plan.needs_proxy();
-  check_scene_fits(load_plan);
+  RenderPlan plan = requested;
   activity = fmt::format("loading {}", plan.scene.source);
   const auto load_start = std::chrono::steady_clock::now();
-  Scene scene = load_scene(load_plan.scene);
+  SceneForWorld loaded = load_scene_for_world(plan, plan.needs_proxy());
+  Scene& scene = loaded.scene;
+  const Camera& camera = loaded.camera;
+  const ResolvedAccelerator& resolved = loaded.accelerator;
+  plan.accelerator = resolved.options;
+  if (const std::string line = resolution_summary(resolved); !line.empty()) fmt::print("{}\n", line);
   measured.load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
   measured.after_load_bytes = read_resident_memory().current_bytes;
-  const Camera camera = resolve_camera(plan.camera, scene);
   activity = fmt::format("building '{}' over {} triangles", plan.accelerator.type, scene.triangle_count);
   const std::unique_ptr<Accelerator> accelerator = build_world_accelerator(scene, plan.accelerator);
   const LightSampler lights(scene);
@@ -118,7 +118,7 @@ int render_scene(const RenderPlan& plan, const RenderArguments& args, std::strin
   measured.after_build_bytes = read_resident_memory().current_bytes;
   const World world{scene, *accelerator, lights, proxy.get()};
   activity = fmt::format("rendering {}x{} at {} spp", plan.image.width, plan.image.height, plan.image.samples_per_pixel);
-  return finish_render(args, plan, scene, world, camera, measured);
+  return finish_render(args, plan, scene, world, camera, measured, resolved.choice ? &*resolved.choice : nullptr);
 }
 
 int run_render(const RenderArguments& args) {

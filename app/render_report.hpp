@@ -29,6 +29,7 @@ struct RenderFacts {
   std::string image_path;
   const Proxy* proxy = nullptr;
   RenderPhases phases;
+  const AccelChoice* accel_choice = nullptr;  // accel.type = auto: its candidates and reasons
 };
 
 nlohmann::json proxy_json(const Proxy& proxy);

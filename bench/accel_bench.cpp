@@ -58,8 +58,12 @@ void apply_accelerator_spec(Config& config, const std::string& text) {
     if (option.find('=') == std::string::npos) {
       throw ConfigError(fmt::format("--accel '{}': '{}' is not key=value", text, option));
     }
-    // chunk_triangles is the build's, not the type's: hmq:chunk_triangles=1048576 builds in chunks.
-    config.set((option.starts_with("chunk_triangles=") ? "build." : "accel." + type + ".") + option);
+    // chunk_triangles is the build's, not the type's: hmq:chunk_triangles=1048576 builds in
+    // chunks; auto's keys are accel.memory_budget and accel.max_error.
+    const std::string section = option.starts_with("chunk_triangles=") ? "build."
+                                : type == "auto"                        ? "accel."
+                                                                        : "accel." + type + ".";
+    config.set(section + option);
     colon = next;
   }
 }
@@ -67,7 +71,20 @@ void apply_accelerator_spec(Config& config, const std::string& text) {
 AcceleratorSpec parse_accelerator_spec(const std::string& text, const Config& base) {
   Config config = base;
   apply_accelerator_spec(config, text);
-  return {text, accelerator_options(config)};
+  return {text, accelerator_options(config), accel_goal(config)};
+}
+
+void resolve_accelerator_spec(AcceleratorSpec& spec, const Scene& scene, const Config& base) {
+  if (!spec.goal.automatic && !(spec.goal.hmq_epsilon_pixel && spec.options.type == "hmq")) return;
+  if (scene.streamed()) throw ConfigError(fmt::format("--accel {}: needs the scene's mesh", spec.label));
+  const RenderPlan plan = plan_render(base);
+  const MeshTriangleSource source(scene.mesh);
+  const ResolvedAccelerator resolved = resolve_accelerator(spec.options, spec.goal, source,
+                                                           resolve_camera(plan.camera, scene), plan.image, false);
+  spec.options = resolved.options;
+  spec.label = resolved.choice ? fmt::format("{} ({})", spec.label, resolved.choice->spec)
+                               : fmt::format("{} ({:.4g})", spec.label, spec.options.hmq.epsilon);
+  spec.goal = AccelGoal{};
 }
 
 // For a lossy accelerator: the distance of each hit point (origin + t direction) from the

@@ -11,18 +11,25 @@
 #include "accel/registry.hpp"
 #include "bench/ray_sets.hpp"
 #include "scene/scene.hpp"
+#include "stages/accel_choice.hpp"
 #include "stages/config.hpp"
 #include "stages/memory_observation.hpp"
 
 namespace wavetrace {
 
 // "TYPE[:key=value]..." where each key is accel.TYPE.key, e.g. "bvh:layout=veb:leaf_size=8",
-// "embree:mode=robust"; other keys come from `base`. Throws ConfigError naming bad parts.
+// "embree:mode=robust"; "auto[:memory_budget=..][:max_error=..]" sets accel.type = auto and
+// its accel.* keys; other keys come from `base`. Throws ConfigError naming bad parts.
 struct AcceleratorSpec {
   std::string label;
   AcceleratorOptions options;
+  AccelGoal goal;  // auto or a pixel epsilon: resolved on the scene by resolve_accelerator_spec
 };
 AcceleratorSpec parse_accelerator_spec(const std::string& text, const Config& base);
+// Resolves auto or hmq:epsilon=pixel against `scene`, its camera (or camera.* of `base`) and
+// render.width x render.height of `base`; the label then names what it came to, as
+// "auto (hmq:width=8:epsilon=0.00123)". Other specs are left as they are.
+void resolve_accelerator_spec(AcceleratorSpec& spec, const Scene& scene, const Config& base);
 // Sets the keys a TYPE[:key=value]... spec names (accel.type, accel.TYPE.key, build.chunk_triangles).
 void apply_accelerator_spec(Config& config, const std::string& text);
 
@@ -76,7 +83,7 @@ struct AccelBenchReport {
 
 struct AccelBenchRequest {
   std::vector<AcceleratorSpec> accelerators;
-  AcceleratorSpec reference{"embree", AcceleratorOptions{}};  // accuracy is measured against it
+  AcceleratorSpec reference{"embree", AcceleratorOptions{}, AccelGoal{}};  // accuracy is measured against it
   RaySetKind rays = RaySetKind::primary;
   std::size_t count = 1 << 20;
   int threads = 0;

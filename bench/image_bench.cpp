@@ -12,10 +12,17 @@
 
 namespace wavetrace {
 
-ImageBenchReport run_image_bench(const Config& config, const std::vector<AcceleratorSpec>& accelerators) {
+ImageBenchReport run_image_bench(const Config& config, std::vector<AcceleratorSpec> accelerators, bool noise_floor) {
   if (accelerators.empty()) throw ConfigError("--accel names no accelerator");
   const RenderPlan plan = plan_render(config);
   const Scene scene = load_scene(plan.scene);
+  for (AcceleratorSpec& spec : accelerators) resolve_accelerator_spec(spec, scene, config);
+  // The Monte Carlo noise: the reference again with the next seed's samples.
+  RenderPlan reseeded = plan;
+  ++reseeded.image.seed;
+  std::vector<std::pair<const AcceleratorSpec*, const RenderPlan*>> renders;
+  for (const AcceleratorSpec& spec : accelerators) renders.emplace_back(&spec, &plan);
+  if (noise_floor) renders.emplace_back(&accelerators.front(), &reseeded);
   const Camera camera = resolve_camera(plan.camera, scene);
   const LightSampler lights(scene);
   ImageBenchReport report;
@@ -25,14 +32,15 @@ ImageBenchReport run_image_bench(const Config& config, const std::vector<Acceler
                              plan.image.samples_per_pixel, plan.rules.max_depth);
   std::vector<float> reference;
   double reference_mean = 0.0;
-  for (const AcceleratorSpec& spec : accelerators) {
+  for (const auto& [spec, render_plan] : renders) {
     // Hits carry the surface the accelerator answers for: a lossy one's renders shade it.
-    const auto accelerator = build_world_accelerator(scene, spec.options);
+    const auto accelerator = build_world_accelerator(scene, spec->options);
     const World world{scene, *accelerator, lights, nullptr};
-    const RenderOutput output = render_image(plan, world, camera);
+    const RenderOutput output = render_image(*render_plan, world, camera);
     report.threads = output.run.threads;
     ImageBenchResult result;
-    result.label = spec.label;
+    result.label = render_plan == &plan ? spec->label : fmt::format("{}, seed {}", spec->label, render_plan->image.seed);
+    result.noise_floor = render_plan != &plan;
     result.bytes_per_triangle = double(accelerator->memory().total()) / double(scene.mesh.triangle_count());
     result.build_seconds = accelerator->build().seconds;
     result.render_seconds = output.run.seconds;
@@ -68,7 +76,8 @@ nlohmann::json to_json(const ImageBenchReport& report) {
                        {"rmse", r.rmse},
                        {"relative_rmse", r.relative_rmse},
                        {"max_difference", r.max_difference},
-                       {"build_notes", r.notes}});
+                       {"build_notes", r.notes},
+                       {"noise_floor", r.noise_floor}});
   }
   return {{"scene", {{"source", report.scene}, {"triangles", report.triangles}}},
           {"image", report.image},

@@ -23,6 +23,7 @@ struct ImageBenchResult {
   double relative_rmse = 0.0;        // rmse over the first image's mean channel value
   double max_difference = 0.0;       // largest channel difference
   std::string notes;                 // the accelerator's build notes
+  bool noise_floor = false;          // the reference with other samples: its rmse is Monte Carlo noise
 };
 
 struct ImageBenchReport {
@@ -34,8 +35,10 @@ struct ImageBenchReport {
 };
 
 // `config` holds the scene, camera and render settings; the first accelerator's image is
-// the reference. Throws ConfigError for an empty list.
-ImageBenchReport run_image_bench(const Config& config, const std::vector<AcceleratorSpec>& accelerators);
+// the reference. With `noise_floor`, the reference is rendered again with render.seed + 1:
+// the difference no accelerator can be told from. Throws ConfigError for an empty list.
+ImageBenchReport run_image_bench(const Config& config, std::vector<AcceleratorSpec> accelerators,
+                                 bool noise_floor = false);
 
 nlohmann::json to_json(const ImageBenchReport& report);
 std::string to_table(const ImageBenchReport& report);

@@ -35,6 +35,11 @@ const ConfigKey& require_key(std::string_view name) {
                                               : fmt::format(" (known in this section: {})", known)));
 }
 
+// A number key whose schema lists choices takes those words too ("pixel"), held as text.
+bool is_word_of(const ConfigKey& key, const std::string& text) {
+  return key.type == ConfigType::real && std::find(key.choices.begin(), key.choices.end(), text) != key.choices.end();
+}
+
 std::string_view type_name(ConfigType type) {
   switch (type) {
     case ConfigType::boolean: return "true or false";
@@ -44,6 +49,14 @@ std::string_view type_name(ConfigType type) {
     case ConfigType::vector3: return "three numbers";
     default: return "a list of strings";
   }
+}
+
+// ", or pixel" for a number key that also takes words.
+std::string words_of(const ConfigKey& key) {
+  std::string words;
+  if (key.type != ConfigType::real) return words;
+  for (const std::string& choice : key.choices) words += fmt::format(", or '{}'", choice);
+  return words;
 }
 
 std::string trim(std::string_view text) {
@@ -87,7 +100,7 @@ std::optional<Number> parse_number(const std::string& text) {
 ConfigValue parse_text_value(const ConfigKey& key, const std::string& raw) {
   const std::string text = trim(raw);
   const auto fail = [&]() -> ConfigValue {
-    throw ConfigError(fmt::format("{} = '{}': expected {}", key.name, text, type_name(key.type)));
+    throw ConfigError(fmt::format("{} = '{}': expected {}{}", key.name, text, type_name(key.type), words_of(key)));
   };
   switch (key.type) {
     case ConfigType::boolean:
@@ -99,6 +112,7 @@ ConfigValue parse_text_value(const ConfigKey& key, const std::string& raw) {
       return fail();
     case ConfigType::real:
       if (auto value = parse_number<double>(text)) return *value;
+      if (is_word_of(key, unquote(text))) return unquote(text);
       return fail();
     case ConfigType::text: return unquote(text);
     case ConfigType::vector3: {
@@ -118,7 +132,7 @@ ConfigValue parse_text_value(const ConfigKey& key, const std::string& raw) {
 
 ConfigValue from_toml(const ConfigKey& key, const toml::node& node) {
   const auto fail = [&]() -> ConfigValue {
-    throw ConfigError(fmt::format("{}: expected {}", key.name, type_name(key.type)));
+    throw ConfigError(fmt::format("{}: expected {}{}", key.name, type_name(key.type), words_of(key)));
   };
   switch (key.type) {
     case ConfigType::boolean:
@@ -129,6 +143,7 @@ ConfigValue from_toml(const ConfigKey& key, const toml::node& node) {
       return fail();
     case ConfigType::real:
       if (node.is_number()) return *node.value<double>();
+      if (auto word = node.value_exact<std::string>(); word && is_word_of(key, *word)) return *word;
       return fail();
     case ConfigType::text:
       if (auto value = node.value_exact<std::string>()) return *value;
@@ -242,7 +257,8 @@ void Config::set_value(std::string_view name, ConfigValue value) {
   if (key.type == ConfigType::real) {
     if (const auto* integer = std::get_if<std::int64_t>(&value)) value = double(*integer);
   }
-  if (value.index() != static_cast<std::size_t>(key.type)) {
+  const bool word = std::holds_alternative<std::string>(value) && is_word_of(key, std::get<std::string>(value));
+  if (value.index() != static_cast<std::size_t>(key.type) && !word) {
     throw ConfigError(fmt::format("{}: expected {}", key.name, type_name(key.type)));
   }
   check_limits(key, value);
@@ -284,7 +300,18 @@ bool Config::boolean(std::string_view key) const { return std::get<bool>(value(k
 std::int64_t Config::integer(std::string_view key) const {
   return std::get<std::int64_t>(value(key, ConfigType::integer));
 }
-double Config::real(std::string_view key) const { return std::get<double>(value(key, ConfigType::real)); }
+double Config::real(std::string_view key) const {
+  const ConfigValue& held = value(key, ConfigType::real);
+  if (const auto* word = std::get_if<std::string>(&held)) {
+    throw ConfigError(fmt::format("{} = '{}': a number is needed here", key, *word));
+  }
+  return std::get<double>(held);
+}
+std::optional<std::string> Config::word(std::string_view key) const {
+  const ConfigValue& held = value(key, ConfigType::real);
+  if (const auto* word = std::get_if<std::string>(&held)) return *word;
+  return std::nullopt;
+}
 const std::string& Config::text(std::string_view key) const {
   return std::get<std::string>(value(key, ConfigType::text));
 }

@@ -30,7 +30,8 @@ struct ConfigKey {
   ConfigType type;
   std::optional<ConfigValue> default_value;  // none: unset unless given
   double min = 0.0, max = 0.0;               // integer and real keys
-  std::vector<std::string> choices;          // text keys (and list items) limited to these
+  std::vector<std::string> choices;          // text keys (and list items) limited to these;
+                                             // number keys also take these words
   std::string help;
 };
 
@@ -60,7 +61,9 @@ class Config {
   std::string assignment(std::string_view key) const;
   bool boolean(std::string_view key) const;
   std::int64_t integer(std::string_view key) const;
-  double real(std::string_view key) const;
+  double real(std::string_view key) const;  // throws ConfigError when the key holds a word
+  // The word a number key holds instead of a number (accel.max_error = "pixel"), if any.
+  std::optional<std::string> word(std::string_view key) const;
   const std::string& text(std::string_view key) const;
   glm::vec3 vector3(std::string_view key) const;
   const std::vector<std::string>& text_list(std::string_view key) const;

@@ -25,6 +25,9 @@ const std::vector<ConfigKey>& config_schema() {
       {"render.width", T::integer, std::int64_t{640}, 1, 16384, {}, "image width in pixels"},
       {"render.height", T::integer, std::int64_t{480}, 1, 16384, {}, "image height in pixels"},
       {"render.spp", T::integer, std::int64_t{8}, 1, 65536, {}, "samples per pixel"},
+      {"render.seed", T::integer, std::int64_t{0}, 0, 1 << 20, {},
+       "which samples are drawn: seed k draws samples k*spp .. (k+1)*spp - 1 of each pixel (another seed, "
+       "independent noise)"},
       {"render.max_depth", T::integer, std::int64_t{5}, 0, 64, {},
        "most bounces of a path (0: direct light only)"},
       {"render.russian_roulette_depth", T::integer, std::int64_t{3}, 0, 64, {},
@@ -40,7 +43,15 @@ const std::vector<ConfigKey>& config_schema() {
       {"render.pixel_order", T::text, std::string("scanline"), 0, 0, {"scanline", "zcurve"},
        "order in which camera rays are generated"},
 
-      {"accel.type", T::text, std::string("embree"), 0, 0, {"embree", "bvh", "raystrips", "hmq", "grid", "mlgrid", "arraygrid"}, "main accelerator"},
+      {"accel.type", T::text, std::string("embree"), 0, 0,
+       {"embree", "bvh", "raystrips", "hmq", "grid", "mlgrid", "arraygrid", "auto"},
+       "main accelerator (auto: the fastest that fits accel.memory_budget and meets accel.max_error)"},
+      {"accel.memory_budget", T::text, std::string("available"), 0, 0, {},
+       "what accel.type = auto may spend on the world (structure, mesh, build): bytes ('8GB', '512MiB'), a share "
+       "of the memory available now ('50%'), or 'available' (what is available now, less 10%)"},
+      {"accel.max_error", T::real, std::string("pixel"), 0.0, 1e30, {"pixel"},
+       "largest hit-point error accel.type = auto may accept, in scene units (0: exact methods only), or pixel: half "
+       "a pixel's footprint at the nearest surface in view"},
       {"accel.embree.mode", T::text, std::string("default"), 0, 0, {"default", "compact", "robust"},
        "Embree scene flags"},
       {"accel.embree.queries", T::text, std::string("stream"), 0, 0, {"single", "stream"},
@@ -81,8 +92,9 @@ const std::vector<ConfigKey>& config_schema() {
       {"accel.raystrips.packet_min_active", T::integer, std::int64_t{2}, 1, 4, {},
        "below this many active rays a packet continues as single rays"},
       {"accel.hmq.bits", T::integer, std::int64_t{16}, 1, 24, {}, "global grid bits per axis (the paper: 16)"},
-      {"accel.hmq.epsilon", T::real, 0.0, 0.0, 1e30, {},
-       "error bound in scene units instead of bits (0: unset); the grid is the coarsest that keeps every vertex within it"},
+      {"accel.hmq.epsilon", T::real, 0.0, 0.0, 1e30, {"pixel"},
+       "error bound in scene units instead of bits (0: unset), or pixel: half a pixel's footprint at the nearest "
+       "surface in view; the grid is the coarsest that keeps every vertex within it"},
       {"accel.hmq.leaf_size", T::integer, std::int64_t{8}, 1, 14, {}, "most triangles per leaf (the paper: 4, 8, 12)"},
       {"accel.hmq.top_fraction", T::real, 0.05, 0.0, 1.0, {},
        "share of the BVH's nodes kept uncompressed at the top (width 2 only)"},

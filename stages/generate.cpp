@@ -65,7 +65,8 @@ std::size_t GenerateStage::fill(RayBatch& rays) {
   return claimed.count;
 }
 
-void GenerateStage::write_camera_ray(RayBatch& rays, std::size_t slot, std::uint32_t pixel, std::uint32_t sample) const {
+void GenerateStage::write_camera_ray(RayBatch& rays, std::size_t slot, std::uint32_t pixel, std::uint32_t image_sample) const {
+  const std::uint32_t sample = image_sample + image_.seed * image_.samples_per_pixel;
   const std::uint64_t path = path_key(pixel, sample);
   const float jitter_x = unit_float32(path_draw(path, 0, RandomPurpose::pixel_jitter, 0));
   const float jitter_y = unit_float32(path_draw(path, 0, RandomPurpose::pixel_jitter, 1));

@@ -20,6 +20,9 @@ struct ImageSpec {
   std::uint32_t width = 640;
   std::uint32_t height = 480;
   std::uint32_t samples_per_pixel = 8;
+  // Samples are numbered from seed * samples_per_pixel: each path's draws hang on its
+  // (pixel, sample), so another seed draws independent samples of the same image.
+  std::uint32_t seed = 0;
   std::uint32_t pixel_count() const { return width * height; }
 };
 

@@ -2,6 +2,7 @@
 #include "stages/render_setup.hpp"
 
 #include <algorithm>
+#include <limits>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -114,7 +115,8 @@ AcceleratorOptions accelerator_options(const Config& config) {
   options.raystrips.bins = options.bvh.bins;
   options.raystrips.width = static_cast<std::uint32_t>(config.integer("accel.raystrips.width"));
   options.hmq.bits = static_cast<std::uint32_t>(config.integer("accel.hmq.bits"));
-  options.hmq.epsilon = config.real("accel.hmq.epsilon");
+  // "pixel" is resolved against the camera once the scene is loaded (resolve_accelerator).
+  options.hmq.epsilon = config.word("accel.hmq.epsilon") ? 0.0 : config.real("accel.hmq.epsilon");
   options.hmq.leaf_size = static_cast<std::uint32_t>(config.integer("accel.hmq.leaf_size"));
   options.hmq.top_fraction = config.real("accel.hmq.top_fraction");
   options.hmq.width = static_cast<std::uint32_t>(config.integer("accel.hmq.width"));
@@ -157,7 +159,8 @@ std::unique_ptr<Accelerator> build_world_accelerator(const Scene& scene, const A
 
 void check_scene_fits(const RenderPlan& plan) {
   const std::string& source = plan.scene.source;
-  if (!is_builtin_scene(source) || plan.scene.subdivide > 0) return;
+  // accel.type = auto chooses by its own budget.
+  if (!is_builtin_scene(source) || plan.scene.subdivide > 0 || plan.accel_goal.automatic) return;
   const std::optional<std::size_t> requested = requested_triangle_count(source);
   if (!requested) return;
   const double triangles = double(*requested);
@@ -166,7 +169,7 @@ void check_scene_fits(const RenderPlan& plan) {
   // Measured on builtin:room (README, "Memory at scale"): the finished structure, the mesh
   // when it is built whole (positions, indices, a material per triangle), and the build's
   // temporaries, bounded by a chunk where the type builds in chunks.
-  const double structure = estimated_bytes_per_triangle(plan.accelerator.type);
+  const double structure = estimated_bytes_per_triangle(plan.accelerator);
   const double mesh = plan.scene.streamed ? 0.0 : 22.0;
   const double build_triangles = builds_in_chunks(plan.accelerator.type)
                                      ? std::min(triangles, double(plan.accelerator.chunk_triangles))
@@ -180,6 +183,25 @@ void check_scene_fits(const RenderPlan& plan) {
         source, needed * 1e-9, plan.accelerator.type, structure, mesh > 0.0 ? " and the whole mesh" : "",
         double(available) * 1e-9));
   }
+}
+
+SceneForWorld load_scene_for_world(const RenderPlan& plan, bool keep_mesh) {
+  SceneRequest request = plan.scene;
+  request.streamed = (plan.accel_goal.automatic || holds_own_geometry(plan.accelerator.type)) && !keep_mesh;
+  RenderPlan checked = plan;
+  checked.scene = request;
+  check_scene_fits(checked);
+  Scene scene = load_scene(request);
+  const Camera camera = resolve_camera(plan.camera, scene);
+  const MeshTriangleSource whole(scene.mesh);
+  const TriangleSource& triangles = scene.streamed() ? *scene.stream : static_cast<const TriangleSource&>(whole);
+  ResolvedAccelerator resolved =
+      resolve_accelerator(plan.accelerator, plan.accel_goal, triangles, camera, plan.image, scene.streamed());
+  if (scene.streamed() && !holds_own_geometry(resolved.options.type)) {
+    request.streamed = false;
+    scene = load_scene(request);
+  }
+  return {std::move(scene), camera, std::move(resolved)};
 }
 
 RenderPlan plan_render(const Config& config) {
@@ -197,6 +219,13 @@ RenderPlan plan_render(const Config& config) {
   if (std::uint64_t(plan.image.width) * plan.image.height * plan.image.samples_per_pixel > (std::uint64_t{1} << 40)) {
     throw ConfigError("render: width x height x spp is over 2^40 rays");
   }
+  const std::uint64_t seed = static_cast<std::uint64_t>(config.integer("render.seed"));
+  if ((seed + 1) * plan.image.samples_per_pixel > std::numeric_limits<std::uint32_t>::max()) {
+    throw ConfigError(fmt::format("render.seed = {} with render.spp = {}: the sample numbers, up to (seed + 1) x spp, "
+                                  "must stay under 2^32",
+                                  seed, plan.image.samples_per_pixel));
+  }
+  plan.image.seed = static_cast<std::uint32_t>(seed);
   plan.pixel_order = parse_pixel_order(config.text("render.pixel_order"));
   plan.film_per_thread = config.text("render.film") == "per_thread";
   plan.rules.max_depth = static_cast<std::uint32_t>(config.integer("render.max_depth"));
@@ -208,6 +237,7 @@ RenderPlan plan_render(const Config& config) {
   plan.memory = plan_memory(config);
 
   plan.accelerator = accelerator_options(config);
+  plan.accel_goal = accel_goal(config);
 
   plan.proxy.share = config.real("proxy.share");
   plan.proxy.method = parse_proxy_method(config.text("proxy.method"));

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "accel/registry.hpp"
+#include "stages/accel_choice.hpp"
 #include "scene/scene.hpp"
 #include "stages/config.hpp"
 #include "stages/film.hpp"
@@ -37,7 +38,8 @@ struct RenderPlan {
   bool film_per_thread = false;  // render.film
   PathRules rules;
   PipelineOptions pipeline;
-  AcceleratorOptions accelerator;
+  AcceleratorOptions accelerator;  // type "auto" until resolve_accelerator chooses
+  AccelGoal accel_goal;
   MemoryPlan memory;
   ProxyOptions proxy;
   ZSortOptions reorder;
@@ -64,6 +66,18 @@ std::unique_ptr<Accelerator> build_world_accelerator(const Scene& scene, const A
 // size would not fit in the memory the machine has available, by the accelerator's bytes
 // per triangle (and the whole mesh's, when the scene is not streamed).
 void check_scene_fits(const RenderPlan& plan);
+
+// A scene loaded for building its world, and the accelerator it is built with: the plan's,
+// or what accel.type = auto and pixel error bounds resolve to on this scene and camera. The
+// scene is generated streamed when the type (or auto) may build from a stream and no mesh
+// is wanted (`keep_mesh`: a proxy is simplified from it), and loaded again whole when the
+// chosen type reads the mesh in place.
+struct SceneForWorld {
+  Scene scene;
+  Camera camera;
+  ResolvedAccelerator accelerator;
+};
+SceneForWorld load_scene_for_world(const RenderPlan& plan, bool keep_mesh);
 
 // Reads every key; throws ConfigError for a stage list that cannot run.
 RenderPlan plan_render(const Config& config);

@@ -97,22 +97,12 @@ class HashedGridAccelerator final : public Accelerator {
   }
 
  private:
-  // Woo's heuristic: M_i = S_i · cbrt(ρN / V), capped so that Mx·My·Mz stays in the guard.
   void choose_resolution(const HashedGridOptions& options) {
     bounds_ = mesh_.bounds();
-    const glm::vec3 extent = bounds_.extent();
-    const float floor_extent = std::max(1e-6f * bounds_.diagonal(), 1e-30f);
-    const glm::dvec3 size(std::max(extent.x, floor_extent), std::max(extent.y, floor_extent),
-                          std::max(extent.z, floor_extent));
-    double scale = std::cbrt(options.density * double(mesh_.triangle_count()) / (size.x * size.y * size.z));
-    for (int attempt = 0; attempt < 64; ++attempt) {
-      for (int axis = 0; axis < 3; ++axis) {
-        cells_[axis] = static_cast<std::uint32_t>(std::clamp(std::ceil(size[axis] * scale), 1.0, double(1 << 21)));
-      }
-      if (double(cells_.x) * cells_.y * cells_.z <= double(options.max_cells)) break;
-      capped_ = true;
-      scale *= 0.97 * std::cbrt(double(options.max_cells) / (double(cells_.x) * cells_.y * cells_.z));
-    }
+    const GridResolution resolution = hashed_grid_resolution(bounds_, mesh_.triangle_count(), options);
+    cells_ = resolution.cells;
+    capped_ = resolution.capped;
+    const glm::dvec3 size = resolution.size;
     max_cells_ = options.max_cells;
     effective_density_ = double(cells_.x) * cells_.y * cells_.z / double(mesh_.triangle_count());
     cell_size_ = glm::vec3(size) / glm::vec3(cells_);
@@ -382,6 +372,27 @@ class HashedGridAccelerator final : public Accelerator {
 };
 
 }  // namespace
+
+// Woo's heuristic: M_i = S_i · cbrt(ρN / V), capped so that Mx·My·Mz stays in the guard.
+GridResolution hashed_grid_resolution(const Bounds3& bounds, std::size_t triangles, const HashedGridOptions& options) {
+  GridResolution resolution;
+  const glm::vec3 extent = bounds.extent();
+  const float floor_extent = std::max(1e-6f * bounds.diagonal(), 1e-30f);
+  resolution.size = glm::dvec3(std::max(extent.x, floor_extent), std::max(extent.y, floor_extent),
+                               std::max(extent.z, floor_extent));
+  const glm::dvec3& size = resolution.size;
+  glm::uvec3& cells = resolution.cells;
+  double scale = std::cbrt(options.density * double(std::max<std::size_t>(triangles, 1)) / (size.x * size.y * size.z));
+  for (int attempt = 0; attempt < 64; ++attempt) {
+    for (int axis = 0; axis < 3; ++axis) {
+      cells[axis] = static_cast<std::uint32_t>(std::clamp(std::ceil(size[axis] * scale), 1.0, double(1 << 21)));
+    }
+    if (double(cells.x) * cells.y * cells.z <= double(options.max_cells)) break;
+    resolution.capped = true;
+    scale *= 0.97 * std::cbrt(double(options.max_cells) / (double(cells.x) * cells.y * cells.z));
+  }
+  return resolution;
+}
 
 std::unique_ptr<Accelerator> make_hashed_grid_accelerator(const TriangleMesh& mesh, const HashedGridOptions& options) {
   return std::make_unique<HashedGridAccelerator>(mesh, options);

@@ -31,6 +31,16 @@ struct HashedGridOptions {
   std::uint32_t macrocell_factor = 0;
 };
 
+// The cells per axis the grid takes over `bounds` for `triangles` (the box's extent floored
+// at a millionth of its diagonal): what a build will choose, known before it (accel.type = auto
+// counts triangles per cell on it).
+struct GridResolution {
+  glm::uvec3 cells{1};
+  glm::dvec3 size{1.0};  // the extent the cells divide
+  bool capped = false;   // the resolution guard lowered the density
+};
+GridResolution hashed_grid_resolution(const Bounds3& bounds, std::size_t triangles, const HashedGridOptions& options);
+
 // `mesh` must outlive the accelerator (its arrays are read in place).
 std::unique_ptr<Accelerator> make_hashed_grid_accelerator(const TriangleMesh& mesh, const HashedGridOptions& options);
 

@@ -1,0 +1,194 @@
+// accel.type = auto: what it measures of a scene, what it chooses under a budget and an
+// error bound, and the methods it never puts on their failure case.
+#include <filesystem>
+#include <fstream>
+
+#include <glm/trigonometric.hpp>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "scene/builtin_scenes.hpp"
+#include "stages/accel_choice.hpp"
+#include "stages/render_setup.hpp"
+#include "test_support.hpp"
+
+namespace wavetrace {
+namespace {
+
+constexpr std::size_t kMB = 1000000;
+
+SceneTraits traits_of(const std::string& source) {
+  const Scene scene = make_builtin_scene(source);
+  return measure_scene_traits(MeshTriangleSource(scene.mesh));
+}
+
+// Chunks of 10k triangles keep the builds' temporaries small, so that on 100k-triangle
+// scenes the compact structures cost less than the uncompressed ones, as at scale.
+AcceleratorOptions small_chunks() {
+  AcceleratorOptions options;
+  options.chunk_triangles = 10000;
+  return options;
+}
+
+const AccelCandidate& candidate(const AccelChoice& choice, const std::string& type) {
+  for (const AccelCandidate& c : choice.candidates) {
+    if (c.options.type == type) return c;
+  }
+  throw std::logic_error("no candidate " + type);
+}
+
+TEST(AccelChoice, ASmallSceneGetsRobustEmbree) {
+  const AccelChoice choice = choose_accelerator(traits_of("builtin:sphere:20k"), 1000 * kMB, 0.01, AcceleratorOptions{}, false);
+  EXPECT_EQ(choice.options.type, "embree");
+  EXPECT_EQ(choice.options.embree.mode, EmbreeMode::robust);
+  EXPECT_TRUE(candidate(choice, "embree").chosen);
+  EXPECT_NE(choice.summary.find("embree:mode=robust"), std::string::npos) << choice.summary;
+}
+
+TEST(AccelChoice, ABudgetThatExcludesUncompressedStructuresGetsACompactOne) {
+  const SceneTraits sphere = traits_of("builtin:sphere:100k");
+  const AccelChoice lossy = choose_accelerator(sphere, 8 * kMB, 0.01, small_chunks(), true);
+  EXPECT_EQ(lossy.spec, "hmq:width=8:epsilon=0.01");
+  EXPECT_FALSE(candidate(lossy, "embree").fits);
+  EXPECT_FALSE(candidate(lossy, "bvh").fits);
+  // Exact only: HMQ is out, the strips are the compact exact method.
+  const AccelChoice exact = choose_accelerator(sphere, 8 * kMB, 0.0, small_chunks(), true);
+  EXPECT_EQ(exact.spec, "raystrips:width=8");
+  EXPECT_FALSE(candidate(exact, "hmq").meets_error);
+  EXPECT_THROW(choose_accelerator(sphere, kMB, 0.01, small_chunks(), true), ConfigError);
+}
+
+TEST(AccelChoice, ASoupNeverGetsRayStrips) {
+  const SceneTraits soup = traits_of("builtin:soup:100k");
+  const SceneTraits sphere = traits_of("builtin:sphere:100k");
+  EXPECT_LT(soup.triangles_per_vertex, kSoupTrianglesPerVertex);
+  EXPECT_GT(sphere.triangles_per_vertex, 5.0);
+  for (const std::size_t budget : {4 * kMB, 6 * kMB, 8 * kMB, 10 * kMB, 100 * kMB}) {
+    const AccelChoice on_sphere = choose_accelerator(sphere, budget, 0.0, small_chunks(), true);
+    EXPECT_FALSE(candidate(on_sphere, "raystrips").failure_case);
+    try {
+      const AccelChoice on_soup = choose_accelerator(soup, budget, 0.0, small_chunks(), true);
+      EXPECT_NE(on_soup.options.type, "raystrips") << budget;
+      EXPECT_TRUE(candidate(on_soup, "raystrips").failure_case) << budget;
+      // Where the strips would have been chosen, the exact method next in line is.
+      if (on_sphere.options.type == "raystrips") {
+        EXPECT_EQ(on_soup.options.type, "grid") << budget;
+      }
+    } catch (const ConfigError& error) {
+      EXPECT_NE(on_sphere.options.type, "embree") << budget << ": " << error.what();
+    }
+  }
+}
+
+TEST(AccelChoice, AStadiumNeverGetsAHashedGrid) {
+  const SceneTraits stadium = traits_of("builtin:stadium:100k");
+  const SceneTraits soup = traits_of("builtin:soup:100k");
+  EXPECT_GT(stadium.triangles_per_grid_cell, 1000.0);  // the small sphere shares a few cells
+  EXPECT_LT(soup.triangles_per_grid_cell, kCrowdedGridCell);
+  // Even where the grid is the only exact method left (strips ruled out as on a soup).
+  SceneTraits crowded_soup = stadium;
+  crowded_soup.triangles_per_vertex = soup.triangles_per_vertex;
+  EXPECT_EQ(choose_accelerator(soup, 8 * kMB, 0.0, small_chunks(), true).options.type, "grid");
+  EXPECT_THROW(choose_accelerator(crowded_soup, 8 * kMB, 0.0, small_chunks(), true), ConfigError);
+  for (const std::size_t budget : {4 * kMB, 8 * kMB, 100 * kMB}) {
+    const AccelChoice choice = choose_accelerator(stadium, budget, 0.0, small_chunks(), true);
+    EXPECT_NE(choice.options.type, "grid");
+    EXPECT_TRUE(candidate(choice, "grid").failure_case);
+  }
+}
+
+TEST(AccelChoice, TheChosenHmqGridMeetsTheErrorBound) {
+  const Scene scene = make_builtin_scene("builtin:sphere:100k");
+  const MeshTriangleSource source(scene.mesh);
+  for (const double bound : {1e-2, 1e-3, 2e-4}) {
+    const AccelChoice choice = choose_accelerator(measure_scene_traits(source), 8 * kMB, bound, small_chunks(), false);
+    ASSERT_EQ(choice.options.type, "hmq");
+    const auto accelerator = build_world_accelerator(scene, choice.options);
+    const std::optional<TriangleMesh> represented = accelerator->represented_mesh(scene.mesh);
+    ASSERT_TRUE(represented);
+    double moved = 0.0;
+    for (std::size_t v = 0; v < scene.mesh.vertex_count(); ++v) {
+      moved = std::max(moved, double(glm::distance(scene.mesh.positions[v], represented->positions[v])));
+    }
+    EXPECT_LE(moved, bound);
+    EXPECT_GT(moved, bound / 8) << "the coarsest grid within the bound, not a finer one";
+  }
+  // A bound finer than 24 bits a side can reach on the scene is refused, not met loosely.
+  const AccelChoice exact = choose_accelerator(measure_scene_traits(source), 8 * kMB, 1e-9, small_chunks(), false);
+  EXPECT_FALSE(candidate(exact, "hmq").meets_error);
+  EXPECT_NE(exact.options.type, "hmq");
+}
+
+TEST(AccelChoice, TheNearestSurfaceInViewIgnoresWhatTheCameraCannotSee) {
+  // A square at z = 0 in view, 3 units ahead; a triangle 0.5 behind the eye and one off to
+  // the side, both nearer and both out of view.
+  TriangleMesh mesh;
+  mesh.positions = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0},    // the square
+                    {-1, -1, 3.5}, {1, -1, 3.5}, {0, 1, 3.5},          // behind
+                    {5, 0, 2.5}, {6, 0, 2.5}, {5, 1, 2.5}};            // beside
+  mesh.triangles = {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {7, 8, 9}};
+  const MeshTriangleSource source(mesh);
+  const Camera camera{glm::vec3(0, 0, 3), glm::vec3(0), glm::vec3(0, 1, 0), 40.0f};
+  ImageSpec image;
+  image.width = 400;
+  image.height = 300;
+  const SceneTraits traits = measure_scene_traits(source, &camera, &image);
+  ASSERT_TRUE(traits.nearest_in_view);
+  EXPECT_NEAR(*traits.nearest_in_view, 3.0, 1e-6);
+  // Half a pixel: 3 x tan(20 degrees) / 300 lies between one pixel's two halves.
+  EXPECT_NEAR(half_pixel_footprint(camera, image, 3.0), 3.0 * std::tan(glm::radians(20.0)) / 300.0, 1e-9);
+  // Nothing in view: a pixel bound cannot be resolved and says so.
+  const Camera away{glm::vec3(0, 0, 3), glm::vec3(0, 0, 6), glm::vec3(0, 1, 0), 40.0f};
+  TriangleMesh ahead = mesh;
+  ahead.triangles = {{0, 1, 2}, {0, 2, 3}};
+  EXPECT_FALSE(measure_scene_traits(MeshTriangleSource(ahead), &away, &image).nearest_in_view);
+  AccelGoal goal;
+  goal.automatic = true;
+  EXPECT_THROW(resolve_accelerator(AcceleratorOptions{}, goal, MeshTriangleSource(ahead), away, image, false),
+               ConfigError);
+}
+
+TEST(AccelChoice, ConfigTakesPixelOrANumberForErrorBounds) {
+  Config config;
+  EXPECT_FALSE(accel_goal(config).max_error);  // pixel by default
+  config.set("accel.max_error=0.25");
+  EXPECT_EQ(accel_goal(config).max_error, 0.25);
+  config.set("accel.max_error=pixel");
+  EXPECT_FALSE(accel_goal(config).max_error);
+  EXPECT_THROW(config.set("accel.max_error=pixels"), ConfigError);
+  EXPECT_THROW(config.set("accel.max_error=-1"), ConfigError);
+  config.set("accel.hmq.epsilon=pixel");
+  EXPECT_TRUE(accel_goal(config).hmq_epsilon_pixel);
+  EXPECT_THROW(config.real("accel.hmq.epsilon"), ConfigError);
+  EXPECT_EQ(accelerator_options(config).hmq.epsilon, 0.0);  // resolved on the scene, later
+  Config from_file;
+  from_file.load_string("[accel]\ntype = \"auto\"\nmax_error = 0.5\n[accel.hmq]\nepsilon = \"pixel\"\n");
+  EXPECT_TRUE(accel_goal(from_file).automatic);
+  EXPECT_EQ(accel_goal(from_file).max_error, 0.5);
+  EXPECT_THROW(from_file.load_string("[accel]\nmax_error = \"far\"\n"), ConfigError);
+  EXPECT_THROW(resolve_accel_memory_budget("lots"), ConfigError);
+  EXPECT_EQ(resolve_accel_memory_budget("512MB"), 512 * kMB);
+}
+
+TEST(AccelChoice, RenderPrintsTheChoiceAndItsStatsNameIt) {
+  const std::string dir = (std::filesystem::temp_directory_path() / "wavetrace_tests").string();
+  std::filesystem::create_directories(dir);
+  const auto result = testing::run_wavetrace(
+      "render builtin:sphere:100k --accel auto --set accel.memory_budget=8MB --set build.chunk_triangles=10000 "
+      "--size 64x48 --spp 1 --threads 2 --out " + dir + "/auto.exr --stats " + dir + "/auto.json");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("accel auto: hmq:width=8:epsilon="), std::string::npos) << result.output;
+  std::ifstream file(dir + "/auto.json");
+  const nlohmann::json stats = nlohmann::json::parse(file);
+  EXPECT_EQ(stats["accel"]["type"], "hmq8");
+  const nlohmann::json& chosen = stats["accel"]["auto"];
+  EXPECT_EQ(chosen["candidates"].size(), 5u);
+  EXPECT_FALSE(chosen["candidates"][0]["fits"].get<bool>());
+  EXPECT_TRUE(chosen["candidates"][1]["chosen"].get<bool>());
+  EXPECT_GT(chosen["pixel_distance"].get<double>(), 0.0);
+  const double half_pixel = chosen["pixel_distance"].get<double>() * std::tan(glm::radians(20.0)) / 48.0;
+  EXPECT_NEAR(chosen["max_error"].get<double>(), half_pixel, 1e-6 * half_pixel);
+}
+
+}  // namespace
+}  // namespace wavetrace
