@@ -70,6 +70,10 @@ class Accelerator {
   // representation (hmq snaps vertices to a grid) returns `source` with its vertices moved
   // as it decodes them, so that tests and the leak bench can ask exact questions of it.
   virtual std::optional<TriangleMesh> represented_mesh(const TriangleMesh& source) const { return std::nullopt; }
+  // Where a vertex at `point` lies on that surface (hmq: snapped to its global grid). Lights
+  // are sampled there: samples on the exact emitter lie behind or inside the represented one,
+  // which would shadow its own light.
+  virtual glm::vec3 represented_point(const glm::vec3& point) const { return point; }
 
   // Writes the structure as sections named PREFIX + part (its format beside its code), for
   // load_accelerator to trace in place. The default throws std::logic_error: Embree's

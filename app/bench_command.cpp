@@ -313,6 +313,8 @@ void add_bench_command(CLI::App& app, int& exit_code) {
   image->add_option("--json", image_args->json, "write results as JSON");
   add_set_option(image, image_args->assignments, "render.max_depth=2");
   image->callback([image_args, &exit_code] { exit_code = run_image(*image_args); });
+
+  add_bench_report_command(*bench, exit_code);
 }
 
 }  // namespace wavetrace

@@ -65,7 +65,7 @@ int run_build(const BuildArguments& args) {
   info.scene_seconds = seconds_since(load_start);
   const auto build_start = std::chrono::steady_clock::now();
   const std::unique_ptr<Accelerator> accelerator = build_world_accelerator(scene, plan.accelerator);
-  const LightSampler lights(scene);
+  const LightSampler lights = represented_lights(scene, *accelerator);
   std::unique_ptr<Proxy> proxy;
   if (with_proxy) proxy = std::make_unique<Proxy>(scene.mesh, plan.proxy, *accelerator);
   // A type traced in place no longer needs the mesh (bvh's face sets have their own copy

@@ -111,7 +111,7 @@ int render_scene(const RenderPlan& requested, const RenderArguments& args, std::
   measured.after_load_bytes = read_resident_memory().current_bytes;
   activity = fmt::format("building '{}' over {} triangles", plan.accelerator.type, scene.triangle_count);
   const std::unique_ptr<Accelerator> accelerator = build_world_accelerator(scene, plan.accelerator);
-  const LightSampler lights(scene);
+  const LightSampler lights = represented_lights(scene, *accelerator);
   activity = fmt::format("building the proxy of {} triangles", scene.triangle_count);
   const std::unique_ptr<Proxy> proxy = build_proxy(plan, scene, *accelerator);
   if (holds_own_geometry(plan.accelerator.type)) scene.release_mesh();

@@ -71,7 +71,7 @@ void apply_accelerator_spec(Config& config, const std::string& text) {
 AcceleratorSpec parse_accelerator_spec(const std::string& text, const Config& base) {
   Config config = base;
   apply_accelerator_spec(config, text);
-  return {text, accelerator_options(config), accel_goal(config)};
+  return {text, accelerator_options(config), accel_goal(config), std::nullopt};
 }
 
 void resolve_accelerator_spec(AcceleratorSpec& spec, const Scene& scene, const Config& base) {
@@ -82,6 +82,7 @@ void resolve_accelerator_spec(AcceleratorSpec& spec, const Scene& scene, const C
   const ResolvedAccelerator resolved = resolve_accelerator(spec.options, spec.goal, source,
                                                            resolve_camera(plan.camera, scene), plan.image, false);
   spec.options = resolved.options;
+  spec.auto_choice = resolved.choice;
   spec.label = resolved.choice ? fmt::format("{} ({})", spec.label, resolved.choice->spec)
                                : fmt::format("{} ({:.4g})", spec.label, spec.options.hmq.epsilon);
   spec.goal = AccelGoal{};
@@ -183,6 +184,7 @@ AccelBenchReport run_accel_bench(const Scene& scene, const AccelBenchRequest& re
       } else {
         const AcceleratorSpec& spec = request.accelerators[subject];
         result.label = spec.label;
+        result.auto_choice = spec.auto_choice;
         // The build's peak resident memory, from the OS: the peak window starts here, so it
         // holds what the process already had (scene, rays, reference) plus the build's own.
         const bool windowed = reset_peak_resident_memory();
@@ -263,7 +265,8 @@ nlohmann::json to_json(const AccelBenchReport& report) {
                        {"vertex_error_max", optional(r.vertex_error_max)},
                        {"t_error_max", optional(r.t_error_max)},
                        {"t_error_mean", optional(r.t_error_mean)},
-                       {"memory_runs", memory_runs_json(report, r)}});
+                       {"memory_runs", memory_runs_json(report, r)},
+                       {"auto", r.auto_choice ? to_json(*r.auto_choice) : nlohmann::json(nullptr)}});
   }
   return {{"scene", {{"source", report.scene}, {"triangles", report.triangles}}},
           {"reference", report.reference},

@@ -24,6 +24,7 @@ struct AcceleratorSpec {
   std::string label;
   AcceleratorOptions options;
   AccelGoal goal;  // auto or a pixel epsilon: resolved on the scene by resolve_accelerator_spec
+  std::optional<AccelChoice> auto_choice;  // once resolved: what auto chose and why
 };
 AcceleratorSpec parse_accelerator_spec(const std::string& text, const Config& base);
 // Resolves auto or hmq:epsilon=pixel against `scene`, its camera (or camera.* of `base`) and
@@ -65,6 +66,7 @@ struct AccelBenchResult {
   std::optional<double> vertex_error_max;
   bool probed = false;                 // false: the accelerator's reads cannot be observed (Embree)
   std::vector<MemoryRun> memory_runs;  // one per budget, when memory observation was asked for
+  std::optional<AccelChoice> auto_choice;  // the spec was auto: its candidates and reasons
 };
 
 struct AccelBenchReport {
@@ -83,7 +85,7 @@ struct AccelBenchReport {
 
 struct AccelBenchRequest {
   std::vector<AcceleratorSpec> accelerators;
-  AcceleratorSpec reference{"embree", AcceleratorOptions{}, AccelGoal{}};  // accuracy is measured against it
+  AcceleratorSpec reference{"embree", AcceleratorOptions{}, AccelGoal{}, std::nullopt};  // accuracy is measured against it
   RaySetKind rays = RaySetKind::primary;
   std::size_t count = 1 << 20;
   int threads = 0;

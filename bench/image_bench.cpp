@@ -24,7 +24,6 @@ ImageBenchReport run_image_bench(const Config& config, std::vector<AcceleratorSp
   for (const AcceleratorSpec& spec : accelerators) renders.emplace_back(&spec, &plan);
   if (noise_floor) renders.emplace_back(&accelerators.front(), &reseeded);
   const Camera camera = resolve_camera(plan.camera, scene);
-  const LightSampler lights(scene);
   ImageBenchReport report;
   report.scene = scene.name;
   report.triangles = scene.mesh.triangle_count();
@@ -35,6 +34,7 @@ ImageBenchReport run_image_bench(const Config& config, std::vector<AcceleratorSp
   for (const auto& [spec, render_plan] : renders) {
     // Hits carry the surface the accelerator answers for: a lossy one's renders shade it.
     const auto accelerator = build_world_accelerator(scene, spec->options);
+    const LightSampler lights = represented_lights(scene, *accelerator);
     const World world{scene, *accelerator, lights, nullptr};
     const RenderOutput output = render_image(*render_plan, world, camera);
     report.threads = output.run.threads;

@@ -17,7 +17,7 @@ RenderWorld::RenderWorld(const RenderPlan& base, bool needs_proxy) {
   if (base.memory.file_backing) throw ConfigError("memory.backing = file pages a world file: give one (wavetrace build)");
   built_scene_ = load_scene(base.scene);
   built_accelerator_ = build_world_accelerator(built_scene_, base.accelerator);
-  built_lights_ = std::make_unique<LightSampler>(built_scene_);
+  built_lights_ = std::make_unique<LightSampler>(represented_lights(built_scene_, *built_accelerator_));
   if (needs_proxy) built_proxy_ = std::make_unique<Proxy>(built_scene_.mesh, base.proxy, *built_accelerator_);
 }
 

@@ -10,7 +10,9 @@
 
 namespace wavetrace {
 
-LightSampler::LightSampler(const Scene& scene) {
+LightSampler::LightSampler(const Scene& scene) : LightSampler(scene, {}) {}
+
+LightSampler::LightSampler(const Scene& scene, const std::function<glm::vec3(const glm::vec3&)>& represent) {
   // A streamed scene generates just its emissive objects here.
   TriangleMesh generated;
   if (scene.streamed()) {
@@ -27,11 +29,13 @@ LightSampler::LightSampler(const Scene& scene) {
     const Material& material = scene.materials[mesh.material(t)];
     if (!material.emissive()) continue;
     const glm::uvec3& tri = mesh.triangles[t];
+    const auto corner = [&](std::uint32_t v) { return represent ? represent(mesh.positions[v]) : mesh.positions[v]; };
     EmissiveTriangle light;
-    light.corner = mesh.positions[tri.x];
-    light.edge1 = mesh.positions[tri.y] - light.corner;
-    light.edge2 = mesh.positions[tri.z] - light.corner;
+    light.corner = corner(tri.x);
+    light.edge1 = corner(tri.y) - light.corner;
+    light.edge2 = corner(tri.z) - light.corner;
     const glm::vec3 cross = glm::cross(light.edge1, light.edge2);
+    if (!(glm::length(cross) > 0.0f)) continue;  // collapsed by the representation: it emits nothing there
     light.normal = glm::normalize(cross);
     light.emission = material.emission;
     light.pdf_area = 0.5f * glm::length(cross);  // the area, until divided below

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -23,6 +24,9 @@ struct LightSample {
 class LightSampler {
  public:
   explicit LightSampler(const Scene& scene);
+  // The emitters with every corner moved by `represent` (a lossy accelerator's surface:
+  // Accelerator::represented_point); a light that becomes degenerate there is dropped.
+  LightSampler(const Scene& scene, const std::function<glm::vec3(const glm::vec3&)>& represent);
 
   // What sampling needs, precomputed per emissive triangle so a sample is arithmetic only.
   // A saved world stores these as they are, 64 bytes each: corner, edge1, edge2, normal,

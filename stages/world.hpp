@@ -17,4 +17,9 @@ struct World {
   FilePager* pager = nullptr;    // the real pager, when the world is a world file paged from disk
 };
 
+// The scene's lights on the surface `accelerator` answers for (its represented_point).
+inline LightSampler represented_lights(const Scene& scene, const Accelerator& accelerator) {
+  return LightSampler(scene, [&](const glm::vec3& point) { return accelerator.represented_point(point); });
+}
+
 }  // namespace wavetrace

@@ -219,6 +219,11 @@ class ChunkedAccelerator final : public Accelerator {
     return notes;
   }
 
+  // Every chunk snaps to the one global grid (make_world_accelerator): the first answers.
+  glm::vec3 represented_point(const glm::vec3& point) const override {
+    return chunks_.empty() ? point : chunks_.front().accelerator->represented_point(point);
+  }
+
   std::optional<TriangleMesh> represented_mesh(const TriangleMesh& source) const override {
     if (source.triangle_count() != triangles()) throw std::invalid_argument("represented_mesh: not the mesh of this world");
     TriangleMesh result = source;

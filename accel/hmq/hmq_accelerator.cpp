@@ -321,6 +321,7 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
   std::optional<TriangleMesh> represented_mesh(const TriangleMesh& source) const override {
     return snapped_mesh(grid_, source);
   }
+  glm::vec3 represented_point(const glm::vec3& point) const override { return grid_.point(grid_.snap(point)); }
 
  private:
   std::size_t triangles() const { return std::max<std::size_t>(1, triangles_); }

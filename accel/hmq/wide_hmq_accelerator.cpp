@@ -193,6 +193,7 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
   std::optional<TriangleMesh> represented_mesh(const TriangleMesh& source) const override {
     return snapped_mesh(grid_, source);
   }
+  glm::vec3 represented_point(const glm::vec3& point) const override { return grid_.point(grid_.snap(point)); }
 
  private:
   template <bool kAnyHit, typename Probe>

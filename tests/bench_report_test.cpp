@@ -1,0 +1,79 @@
+// `wavetrace bench report`: the quick matrix produces every chart and every table row, and
+// --from charts earlier JSON files.
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "test_support.hpp"
+
+namespace wavetrace {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string read_text(const fs::path& path) {
+  std::ifstream file(path);
+  std::stringstream text;
+  text << file.rdbuf();
+  return text.str();
+}
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / "wavetrace_tests" / name;
+  fs::remove_all(dir);
+  return dir;
+}
+
+std::size_t count_lines_starting(const std::string& text, const std::string& prefix) {
+  std::size_t count = 0;
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);) count += line.starts_with(prefix);
+  return count;
+}
+
+TEST(BenchReport, TheQuickMatrixProducesEveryChartAndTableRow) {
+  const fs::path dir = fresh_dir("report_quick");
+  const auto result = testing::run_wavetrace("bench report " + dir.string() + " --quick");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const std::string report = read_text(dir / "report.md");
+  for (const std::string chart : {"pareto_room_primary", "pareto_room_diffuse", "pareto_sphere_primary",
+                                  "pareto_sphere_diffuse", "pareto_mesh_primary", "pareto_mesh_diffuse", "hmq_error",
+                                  "hmq_image", "faults", "stages"}) {
+    EXPECT_NE(report.find("](" + chart + ".png)"), std::string::npos) << chart;
+    ASSERT_TRUE(fs::exists(dir / (chart + ".png"))) << chart;
+    EXPECT_GT(fs::file_size(dir / (chart + ".png")), 10000u) << chart;
+  }
+  // Each chart's commands, with the wavetrace they ran.
+  EXPECT_EQ(count_lines_starting(report, "wavetrace bench accel"), 10u);
+  // auto: three settings on each of six accel runs, each against the fastest that fits.
+  EXPECT_EQ(count_lines_starting(report, "| room:20k ") + count_lines_starting(report, "| sphere:20k "), 12u);
+  for (const std::string row :
+       {"| Ray-Strips on a soup", "| Hashed grid on a stadium", "| HMQ, huge extents", "| HMQ, thin features",
+        "| The proxy on fur", "| Rays through shared edges"}) {
+    EXPECT_NE(report.find(row), std::string::npos) << row;
+  }
+  EXPECT_NE(report.find("At `epsilon = pixel`"), std::string::npos);
+  // Real paging next to simulated in the faults table.
+  EXPECT_NE(report.find("50% real"), std::string::npos);
+  std::ifstream runs_file(dir / "data" / "runs.json");
+  const nlohmann::json runs = nlohmann::json::parse(runs_file);
+  for (const auto& run : runs["runs"]) EXPECT_EQ(run["status"], 0) << run["name"];
+
+  // --from: earlier JSON files, charted without running anything.
+  const fs::path again = fresh_dir("report_from");
+  const auto from = testing::run_wavetrace("bench report " + again.string() + " --from " +
+                                           (dir / "data" / "pareto_room_primary.json").string() + " " +
+                                           (dir / "data" / "hmq_image.json").string());
+  ASSERT_EQ(from.exit_code, 0) << from.output;
+  const std::string charted = read_text(again / "report.md");
+  EXPECT_NE(charted.find("](pareto_room_primary.png)"), std::string::npos);
+  EXPECT_NE(charted.find("](hmq_image.png)"), std::string::npos);
+  EXPECT_NE(charted.find("(given: "), std::string::npos);
+  EXPECT_TRUE(fs::exists(again / "hmq_image.png"));
+}
+
+}  // namespace
+}  // namespace wavetrace
