@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Charts from `wavetrace bench accel --json` files: speed (Mrays/s, median) and memory
 (bytes per triangle, split into hierarchy / geometry / other) per accelerator, one group
 of bars per run. Usage: bench/plot_accel.py OUT.png RESULT.json [RESULT.json ...]"""

@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Charts and OUT/report.md from the JSON files of `wavetrace bench report` (OUT/data/).
 
 Each file is recognised by its content (bench accel, image, reorder, leak; render stats), so
