@@ -25,9 +25,6 @@ namespace wavetrace {
 namespace {
 
 constexpr std::size_t kTraitChunk = std::size_t{1} << 20;
-// A mesh read whole: positions, 32-bit indices and a material per triangle (README, "Memory
-// at scale", as check_scene_fits counts it).
-constexpr double kMeshBytesPerTriangle = 22.0;
 
 // The view frustum in camera space: a point is (right, up, forward) from the eye.
 struct ViewFrustum {
@@ -210,14 +207,17 @@ AccelChoice choose_accelerator(const SceneTraits& traits, std::size_t budget_byt
   for (const std::string& type : candidate_types()) {
     AccelCandidate candidate = make_candidate(type, base, max_error);
     const AcceleratorOptions& options = candidate.options;
-    // Peak while building: the structure (with the mesh, for a type that reads it in place),
-    // the whole mesh a type keeping its own geometry is built from unless the source is
-    // streamed, and the build's temporaries (per chunk).
-    const double mesh = holds_own_geometry(type) && !streamed_source ? kMeshBytesPerTriangle : 0.0;
+    // Peak while building: the structure, the whole mesh unless the type keeps its own
+    // geometry and is built from a streamed source (counted apart even where the structure's
+    // bytes include the mesh it reads in place: measured peaks need it), the build's
+    // temporaries (per chunk) and the process. On builtin:room:8M (render, VmHWM), estimate
+    // against peak: robust Embree 1.19 / 1.02 GB, bvh:width=8 1.57 / 1.54, hmq:width=8
+    // 0.90 / 0.64, raystrips:width=8 0.98 / 0.67.
+    const double mesh = holds_own_geometry(type) && streamed_source ? 0.0 : kAutoMeshBytesPerTriangle;
     const double built_at_once =
         builds_in_chunks(type) ? std::min(triangles, double(options.chunk_triangles)) : triangles;
     candidate.estimated_bytes = triangles * (estimated_bytes_per_triangle(options) + mesh) +
-                                built_at_once * estimated_build_bytes_per_triangle(type);
+                                built_at_once * estimated_build_bytes_per_triangle(type) + double(kAutoProcessBytes);
     candidate.fits = candidate.estimated_bytes <= double(budget_bytes);
 
     std::string error_reason;
@@ -293,6 +293,8 @@ nlohmann::json to_json(const AccelChoice& choice) {
   const SceneTraits& t = choice.traits;
   return {{"chosen", choice.spec},
           {"budget_bytes", choice.budget_bytes},
+          {"process_bytes", kAutoProcessBytes},
+          {"mesh_bytes_per_triangle", kAutoMeshBytesPerTriangle},
           {"max_error", choice.max_error},
           {"pixel_distance", choice.pixel_distance ? nlohmann::json(*choice.pixel_distance) : nlohmann::json(nullptr)},
           {"traits",

@@ -54,6 +54,12 @@ inline constexpr std::size_t kTraitSampleLimit = std::size_t{1} << 22;
 // A mean over a grid cell past this is crowded; triangles per vertex under this, a soup.
 inline constexpr double kCrowdedGridCell = 64.0;
 inline constexpr double kSoupTrianglesPerVertex = 2.0;
+// What auto counts for the process besides the world: code, TBB and Embree, film, batches,
+// lights (a 64x48 render of builtin:room:20k peaks at 20 MB).
+inline constexpr std::size_t kAutoProcessBytes = 64000000;
+// A mesh read whole: positions, 32-bit indices and a material per triangle (README, "Memory
+// at scale", as check_scene_fits counts it).
+inline constexpr double kAutoMeshBytesPerTriangle = 22.0;
 
 // The pass; `camera` and `image` (for the aspect) when the nearest distance in view is wanted.
 SceneTraits measure_scene_traits(const TriangleSource& source, const Camera* camera = nullptr,

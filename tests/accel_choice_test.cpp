@@ -16,6 +16,8 @@ namespace wavetrace {
 namespace {
 
 constexpr std::size_t kMB = 1000000;
+// A budget of `megabytes` for the world, besides what auto counts for the process.
+std::size_t world_budget(std::size_t megabytes) { return kAutoProcessBytes + megabytes * kMB; }
 
 SceneTraits traits_of(const std::string& source) {
   const Scene scene = make_builtin_scene(source);
@@ -38,7 +40,7 @@ const AccelCandidate& candidate(const AccelChoice& choice, const std::string& ty
 }
 
 TEST(AccelChoice, ASmallSceneGetsRobustEmbree) {
-  const AccelChoice choice = choose_accelerator(traits_of("builtin:sphere:20k"), 1000 * kMB, 0.01, AcceleratorOptions{}, false);
+  const AccelChoice choice = choose_accelerator(traits_of("builtin:sphere:20k"), world_budget(1000), 0.01, AcceleratorOptions{}, false);
   EXPECT_EQ(choice.options.type, "embree");
   EXPECT_EQ(choice.options.embree.mode, EmbreeMode::robust);
   EXPECT_TRUE(candidate(choice, "embree").chosen);
@@ -47,15 +49,15 @@ TEST(AccelChoice, ASmallSceneGetsRobustEmbree) {
 
 TEST(AccelChoice, ABudgetThatExcludesUncompressedStructuresGetsACompactOne) {
   const SceneTraits sphere = traits_of("builtin:sphere:100k");
-  const AccelChoice lossy = choose_accelerator(sphere, 8 * kMB, 0.01, small_chunks(), true);
+  const AccelChoice lossy = choose_accelerator(sphere, world_budget(8), 0.01, small_chunks(), true);
   EXPECT_EQ(lossy.spec, "hmq:width=8:epsilon=0.01");
   EXPECT_FALSE(candidate(lossy, "embree").fits);
   EXPECT_FALSE(candidate(lossy, "bvh").fits);
   // Exact only: HMQ is out, the strips are the compact exact method.
-  const AccelChoice exact = choose_accelerator(sphere, 8 * kMB, 0.0, small_chunks(), true);
+  const AccelChoice exact = choose_accelerator(sphere, world_budget(8), 0.0, small_chunks(), true);
   EXPECT_EQ(exact.spec, "raystrips:width=8");
   EXPECT_FALSE(candidate(exact, "hmq").meets_error);
-  EXPECT_THROW(choose_accelerator(sphere, kMB, 0.01, small_chunks(), true), ConfigError);
+  EXPECT_THROW(choose_accelerator(sphere, world_budget(1), 0.01, small_chunks(), true), ConfigError);
 }
 
 TEST(AccelChoice, ASoupNeverGetsRayStrips) {
@@ -63,7 +65,7 @@ TEST(AccelChoice, ASoupNeverGetsRayStrips) {
   const SceneTraits sphere = traits_of("builtin:sphere:100k");
   EXPECT_LT(soup.triangles_per_vertex, kSoupTrianglesPerVertex);
   EXPECT_GT(sphere.triangles_per_vertex, 5.0);
-  for (const std::size_t budget : {4 * kMB, 6 * kMB, 8 * kMB, 10 * kMB, 100 * kMB}) {
+  for (const std::size_t budget : {world_budget(6), world_budget(8), world_budget(10), world_budget(12), world_budget(100)}) {
     const AccelChoice on_sphere = choose_accelerator(sphere, budget, 0.0, small_chunks(), true);
     EXPECT_FALSE(candidate(on_sphere, "raystrips").failure_case);
     try {
@@ -88,9 +90,9 @@ TEST(AccelChoice, AStadiumNeverGetsAHashedGrid) {
   // Even where the grid is the only exact method left (strips ruled out as on a soup).
   SceneTraits crowded_soup = stadium;
   crowded_soup.triangles_per_vertex = soup.triangles_per_vertex;
-  EXPECT_EQ(choose_accelerator(soup, 8 * kMB, 0.0, small_chunks(), true).options.type, "grid");
-  EXPECT_THROW(choose_accelerator(crowded_soup, 8 * kMB, 0.0, small_chunks(), true), ConfigError);
-  for (const std::size_t budget : {4 * kMB, 8 * kMB, 100 * kMB}) {
+  EXPECT_EQ(choose_accelerator(soup, world_budget(10), 0.0, small_chunks(), true).options.type, "grid");
+  EXPECT_THROW(choose_accelerator(crowded_soup, world_budget(10), 0.0, small_chunks(), true), ConfigError);
+  for (const std::size_t budget : {world_budget(6), world_budget(10), world_budget(100)}) {
     const AccelChoice choice = choose_accelerator(stadium, budget, 0.0, small_chunks(), true);
     EXPECT_NE(choice.options.type, "grid");
     EXPECT_TRUE(candidate(choice, "grid").failure_case);
@@ -101,7 +103,7 @@ TEST(AccelChoice, TheChosenHmqGridMeetsTheErrorBound) {
   const Scene scene = make_builtin_scene("builtin:sphere:100k");
   const MeshTriangleSource source(scene.mesh);
   for (const double bound : {1e-2, 1e-3, 2e-4}) {
-    const AccelChoice choice = choose_accelerator(measure_scene_traits(source), 8 * kMB, bound, small_chunks(), false);
+    const AccelChoice choice = choose_accelerator(measure_scene_traits(source), world_budget(8), bound, small_chunks(), false);
     ASSERT_EQ(choice.options.type, "hmq");
     const auto accelerator = build_world_accelerator(scene, choice.options);
     const std::optional<TriangleMesh> represented = accelerator->represented_mesh(scene.mesh);
@@ -114,7 +116,7 @@ TEST(AccelChoice, TheChosenHmqGridMeetsTheErrorBound) {
     EXPECT_GT(moved, bound / 8) << "the coarsest grid within the bound, not a finer one";
   }
   // A bound finer than 24 bits a side can reach on the scene is refused, not met loosely.
-  const AccelChoice exact = choose_accelerator(measure_scene_traits(source), 8 * kMB, 1e-9, small_chunks(), false);
+  const AccelChoice exact = choose_accelerator(measure_scene_traits(source), world_budget(8), 1e-9, small_chunks(), false);
   EXPECT_FALSE(candidate(exact, "hmq").meets_error);
   EXPECT_NE(exact.options.type, "hmq");
 }
@@ -174,7 +176,7 @@ TEST(AccelChoice, RenderPrintsTheChoiceAndItsStatsNameIt) {
   const std::string dir = (std::filesystem::temp_directory_path() / "wavetrace_tests").string();
   std::filesystem::create_directories(dir);
   const auto result = testing::run_wavetrace(
-      "render builtin:sphere:100k --accel auto --set accel.memory_budget=8MB --set build.chunk_triangles=10000 "
+      "render builtin:sphere:100k --accel auto --set accel.memory_budget=72MB --set build.chunk_triangles=10000 "
       "--size 64x48 --spp 1 --threads 2 --out " + dir + "/auto.exr --stats " + dir + "/auto.json");
   ASSERT_EQ(result.exit_code, 0) << result.output;
   EXPECT_NE(result.output.find("accel auto: hmq:width=8:epsilon="), std::string::npos) << result.output;
