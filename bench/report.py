@@ -61,7 +61,7 @@ def base_spec(label):
 
 def short(label):
     label = re.sub(r"memory_budget=(\d+)", lambda m: f"budget={int(m.group(1)) / 1e6:.0f}MB", label)
-    return re.sub(r":chunk_triangles=\d+", "", label)
+    return re.sub(r":chunk_triangles=\d+", ":chunked", label)
 
 
 def pareto_front(points):
@@ -230,9 +230,11 @@ def ratio(doc, spec, against="embree:mode=robust"):
 
 
 def footprint(r):
-    """The most a setting held at once, measured: its structure's bytes, or the build's peak
-    resident memory above where it began (the OS's VmHWM), whichever is more."""
-    return max(r["bytes"], r.get("build_peak_rss_above_start_bytes") or 0)
+    """The most a setting held at once, measured: its structure's bytes, or its build's peak
+    resident memory above where it began (the OS's VmHWM) plus, for a type that reads the mesh
+    in place, the mesh's bytes it counts (resident before the build began), whichever is more."""
+    in_place = 0 if base_spec(r["accel"]).startswith(("hmq", "raystrips")) else r["parts"]["geometry"]
+    return max(r["bytes"], (r.get("build_peak_rss_above_start_bytes") or 0) + in_place)
 
 
 def auto_rows(name, doc):
@@ -369,8 +371,8 @@ def main():
 
     md += ["## accel.type = auto against the fastest that fits", "",
            "For each auto setting: what it chose (from estimates, before building), and the fastest setting of the same "
-           "run whose measured footprint (its bytes, or its build's peak resident memory above where it began, "
-           "whichever is more; plus the whole mesh a compact type is built from) fits the same budget less auto's "
+           "run whose measured footprint (its bytes, or its build's peak resident memory above where it began with "
+           "the mesh it reads in place, whichever is more; plus the whole mesh a compact type is built from) fits the same budget less auto's "
            "allowance for the process, and whose measured hit-point error meets the same bound, "
            f"leaving out leaky ones ({WATERTIGHT_NOTE}). Auto's estimates are conservative (the largest bytes per "
            "triangle measured on the README's scenes, and the mesh a compact type is built from), so it may take a "
