@@ -103,7 +103,8 @@ def chart_pareto(name, doc, out):
 
 
 def chart_hmq_error(name, doc, out):
-    results = [r for r in doc["results"] if r.get("vertex_error_max") is not None]
+    results = sorted((r for r in doc["results"] if r.get("vertex_error_max") is not None),
+                     key=lambda r: r["vertex_error_max"])
     reference = next((r for r in doc["results"] if r["accel"].startswith("embree")), None)
     figure, (bound, speed) = plt.subplots(1, 2, figsize=(10, 4.2))
     xs = [r["vertex_error_max"] for r in results]
