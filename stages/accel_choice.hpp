@@ -25,7 +25,6 @@ struct AccelGoal {
   std::string memory_budget = "available";  // as given
   std::optional<double> max_error;         // scene units; none: half a pixel's footprint
   bool hmq_epsilon_pixel = false;          // accel.hmq.epsilon = pixel
-  bool needs_pixel() const { return (automatic && !max_error) || hmq_epsilon_pixel; }
 };
 AccelGoal accel_goal(const Config& config);
 
