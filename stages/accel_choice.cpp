@@ -213,7 +213,7 @@ AccelChoice choose_accelerator(const SceneTraits& traits, std::size_t budget_byt
     // temporaries (per chunk) and the process. On builtin:room:8M (render, VmHWM), estimate
     // against peak: robust Embree 1.19 / 1.02 GB, bvh:width=8 1.57 / 1.54, hmq:width=8
     // 0.90 / 0.64, raystrips:width=8 0.98 / 0.67.
-    const double mesh = holds_own_geometry(type) && streamed_source ? 0.0 : kAutoMeshBytesPerTriangle;
+    const double mesh = holds_own_geometry(type) && streamed_source ? 0.0 : kWholeMeshBytesPerTriangle;
     const double built_at_once =
         builds_in_chunks(type) ? std::min(triangles, double(options.chunk_triangles)) : triangles;
     candidate.estimated_bytes = triangles * (estimated_bytes_per_triangle(options) + mesh) +
@@ -294,7 +294,7 @@ nlohmann::json to_json(const AccelChoice& choice) {
   return {{"chosen", choice.spec},
           {"budget_bytes", choice.budget_bytes},
           {"process_bytes", kAutoProcessBytes},
-          {"mesh_bytes_per_triangle", kAutoMeshBytesPerTriangle},
+          {"mesh_bytes_per_triangle", kWholeMeshBytesPerTriangle},
           {"max_error", choice.max_error},
           {"pixel_distance", choice.pixel_distance ? nlohmann::json(*choice.pixel_distance) : nlohmann::json(nullptr)},
           {"traits",

@@ -57,8 +57,8 @@ inline constexpr double kSoupTrianglesPerVertex = 2.0;
 // lights (a 64x48 render of builtin:room:20k peaks at 20 MB).
 inline constexpr std::size_t kAutoProcessBytes = 64000000;
 // A mesh read whole: positions, 32-bit indices and a material per triangle (README, "Memory
-// at scale", as check_scene_fits counts it).
-inline constexpr double kAutoMeshBytesPerTriangle = 22.0;
+// at scale"); check_scene_fits counts it too.
+inline constexpr double kWholeMeshBytesPerTriangle = 22.0;
 
 // The pass; `camera` and `image` (for the aspect) when the nearest distance in view is wanted.
 SceneTraits measure_scene_traits(const TriangleSource& source, const Camera* camera = nullptr,

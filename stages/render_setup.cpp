@@ -170,7 +170,7 @@ void check_scene_fits(const RenderPlan& plan) {
   // when it is built whole (positions, indices, a material per triangle), and the build's
   // temporaries, bounded by a chunk where the type builds in chunks.
   const double structure = estimated_bytes_per_triangle(plan.accelerator);
-  const double mesh = plan.scene.streamed ? 0.0 : 22.0;
+  const double mesh = plan.scene.streamed ? 0.0 : kWholeMeshBytesPerTriangle;
   const double build_triangles = builds_in_chunks(plan.accelerator.type)
                                      ? std::min(triangles, double(plan.accelerator.chunk_triangles))
                                      : triangles;
