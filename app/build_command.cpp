@@ -12,6 +12,7 @@
 #include "app/commands.hpp"
 #include "memory/process_memory.hpp"
 #include "scene/lights.hpp"
+#include "stages/accelerator_spec.hpp"
 #include "stages/render_setup.hpp"
 #include "stages/world_file.hpp"
 
@@ -37,7 +38,7 @@ int run_build(const BuildArguments& args) {
   Config config;
   if (!args.config_file.empty()) config.load_file(args.config_file);
   if (!args.scene.empty()) config.set_value("scene.source", args.scene);
-  if (!args.accel.empty()) config.set_value("accel.type", args.accel);
+  if (!args.accel.empty()) apply_accelerator_spec(config, args.accel);
   if (args.threads >= 0) config.set_value("render.threads", std::int64_t{args.threads});
   for (const std::string& assignment : args.assignments) config.set(assignment);
   if (!is_world_file(args.out)) throw ConfigError(fmt::format("--out {}: a world file is named *.wtw", args.out));
@@ -113,7 +114,7 @@ void add_build_command(CLI::App& app, int& exit_code) {
   auto args = std::make_shared<BuildArguments>();
   CLI::App* command = app.add_subcommand("build", "build a scene's world once and save it to a world file (.wtw)");
   command->add_option("scene,--scene", args->scene, "mesh file, scene file (.toml) or builtin:NAME[:TRIANGLES]");
-  command->add_option("--accel", args->accel, "accelerator (accel.type)");
+  command->add_option("--accel", args->accel, "accelerator: TYPE[:key=value]..., as bench takes it (accel.type, accel.TYPE.key, build.chunk_triangles)");
   command->add_option("--threads", args->threads, "worker threads, 0 = all cores (render.threads)");
   command->add_option("--config", args->config_file, "TOML config file");
   command->add_option("--set", args->assignments, "override a config key: section.key=value")

@@ -14,6 +14,7 @@
 #include "app/render_report.hpp"
 #include "memory/process_memory.hpp"
 #include "scene/lights.hpp"
+#include "stages/accelerator_spec.hpp"
 #include "stages/render_setup.hpp"
 #include "stages/world_file.hpp"
 
@@ -36,7 +37,7 @@ Config build_config(const RenderArguments& args) {
   Config config;
   if (!args.config_file.empty()) config.load_file(args.config_file);
   if (!args.scene.empty()) config.set_value("scene.source", args.scene);
-  if (!args.accel.empty()) config.set_value("accel.type", args.accel);
+  if (!args.accel.empty()) apply_accelerator_spec(config, args.accel);
   if (args.spp != 0) config.set_value("render.spp", std::int64_t{args.spp});
   if (args.threads >= 0) config.set_value("render.threads", std::int64_t{args.threads});
   if (!args.size.empty()) {
@@ -78,61 +79,25 @@ int finish_render(const RenderArguments& args, const RenderPlan& plan, const Sce
   return 0;
 }
 
-// A saved world: mapped (or paged from disk under memory.budget) and traced as built.
-int render_world(const RenderArguments& args, RenderPlan plan) {
-  RenderPhases measured;
-  const std::unique_ptr<LoadedWorld> world_file = load_world(plan.scene.source, world_paging(plan), plan.pipeline.threads);
-  LoadedWorld& loaded = *world_file;
-  measured.load_seconds = loaded.seconds;
-  measured.after_load_bytes = measured.after_build_bytes = read_resident_memory().current_bytes;
-  plan.accelerator.type = loaded.type;
-  if (plan.needs_proxy() && !loaded.proxy) {
-    throw ConfigError(fmt::format("{} was saved without a proxy, which the chain's approx_hit needs: build it with --proxy",
-                                  plan.scene.source));
-  }
-  const Camera camera = resolve_camera(plan.camera, loaded.scene);
-  const World world{loaded.scene, *loaded.accelerator, *loaded.lights, plan.needs_proxy() ? loaded.proxy.get() : nullptr,
-                    loaded.file->pager()};
-  return finish_render(args, plan, loaded.scene, world, camera, measured);
-}
-
-int render_scene(const RenderPlan& requested, const RenderArguments& args, std::string& activity) {
-  RenderPhases measured;
-  RenderPlan plan = requested;
-  activity = fmt::format("loading {}", plan.scene.source);
-  const auto load_start = std::chrono::steady_clock::now();
-  SceneForWorld loaded = load_scene_for_world(plan, plan.needs_proxy());
-  Scene& scene = loaded.scene;
-  const Camera& camera = loaded.camera;
-  const ResolvedAccelerator& resolved = loaded.accelerator;
-  plan.accelerator = resolved.options;
-  if (const std::string line = resolution_summary(resolved); !line.empty()) fmt::print("{}\n", line);
-  measured.load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
-  measured.after_load_bytes = read_resident_memory().current_bytes;
-  activity = fmt::format("building '{}' over {} triangles", plan.accelerator.type, scene.triangle_count);
-  const std::unique_ptr<Accelerator> accelerator = build_world_accelerator(scene, plan.accelerator);
-  const LightSampler lights = represented_lights(scene, *accelerator);
-  activity = fmt::format("building the proxy of {} triangles", scene.triangle_count);
-  const std::unique_ptr<Proxy> proxy = build_proxy(plan, scene, *accelerator);
-  if (holds_own_geometry(plan.accelerator.type)) scene.release_mesh();
-  measured.after_build_bytes = read_resident_memory().current_bytes;
-  const World world{scene, *accelerator, lights, proxy.get()};
-  activity = fmt::format("rendering {}x{} at {} spp", plan.image.width, plan.image.height, plan.image.samples_per_pixel);
-  return finish_render(args, plan, scene, world, camera, measured, resolved.choice ? &*resolved.choice : nullptr);
-}
-
 int run_render(const RenderArguments& args) {
   const Config config = build_config(args);
   const RenderPlan plan = plan_render(config);
   // What was being done, so that running out of memory says where (and not "bad_alloc").
-  std::string activity = fmt::format("loading the world {}", plan.scene.source);
+  std::string activity;
   try {
-    if (is_world_file(plan.scene.source)) return render_world(args, plan);
-    if (plan.memory.file_backing) {
-      throw ConfigError(fmt::format(
-          "memory.backing = file pages a world file; {} is not one (make one with wavetrace build)", plan.scene.source));
+    const BuiltWorld built(plan, &activity);
+    if (const ResolvedAccelerator* resolved = built.resolution()) {
+      if (const std::string line = resolution_summary(*resolved); !line.empty()) fmt::print("{}\n", line);
     }
-    return render_scene(plan, args, activity);
+    RenderPhases measured;
+    measured.load_seconds = built.phases().load_seconds;
+    measured.after_load_bytes = built.phases().after_load_bytes;
+    measured.after_build_bytes = built.phases().after_build_bytes;
+    const RenderPlan& done = built.plan();
+    activity = fmt::format("rendering {}x{} at {} spp", done.image.width, done.image.height, done.image.samples_per_pixel);
+    const AccelChoice* choice =
+        built.resolution() != nullptr && built.resolution()->choice ? &*built.resolution()->choice : nullptr;
+    return finish_render(args, done, built.scene(), built.world(), built.camera(), measured, choice);
   } catch (const std::bad_alloc&) {
     throw std::runtime_error(fmt::format("out of memory {} ({:.2f} GB resident at most, {:.2f} GB available now)",
                                          activity, double(read_resident_memory().peak_bytes) * 1e-9,
@@ -147,7 +112,7 @@ void add_render_command(CLI::App& app, int& exit_code) {
   CLI::App* command = app.add_subcommand("render", "path-trace an image through the stage pipeline");
   command->add_option("scene,--scene", args->scene,
                       "mesh file, scene file (.toml), builtin:NAME[:TRIANGLES] or a saved world (.wtw) (default builtin:default)");
-  command->add_option("--accel", args->accel, "accelerator (accel.type)");
+  command->add_option("--accel", args->accel, "accelerator: TYPE[:key=value]..., as bench takes it (accel.type, accel.TYPE.key, build.chunk_triangles)");
   command->add_option("--spp", args->spp, "samples per pixel (render.spp)");
   command->add_option("--size", args->size, "image size as WIDTHxHEIGHT");
   command->add_option("--threads", args->threads, "worker threads, 0 = all cores (render.threads)");

@@ -48,26 +48,6 @@ void compare(const RaySet& rays, const std::vector<std::unique_ptr<HitBatch>>& h
 
 }  // namespace
 
-void apply_accelerator_spec(Config& config, const std::string& text) {
-  std::size_t colon = text.find(':');
-  const std::string type = text.substr(0, colon);
-  config.set("accel.type=" + type);
-  while (colon != std::string::npos) {
-    const std::size_t next = text.find(':', colon + 1);
-    const std::string option = text.substr(colon + 1, next == std::string::npos ? std::string::npos : next - colon - 1);
-    if (option.find('=') == std::string::npos) {
-      throw ConfigError(fmt::format("--accel '{}': '{}' is not key=value", text, option));
-    }
-    // chunk_triangles is the build's, not the type's: hmq:chunk_triangles=1048576 builds in
-    // chunks; auto's keys are accel.memory_budget and accel.max_error.
-    const std::string section = option.starts_with("chunk_triangles=") ? "build."
-                                : type == "auto"                        ? "accel."
-                                                                        : "accel." + type + ".";
-    config.set(section + option);
-    colon = next;
-  }
-}
-
 AcceleratorSpec parse_accelerator_spec(const std::string& text, const Config& base) {
   Config config = base;
   apply_accelerator_spec(config, text);

@@ -12,6 +12,7 @@
 #include "bench/ray_sets.hpp"
 #include "scene/scene.hpp"
 #include "stages/accel_choice.hpp"
+#include "stages/accelerator_spec.hpp"
 #include "stages/config.hpp"
 #include "stages/memory_observation.hpp"
 
@@ -31,8 +32,6 @@ AcceleratorSpec parse_accelerator_spec(const std::string& text, const Config& ba
 // render.width x render.height of `base`; the label then names what it came to, as
 // "auto (hmq:width=8:epsilon=0.00123)". Other specs are left as they are.
 void resolve_accelerator_spec(AcceleratorSpec& spec, const Scene& scene, const Config& base);
-// Sets the keys a TYPE[:key=value]... spec names (accel.type, accel.TYPE.key, build.chunk_triangles).
-void apply_accelerator_spec(Config& config, const std::string& text);
 
 // One probed pass of the ray set: the pager at one budget and/or the simulated cache, and
 // the trace speed with the probes on (the uninstrumented speed is the result's own).

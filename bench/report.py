@@ -238,37 +238,65 @@ def footprint(r):
     return max(r["bytes"], (r.get("build_peak_rss_above_start_bytes") or 0) + in_place)
 
 
-def auto_rows(name, doc):
+def render_peaks(docs, commands):
+    """(scene label, --accel spec) -> the render's peak resident bytes, from the footprint runs."""
+    peaks = {}
+    for stem, run in commands.items():
+        if run.get("section") != "footprint" or stem not in docs:
+            continue
+        words = run["command"].split()
+        spec = words[words.index("--accel") + 1].strip("'")
+        peaks[(stem.split("_")[1], spec)] = docs[stem]["memory"]["peak_rss_bytes"]
+    return peaks
+
+
+def auto_rows(name, doc, peaks):
     """Each auto setting of an accel run against the fastest setting that fits its budget and
-    meets its error bound (measured footprint, measured hit-point error) and is not leaky."""
+    meets its error bound (measured footprint, measured hit-point error) and is not leaky.
+    The footprint is a render's peak resident memory (the footprint runs) where there is one;
+    else (earlier JSON) the bench's bytes or build peak, with the whole mesh for compact types."""
     rows = []
     triangles = doc["scene"]["triangles"]
+    label = name.split("_")[1]
     for r in doc["results"]:
         choice = r.get("auto")
         if not choice:
             continue
         budget, bound = choice["budget_bytes"], choice["max_error"]
-        # What auto's budget holds for the world: less its allowance for the process, and with
-        # the whole mesh a compact type is built from (bench loads it whole) added to its bytes.
-        world = budget - choice["process_bytes"]
+        measured_peaks = any(key[0] == label for key in peaks)
         fitting = []
         for other in doc["results"]:
             spec = base_spec(other["accel"])
-            mesh = choice["mesh_bytes_per_triangle"] * triangles if spec.startswith(("hmq", "raystrips")) else 0
-            if other.get("auto") or spec in LEAKY or footprint(other) + mesh > world:
+            if other.get("auto") or spec in LEAKY:
                 continue
+            if measured_peaks:
+                peak = peaks.get((label, spec))
+                if peak is None or peak > budget:
+                    continue
+            else:
+                mesh = choice["mesh_bytes_per_triangle"] * triangles if spec.startswith(("hmq", "raystrips")) else 0
+                if footprint(other) + mesh > budget - choice["process_bytes"]:
+                    continue
             error = other.get("surface_error_max")
             if error is not None and not error <= bound:
                 continue
             fitting.append(other)
         best = max(fitting, key=lambda o: o["mrays_per_s"], default=None)
+        chosen = next((c for c in choice["candidates"] if c["chosen"]), {})
         rows.append({
             "run": name, "scene": scene_name(doc), "rays": doc["rays"]["kind"], "auto": short(base_spec(r["accel"])),
             "budget": budget, "bound": bound, "chosen": choice["chosen"], "speed": r["mrays_per_s"],
+            "estimate": chosen.get("estimated_bytes", float("nan")),
+            "peak": peaks.get((label, base_spec(r["accel"])), float("nan")),
             "bytes_per_triangle": r["bytes"] / triangles,
             "best": base_spec(best["accel"]) if best else "-", "best_speed": best["mrays_per_s"] if best else float("nan"),
+            "best_peak": peaks.get((label, base_spec(best["accel"])), float("nan")) if best else float("nan"),
         })
     return rows
+
+
+def megabytes(value):
+    return "-" if value != value else f"{value / 1e6:.0f} MB"
 
 
 def fmt_ratio(value):
@@ -341,6 +369,7 @@ def main():
     docs, runs = load(out)
     commands = {run["name"]: run for run in runs["runs"]}
     kinds = {stem: kind_of(doc) for stem, doc in docs.items()}
+    peaks = render_peaks(docs, commands)
 
     def made_by(*stems):
         lines = [commands[s]["command"] + (f"   # {commands[s]['seconds']:.0f} s" if commands[s]["seconds"] else "")
@@ -368,23 +397,38 @@ def main():
         md.append(f"Pareto front: {', '.join(f'{short(f[2])} ({f[0]:.1f} B/tri, {f[1]:.2f} Mrays/s)' for f in front)}.")
         md.append("")
         md.append(made_by(stem))
-        auto_table += auto_rows(stem, docs[stem])
+        auto_table += auto_rows(stem, docs[stem], peaks)
 
     md += ["## accel.type = auto against the fastest that fits", "",
-           "For each auto setting: what it chose (from estimates, before building), and the fastest setting of the same "
-           "run whose measured footprint (its bytes, or its build's peak resident memory above where it began with "
-           "the mesh it reads in place, whichever is more; plus the whole mesh a compact type is built from) fits the same budget less auto's "
-           "allowance for the process, and whose measured hit-point error meets the same bound, "
-           f"leaving out leaky ones ({WATERTIGHT_NOTE}). Auto's estimates are conservative (the largest bytes per "
-           "triangle measured on the README's scenes, and the mesh a compact type is built from), so it may take a "
-           "smaller, slower setting than the fastest that fits.", "",
-           "| run | auto | budget | bound | chose | Mrays/s | fastest that fits | its Mrays/s | auto / fastest |",
-           "|---|---|---|---|---|---|---|---|---|"]
+           "For each auto setting: what it chose (from estimates, before building), its estimate of the render's peak "
+           "and the peak measured (VmHWM of a render of its own at the same image size: the footprint runs), against "
+           "the fastest setting of the same run whose measured render peak fits the same budget and whose measured "
+           f"hit-point error meets the same bound, leaving out leaky ones ({WATERTIGHT_NOTE}). Auto's estimates are "
+           "conservative (the largest bytes per triangle measured on the README's scenes), so it may take a smaller, "
+           "slower setting than the fastest that fits; it ranks the ones that fit by their median speed on these "
+           "scenes, divided for chunked ones by a slowdown that grows with the chunk boxes around a triangle.", "",
+           "| run | auto | budget | bound | chose | estimate | peak | Mrays/s | fastest that fits | its peak | its Mrays/s "
+           "| auto / fastest |",
+           "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for row in auto_table:
         md.append(f"| {row['scene']} {row['rays']} | {row['auto']} | {row['budget'] / 1e6:.0f} MB | {row['bound']:.3g} | "
-                  f"{row['chosen']} | {row['speed']:.2f} | {row['best']} | {row['best_speed']:.2f} | "
+                  f"{row['chosen']} | {megabytes(row['estimate'])} | {megabytes(row['peak'])} | {row['speed']:.2f} | "
+                  f"{row['best']} | {megabytes(row['best_peak'])} | {row['best_speed']:.2f} | "
                   f"{fmt_ratio(row['speed'] / row['best_speed'] if row['best_speed'] > 0 else float('nan'))} |")
     md.append("")
+    footprint_stems = [s for s in ordered if commands[s].get("section") == "footprint"]
+    if footprint_stems:
+        labels = list(dict.fromkeys(label for (label, _) in peaks))
+        settings = list(dict.fromkeys(re.sub(r":budget=\d+MB", ":budget", short(spec)) for (_, spec) in peaks))
+        by_setting = {(label, re.sub(r":budget=\d+MB", ":budget", short(spec))): peak for (label, spec), peak in peaks.items()}
+        md += ["Render peaks (VmHWM, MB) of every setting; `chunked`: in chunks of an eighth of the scene, `budget`: "
+               "the tight budgets above.", "",
+               "| setting | " + " | ".join(labels) + " |", "|---|" + "---|" * len(labels)]
+        for setting in settings:
+            md.append(f"| {setting} | " + " | ".join(
+                f"{by_setting[(label, setting)] / 1e6:.0f}" if (label, setting) in by_setting else "-"
+                for label in labels) + " |")
+        md += ["", made_by(*footprint_stems)]
 
     error_stems = [s for s in docs if kinds[s] == "accel" and s.startswith("hmq_error")]
     image_stems = [s for s in docs if kinds[s] == "image"]
@@ -423,7 +467,7 @@ def main():
             md.append(f"| {heuristic} | " + " | ".join(cells) + " |")
         md += ["", made_by("world_room", *[s for s in docs if s.startswith("faults")])]
 
-    stage_docs = {s: docs[s] for s in docs if kinds[s] == "render"}
+    stage_docs = {s: docs[s] for s in docs if kinds[s] == "render" and s.startswith("stages")}
     if stage_docs:
         chart_stages("stages", stage_docs, out)
         md += ["## Where a render's time goes", "", "![stages](stages.png)", ""]

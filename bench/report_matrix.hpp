@@ -10,7 +10,7 @@ namespace wavetrace {
 
 struct ReportRun {
   std::string name;     // the JSON it writes is data/NAME.json
-  std::string section;  // pareto, hmq_error, hmq_image, faults, stages, stability, leaks, world
+  std::string section;  // pareto, footprint, hmq_error, hmq_image, faults, stages, stability, leaks, world
   std::vector<std::string> arguments;  // after the wavetrace binary
 };
 

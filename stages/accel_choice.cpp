@@ -1,5 +1,6 @@
 // accel.type = auto: one pass over the scene's triangles (connectivity, crowding on the
-// hashed grid's cells, the nearest surface in view), then the candidates in speed order.
+// hashed grid's cells, the overlap of its chunks, the nearest surface in view), then the
+// fastest candidate by estimate that fits and meets the bound.
 #include "stages/accel_choice.hpp"
 
 #include <algorithm>
@@ -9,12 +10,15 @@
 
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
+#include <glm/vector_relational.hpp>
 #include <glm/trigonometric.hpp>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 #include <tbb/parallel_sort.h>
+#include <tbb/task_arena.h>
 
+#include "accel/chunked/chunked_accelerator.hpp"
 #include "accel/grid/hashed_grid.hpp"
 #include "accel/hmq/global_grid.hpp"
 #include "kernels/triangle_distance.hpp"
@@ -24,7 +28,10 @@
 namespace wavetrace {
 namespace {
 
-constexpr std::size_t kTraitChunk = std::size_t{1} << 20;
+// Triangles extracted at once: the pass's own memory stays small beside what it estimates.
+constexpr std::size_t kTraitChunk = std::size_t{1} << 18;
+// Centroids tested against every chunk box: enough for the mean to two digits.
+constexpr std::size_t kOverlapSamples = std::size_t{1} << 16;
 
 // The view frustum in camera space: a point is (right, up, forward) from the eye.
 struct ViewFrustum {
@@ -60,13 +67,29 @@ std::string gigabytes(double bytes) {
   return bytes < 1e9 ? fmt::format("{:.1f} MB", bytes * 1e-6) : fmt::format("{:.2f} GB", bytes * 1e-9);
 }
 
-// The candidates, fastest first, as measured on this machine (README, "Choosing an
-// accelerator"; the wide table of "Wide quantized traversal"): robust Embree, then the
-// 8-wide HMQ (lossy: its grid comes from the error bound), the 8-wide BVH, the 8-wide
-// Ray-Strips, the hashed grid. The binary layouts are slower at no fewer bytes than their
-// 8-wide ones, mlgrid and arraygrid slower or larger than grid, default and compact Embree
-// let rays through shared edges: none of them is a candidate.
-std::vector<std::string> candidate_types() { return {"embree", "hmq", "bvh", "raystrips", "grid"}; }
+// The candidates and their speed against robust Embree's: medians of the six runs of
+// `bench report` (room, sphere and a subdivided bunny at 1M triangles; primary and diffuse
+// rays; ranges in the comments). The binary layouts are slower at no fewer bytes than their
+// 8-wide ones, grid slower than mlgrid at the same bytes, arraygrid larger, default and
+// compact Embree let rays through shared edges: none of them is a candidate.
+struct CandidateType {
+  const char* type;
+  double relative_speed;
+};
+constexpr CandidateType kCandidates[] = {
+    {"embree", 1.0},      // robust
+    {"bvh", 0.60},        // width 8: 0.54 - 0.69
+    {"hmq", 0.53},        // width 8: 0.48 - 0.67
+    {"raystrips", 0.33},  // width 8: 0.25 - 0.40
+    {"mlgrid", 0.24},     // 0.15 - 0.28 (room's empty space is its slowest)
+};
+
+// How much slower a structure traces built in chunks whose boxes overlap so (SceneTraits::
+// chunk_overlap), fitted to `bench report`'s chunked 8-wide hmq, raystrips and bvh against
+// whole ones (chunks of an eighth): room 1.22x at overlap 2.96, sphere 1.5x at 3.44, the
+// subdivided bunny 4.0x at 8. A square: a ray descends into more chunks, and in each it
+// tests more before a hit culls the rest.
+double chunk_slowdown(double overlap) { return 1.0 + 0.065 * (overlap - 1.0) * (overlap - 1.0); }
 
 AccelCandidate make_candidate(const std::string& type, const AcceleratorOptions& base, double max_error) {
   AccelCandidate candidate;
@@ -94,15 +117,6 @@ AccelCandidate make_candidate(const std::string& type, const AcceleratorOptions&
 
 }  // namespace
 
-AccelGoal accel_goal(const Config& config) {
-  AccelGoal goal;
-  goal.automatic = config.text("accel.type") == "auto";
-  goal.memory_budget = config.text("accel.memory_budget");
-  if (!config.word("accel.max_error")) goal.max_error = config.real("accel.max_error");
-  goal.hmq_epsilon_pixel = config.word("accel.hmq.epsilon").has_value();
-  return goal;
-}
-
 std::size_t resolve_accel_memory_budget(const std::string& text) {
   const std::size_t available = available_memory_bytes();
   if (text == "available") {
@@ -122,7 +136,13 @@ std::size_t resolve_accel_memory_budget(const std::string& text) {
   return static_cast<std::size_t>(budget.share * double(available));
 }
 
-SceneTraits measure_scene_traits(const TriangleSource& source, const Camera* camera, const ImageSpec* image) {
+AutoAllowance auto_allowance(const ImageSpec& image) {
+  return {kAutoProcessBaseBytes + kAutoProcessBytesPerPixel * std::size_t(image.width) * std::size_t(image.height),
+          static_cast<std::size_t>(std::max(1, tbb::this_task_arena::max_concurrency()))};
+}
+
+SceneTraits measure_scene_traits(const TriangleSource& source, std::size_t chunk_triangles, const Camera* camera,
+                                 const ImageSpec* image) {
   SceneTraits traits;
   traits.triangles = source.triangle_count();
   traits.bounds = source.bounds();
@@ -135,6 +155,13 @@ SceneTraits measure_scene_traits(const TriangleSource& source, const Camera* cam
 
   std::vector<std::uint64_t> cells;
   cells.reserve(traits.triangles / stride + 1);
+  const std::vector<ChunkRange> chunks =
+      chunk_triangles > 0 && traits.triangles > chunk_triangles
+          ? plan_chunks(source.object_starts(), traits.triangles, chunk_triangles)
+          : std::vector<ChunkRange>{};
+  std::vector<Bounds3> chunk_boxes(chunks.size());
+  std::vector<glm::vec3> centroids;  // a sample, to count the chunk boxes around each
+  const std::size_t centroid_stride = std::max<std::size_t>(1, traits.triangles / kOverlapSamples);
   double nearest = std::numeric_limits<double>::infinity();
   // Extraction is serial (a streamed source generates its chunks in order); each chunk's
   // triangles are measured in parallel.
@@ -159,6 +186,30 @@ SceneTraits measure_scene_traits(const TriangleSource& source, const Camera* cam
         cells[filled + s] = (cell.z * grid.cells.y + cell.y) * grid.cells.x + cell.x;
       }
     });
+    if (!chunks.empty()) {
+      for (std::size_t i = (centroid_stride - first % centroid_stride) % centroid_stride; i < count; i += centroid_stride) {
+        const glm::uvec3 t = chunk.triangles[i];
+        centroids.push_back((chunk.positions[t.x] + chunk.positions[t.y] + chunk.positions[t.z]) / 3.0f);
+      }
+      for (std::size_t c = 0; c < chunks.size(); ++c) {
+        const std::size_t begin = std::max(chunks[c].first, first);
+        const std::size_t end = std::min(chunks[c].first + chunks[c].count, first + count);
+        if (begin >= end) continue;
+        chunk_boxes[c].extend(tbb::parallel_reduce(
+            tbb::blocked_range<std::size_t>(begin - first, end - first), Bounds3{},
+            [&](const tbb::blocked_range<std::size_t>& range, Bounds3 box) {
+              for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                const glm::uvec3 t = chunk.triangles[i];
+                for (const std::uint32_t corner : {t.x, t.y, t.z}) box.extend(chunk.positions[corner]);
+              }
+              return box;
+            },
+            [](Bounds3 a, const Bounds3& b) {
+              a.extend(b);
+              return a;
+            }));
+      }
+    }
     if (!view) continue;
     nearest = tbb::parallel_reduce(
         tbb::blocked_range<std::size_t>(0, count), nearest,
@@ -189,6 +240,16 @@ SceneTraits measure_scene_traits(const TriangleSource& source, const Camera* cam
     run = end;
   }
   traits.triangles_per_grid_cell = total > 0.0 ? std::max(1.0, squares / (share * total)) : 0.0;
+  if (!chunks.empty()) {
+    traits.chunks = chunks.size();
+    std::size_t containing = 0;
+    for (const glm::vec3& point : centroids) {
+      for (const Bounds3& box : chunk_boxes) {
+        containing += glm::all(glm::lessThanEqual(box.lower, point)) && glm::all(glm::lessThanEqual(point, box.upper));
+      }
+    }
+    traits.chunk_overlap = centroids.empty() ? 1.0 : std::max(1.0, double(containing) / double(centroids.size()));
+  }
   if (std::isfinite(nearest)) traits.nearest_in_view = nearest;
   return traits;
 }
@@ -198,26 +259,35 @@ double half_pixel_footprint(const Camera& camera, const ImageSpec& image, double
 }
 
 AccelChoice choose_accelerator(const SceneTraits& traits, std::size_t budget_bytes, double max_error,
-                               const AcceleratorOptions& base, bool streamed_source) {
+                               const AcceleratorOptions& base, bool streamed_source, const AutoAllowance& allowance) {
   AccelChoice choice;
   choice.budget_bytes = budget_bytes;
+  choice.allowance = allowance;
   choice.max_error = max_error;
   choice.traits = traits;
   const double triangles = double(traits.triangles);
-  for (const std::string& type : candidate_types()) {
-    AccelCandidate candidate = make_candidate(type, base, max_error);
+  AccelCandidate* fastest = nullptr;
+  choice.candidates.reserve(std::size(kCandidates));
+  for (const CandidateType& candidate_type : kCandidates) {
+    const std::string type = candidate_type.type;
+    AccelCandidate& candidate = choice.candidates.emplace_back(make_candidate(type, base, max_error));
     const AcceleratorOptions& options = candidate.options;
+    candidate.chunked = builds_in_chunks(type) && traits.triangles > options.chunk_triangles;
+    candidate.estimated_speed = candidate_type.relative_speed / (candidate.chunked ? chunk_slowdown(traits.chunk_overlap) : 1.0);
     // Peak while building: the structure, the whole mesh unless the type keeps its own
     // geometry and is built from a streamed source (counted apart even where the structure's
-    // bytes include the mesh it reads in place: measured peaks need it), the build's
-    // temporaries (per chunk) and the process. On builtin:room:8M (render, VmHWM), estimate
-    // against peak: robust Embree 1.19 / 1.02 GB, bvh:width=8 1.57 / 1.54, hmq:width=8
-    // 0.90 / 0.64, raystrips:width=8 0.98 / 0.67.
+    // bytes include the mesh it reads in place: measured peaks need it), the temporaries of
+    // the builds at once (a chunk per worker) and the process. On builtin:room:8M (render,
+    // VmHWM), estimate against peak: robust Embree 1.19 / 1.02 GB, bvh:width=8 1.57 / 1.54,
+    // hmq:width=8 0.90 / 0.64, raystrips:width=8 0.98 / 0.67; `bench report` measures them
+    // on its scenes.
     const double mesh = holds_own_geometry(type) && streamed_source ? 0.0 : kWholeMeshBytesPerTriangle;
     const double built_at_once =
-        builds_in_chunks(type) ? std::min(triangles, double(options.chunk_triangles)) : triangles;
+        candidate.chunked ? std::min(triangles, double(options.chunk_triangles) * double(allowance.builds_at_once))
+                          : triangles;
     candidate.estimated_bytes = triangles * (estimated_bytes_per_triangle(options) + mesh) +
-                                built_at_once * estimated_build_bytes_per_triangle(type) + double(kAutoProcessBytes);
+                                built_at_once * estimated_build_bytes_per_triangle(type) +
+                                double(allowance.process_bytes);
     candidate.fits = candidate.estimated_bytes <= double(budget_bytes);
 
     std::string error_reason;
@@ -241,33 +311,41 @@ AccelChoice choose_accelerator(const SceneTraits& traits, std::size_t budget_byt
       candidate.failure_case = fmt::format("a soup ({:.2f} triangles per vertex): strips of one triangle each",
                                            traits.triangles_per_vertex);
     }
-    if (type == "grid" && traits.triangles_per_grid_cell > kCrowdedGridCell) {
+    if (type == "mlgrid" && traits.triangles_per_grid_cell > kCrowdedGridCell) {
       candidate.failure_case = fmt::format("crowded cells: {:.0f} triangles share an average triangle's grid cell",
                                            traits.triangles_per_grid_cell);
     }
 
     const std::string size = fmt::format("about {} of {}", gigabytes(candidate.estimated_bytes), gigabytes(double(budget_bytes)));
+    const std::string speed =
+        candidate.chunked ? fmt::format("{:.2f}x robust Embree's speed ({} chunks, {:.2f} boxes around a triangle)",
+                                        candidate.estimated_speed, traits.chunks, traits.chunk_overlap)
+                          : fmt::format("{:.2f}x robust Embree's speed", candidate.estimated_speed);
     if (!candidate.fits) {
       candidate.reason = "needs " + size;
     } else if (!candidate.meets_error) {
       candidate.reason = fmt::format("error bound {:.3g}: {}", max_error, error_reason);
     } else if (candidate.failure_case) {
       candidate.reason = "its failure case: " + *candidate.failure_case;
-    } else if (choice.spec.empty()) {
-      candidate.chosen = true;
-      candidate.reason = fmt::format("fastest that fits ({}), {}", size,
-                                     type == "hmq" ? error_reason : std::string("exact"));
-      choice.options = options;
-      choice.spec = candidate.spec;
     } else {
-      candidate.reason = "fits, but slower than " + choice.spec;
+      candidate.reason = fmt::format("fits ({}), {}, {}", size, speed, type == "hmq" ? error_reason : std::string("exact"));
+      if (fastest == nullptr || candidate.estimated_speed > fastest->estimated_speed) fastest = &candidate;
     }
-    choice.candidates.push_back(std::move(candidate));
+  }
+  if (fastest != nullptr) {
+    fastest->chosen = true;
+    choice.options = fastest->options;
+    choice.spec = fastest->spec;
+    for (AccelCandidate& candidate : choice.candidates) {
+      if (!candidate.chosen && candidate.reason.starts_with("fits")) {
+        candidate.reason = fmt::format("slower than {} ({:.2f}x against {:.2f}x)", fastest->spec,
+                                       candidate.estimated_speed, fastest->estimated_speed);
+      }
+    }
   }
   std::string passed;
   for (const AccelCandidate& candidate : choice.candidates) {
-    if (candidate.chosen) break;
-    passed += fmt::format("; {}: {}", candidate.spec, candidate.reason);
+    if (!candidate.chosen) passed += fmt::format("; {}: {}", candidate.spec, candidate.reason);
   }
   if (choice.spec.empty()) {
     throw ConfigError(fmt::format("accel.type = auto: no accelerator fits accel.memory_budget and accel.max_error{}",
@@ -283,6 +361,8 @@ nlohmann::json to_json(const AccelChoice& choice) {
   nlohmann::json candidates = nlohmann::json::array();
   for (const AccelCandidate& c : choice.candidates) {
     candidates.push_back({{"spec", c.spec},
+                          {"estimated_speed", c.estimated_speed},
+                          {"chunked", c.chunked},
                           {"estimated_bytes", c.estimated_bytes},
                           {"fits", c.fits},
                           {"meets_error", c.meets_error},
@@ -293,7 +373,8 @@ nlohmann::json to_json(const AccelChoice& choice) {
   const SceneTraits& t = choice.traits;
   return {{"chosen", choice.spec},
           {"budget_bytes", choice.budget_bytes},
-          {"process_bytes", kAutoProcessBytes},
+          {"process_bytes", choice.allowance.process_bytes},
+          {"builds_at_once", choice.allowance.builds_at_once},
           {"mesh_bytes_per_triangle", kWholeMeshBytesPerTriangle},
           {"max_error", choice.max_error},
           {"pixel_distance", choice.pixel_distance ? nlohmann::json(*choice.pixel_distance) : nlohmann::json(nullptr)},
@@ -302,6 +383,8 @@ nlohmann::json to_json(const AccelChoice& choice) {
             {"vertices", t.vertices},
             {"triangles_per_vertex", t.triangles_per_vertex},
             {"triangles_per_grid_cell", t.triangles_per_grid_cell},
+            {"chunks", t.chunks},
+            {"chunk_overlap", t.chunk_overlap},
             {"nearest_in_view", t.nearest_in_view ? nlohmann::json(*t.nearest_in_view) : nlohmann::json(nullptr)}}},
           {"candidates", candidates}};
 }
@@ -320,7 +403,8 @@ ResolvedAccelerator resolve_accelerator(const AcceleratorOptions& options, const
   const bool hmq_pixel = goal.hmq_epsilon_pixel && options.type == "hmq";
   if (!goal.automatic && !hmq_pixel) return resolved;
   const bool needs_pixel = hmq_pixel || (goal.automatic && !goal.max_error);
-  const SceneTraits traits = measure_scene_traits(source, needs_pixel ? &camera : nullptr, &image);
+  const SceneTraits traits = measure_scene_traits(source, goal.automatic ? options.chunk_triangles : 0,
+                                                  needs_pixel ? &camera : nullptr, &image);
   if (needs_pixel) {
     if (!traits.nearest_in_view) {
       throw ConfigError("an error bound of 'pixel' needs a surface in view, and no triangle lies in the camera's view");
@@ -340,7 +424,7 @@ ResolvedAccelerator resolve_accelerator(const AcceleratorOptions& options, const
   }
   AccelChoice choice = choose_accelerator(traits, resolve_accel_memory_budget(goal.memory_budget),
                                           goal.max_error.value_or(resolved.pixel_epsilon.value_or(0.0)), options,
-                                          streamed_source);
+                                          streamed_source, auto_allowance(image));
   if (needs_pixel) choice.pixel_distance = traits.nearest_in_view;
   resolved.options = choice.options;
   resolved.choice = std::move(choice);

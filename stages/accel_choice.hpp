@@ -19,14 +19,13 @@
 namespace wavetrace {
 
 // What the config asks of the choice (accel.type, accel.memory_budget, accel.max_error,
-// accel.hmq.epsilon = pixel); read by accel_goal().
+// accel.hmq.epsilon = pixel); read by the key table (plan_keys.hpp: accel_goal).
 struct AccelGoal {
   bool automatic = false;                  // accel.type = auto
   std::string memory_budget = "available";  // as given
   std::optional<double> max_error;         // scene units; none: half a pixel's footprint
   bool hmq_epsilon_pixel = false;          // accel.hmq.epsilon = pixel
 };
-AccelGoal accel_goal(const Config& config);
 
 // "available" (what the OS reports available now, less 10%), "50%" (of that available
 // memory) or a size ("8GB", "512MiB"); throws ConfigError naming accel.memory_budget.
@@ -48,31 +47,50 @@ struct SceneTraits {
   // The nearest distance from the camera to a triangle that may lie in view (not culled by
   // the view frustum; occlusion ignored, so never farther than the nearest surface seen).
   std::optional<double> nearest_in_view;
+  // Built in chunks of the options' chunk_triangles (runs of the source's order, cut at its
+  // objects): the chunk boxes containing an average triangle's centroid; 1 for chunks that
+  // tile the scene, the chunk count where every chunk spans the whole object (a subdivided
+  // scan's faces). A ray near that point may descend into each of them; auto's estimate of
+  // a chunked structure's speed is divided by chunk_slowdown(overlap) (accel_choice.cpp).
+  double chunk_overlap = 1.0;
+  std::size_t chunks = 1;
 };
-inline constexpr std::size_t kTraitSampleLimit = std::size_t{1} << 22;
+inline constexpr std::size_t kTraitSampleLimit = std::size_t{1} << 20;
 // A mean over a grid cell past this is crowded; triangles per vertex under this, a soup.
 inline constexpr double kCrowdedGridCell = 64.0;
 inline constexpr double kSoupTrianglesPerVertex = 2.0;
-// What auto counts for the process besides the world: code, TBB and Embree, film, batches,
-// lights (a 64x48 render of builtin:room:20k peaks at 20 MB).
-inline constexpr std::size_t kAutoProcessBytes = 64000000;
+// What auto counts besides the accelerator and the mesh: the process (code, TBB and Embree,
+// batches, lights: a 64x48 render of builtin:room:20k peaks at 16 MB, and 1920x1080 adds 36
+// bytes a pixel: film, image and its preview), and the chunks the chunked builder builds at
+// once (one per worker thread).
+struct AutoAllowance {
+  std::size_t process_bytes = 0;
+  std::size_t builds_at_once = 1;
+};
+inline constexpr std::size_t kAutoProcessBaseBytes = 32000000;
+inline constexpr std::size_t kAutoProcessBytesPerPixel = 48;
+AutoAllowance auto_allowance(const ImageSpec& image);
 // A mesh read whole: positions, 32-bit indices and a material per triangle (README, "Memory
 // at scale"); check_scene_fits counts it too.
 inline constexpr double kWholeMeshBytesPerTriangle = 22.0;
 
-// The pass; `camera` and `image` (for the aspect) when the nearest distance in view is wanted.
-SceneTraits measure_scene_traits(const TriangleSource& source, const Camera* camera = nullptr,
-                                 const ImageSpec* image = nullptr);
+// The pass; `chunk_triangles` as the chunked builder would cut the scene (0: never chunked);
+// `camera` and `image` (for the aspect) when the nearest distance in view is wanted.
+SceneTraits measure_scene_traits(const TriangleSource& source, std::size_t chunk_triangles = 0,
+                                 const Camera* camera = nullptr, const ImageSpec* image = nullptr);
 
 // Half the footprint of a pixel (at the image's centre, the narrowest) at `distance`.
 double half_pixel_footprint(const Camera& camera, const ImageSpec& image, double distance);
 
-// One candidate of the choice, in the order tried (fastest first, as measured: README,
-// "Choosing an accelerator").
+// One candidate of the choice.
 struct AccelCandidate {
   std::string spec;  // as --accel names it, e.g. "hmq:width=8:epsilon=0.0012"
   AcceleratorOptions options;
-  double estimated_bytes = 0.0;  // structure, the mesh it reads, its build's temporaries
+  // Its speed against robust Embree's on this scene: the median measured on the report's
+  // scenes, over the chunk overlap when it would be built in chunks.
+  double estimated_speed = 0.0;
+  bool chunked = false;
+  double estimated_bytes = 0.0;  // peak: structure, the mesh, its build's temporaries, the process
   bool fits = false;
   bool meets_error = false;
   std::optional<std::string> failure_case;  // the scene is this method's known failure case
@@ -84,6 +102,7 @@ struct AccelChoice {
   AcceleratorOptions options;  // the chosen accelerator's
   std::string spec;
   std::size_t budget_bytes = 0;
+  AutoAllowance allowance;
   double max_error = 0.0;                  // scene units
   std::optional<double> pixel_distance;    // the nearest distance in view, when pixel was asked
   SceneTraits traits;
@@ -91,11 +110,11 @@ struct AccelChoice {
   std::string summary;                     // one line: what was chosen and why
 };
 
-// Tries the candidates in order and keeps the first that fits `budget_bytes`, meets
-// `max_error` and whose failure case the scene is not; `base` supplies every other option.
+// Of the candidates that fit `budget_bytes`, meet `max_error` and whose failure case the scene
+// is not, keeps the one of the highest estimated speed; `base` supplies every other option.
 // Throws ConfigError naming each candidate's reason when none qualifies.
 AccelChoice choose_accelerator(const SceneTraits& traits, std::size_t budget_bytes, double max_error,
-                               const AcceleratorOptions& base, bool streamed_source);
+                               const AcceleratorOptions& base, bool streamed_source, const AutoAllowance& allowance);
 
 nlohmann::json to_json(const AccelChoice& choice);
 

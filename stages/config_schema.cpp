@@ -1,6 +1,7 @@
 // The schema: every configuration key, its type, default and valid range. Adding a
 // feature's option means adding one line here.
 #include "stages/config.hpp"
+#include "stages/pipeline.hpp"
 
 namespace wavetrace {
 
@@ -33,7 +34,7 @@ const std::vector<ConfigKey>& config_schema() {
       {"render.russian_roulette_depth", T::integer, std::int64_t{3}, 0, 64, {},
        "bounce depth from which Russian roulette may end a path"},
       {"render.threads", T::integer, std::int64_t{0}, 0, 1024, {}, "worker threads (0: all cores)"},
-      {"render.batch_size", T::integer, std::int64_t{1024}, 16, 1 << 20, {},
+      {"render.batch_size", T::integer, std::int64_t{kPipelineBatchSize}, 16, 1 << 20, {},
        "rays per batch (1024: a batch and its hits, ~100 KB, stay in L2 between stages)"},
       {"render.rays_in_flight", T::integer, std::nullopt, 1024, std::int64_t{1} << 30, {},
        "most rays alive at once (bounds memory); default: reorder.buffer_rays with zsort in the chain, else 4 "

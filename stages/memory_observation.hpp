@@ -26,9 +26,6 @@ struct MemoryPlan {
   bool enabled() const { return budget.has_value() || cache.has_value(); }
 };
 
-// Reads memory.*; throws ConfigError naming the key on a bad budget, page size or cache.
-MemoryPlan plan_memory(const Config& config);
-
 // The stages whose reads are observed, each a pager and cache client of its own.
 enum class ObservedStage : std::size_t { trace = 0, approx_hit = 1 };
 inline constexpr std::size_t kObservedStageCount = 2;

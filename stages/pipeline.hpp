@@ -89,10 +89,14 @@ enum class PipelineMode { wavefront, megakernel };
 PipelineMode parse_pipeline_mode(const std::string& text);
 std::string to_string(PipelineMode mode);
 
+// Rays per batch of a render: a batch and its hits (~100 KB) stay in L2 between stages.
+// render.batch_size's default; the benches' ray sets use kDefaultBatchCapacity.
+inline constexpr std::size_t kPipelineBatchSize = 1024;
+
 struct PipelineOptions {
   PipelineMode mode = PipelineMode::wavefront;
   std::uint32_t tile_side = 16;  // megakernel tiles
-  std::size_t batch_size = kDefaultBatchCapacity;
+  std::size_t batch_size = kPipelineBatchSize;
   std::size_t rays_in_flight = std::size_t{1} << 18;
   int threads = 0;  // 0: all cores
 };

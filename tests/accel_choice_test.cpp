@@ -1,5 +1,6 @@
 // accel.type = auto: what it measures of a scene, what it chooses under a budget and an
 // error bound, and the methods it never puts on their failure case.
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
@@ -16,20 +17,28 @@ namespace wavetrace {
 namespace {
 
 constexpr std::size_t kMB = 1000000;
+// The process as a small render's, one build at a time.
+const AutoAllowance kAllowance{kAutoProcessBaseBytes, 1};
 // A budget of `megabytes` for the world, besides what auto counts for the process.
-std::size_t world_budget(std::size_t megabytes) { return kAutoProcessBytes + megabytes * kMB; }
-
-SceneTraits traits_of(const std::string& source) {
-  const Scene scene = make_builtin_scene(source);
-  return measure_scene_traits(MeshTriangleSource(scene.mesh));
-}
+std::size_t world_budget(std::size_t megabytes) { return kAllowance.process_bytes + megabytes * kMB; }
 
 // Chunks of 10k triangles keep the builds' temporaries small, so that on 100k-triangle
 // scenes the compact structures cost less than the uncompressed ones, as at scale.
+constexpr std::size_t kSmallChunk = 10000;
 AcceleratorOptions small_chunks() {
   AcceleratorOptions options;
-  options.chunk_triangles = 10000;
+  options.chunk_triangles = kSmallChunk;
   return options;
+}
+
+SceneTraits traits_of(const std::string& source) {
+  const Scene scene = make_builtin_scene(source);
+  return measure_scene_traits(MeshTriangleSource(scene.mesh), kSmallChunk);
+}
+
+AccelChoice choose(const SceneTraits& traits, std::size_t budget, double max_error,
+                   const AcceleratorOptions& base = small_chunks(), bool streamed = true) {
+  return choose_accelerator(traits, budget, max_error, base, streamed, kAllowance);
 }
 
 const AccelCandidate& candidate(const AccelChoice& choice, const std::string& type) {
@@ -40,7 +49,7 @@ const AccelCandidate& candidate(const AccelChoice& choice, const std::string& ty
 }
 
 TEST(AccelChoice, ASmallSceneGetsRobustEmbree) {
-  const AccelChoice choice = choose_accelerator(traits_of("builtin:sphere:20k"), world_budget(1000), 0.01, AcceleratorOptions{}, false);
+  const AccelChoice choice = choose(traits_of("builtin:sphere:20k"), world_budget(1000), 0.01, AcceleratorOptions{}, false);
   EXPECT_EQ(choice.options.type, "embree");
   EXPECT_EQ(choice.options.embree.mode, EmbreeMode::robust);
   EXPECT_TRUE(candidate(choice, "embree").chosen);
@@ -49,15 +58,15 @@ TEST(AccelChoice, ASmallSceneGetsRobustEmbree) {
 
 TEST(AccelChoice, ABudgetThatExcludesUncompressedStructuresGetsACompactOne) {
   const SceneTraits sphere = traits_of("builtin:sphere:100k");
-  const AccelChoice lossy = choose_accelerator(sphere, world_budget(8), 0.01, small_chunks(), true);
+  const AccelChoice lossy = choose(sphere, world_budget(8), 0.01);
   EXPECT_EQ(lossy.spec, "hmq:width=8:epsilon=0.01");
   EXPECT_FALSE(candidate(lossy, "embree").fits);
   EXPECT_FALSE(candidate(lossy, "bvh").fits);
   // Exact only: HMQ is out, the strips are the compact exact method.
-  const AccelChoice exact = choose_accelerator(sphere, world_budget(8), 0.0, small_chunks(), true);
+  const AccelChoice exact = choose(sphere, world_budget(8), 0.0);
   EXPECT_EQ(exact.spec, "raystrips:width=8");
   EXPECT_FALSE(candidate(exact, "hmq").meets_error);
-  EXPECT_THROW(choose_accelerator(sphere, world_budget(1), 0.01, small_chunks(), true), ConfigError);
+  EXPECT_THROW(choose(sphere, world_budget(1), 0.01), ConfigError);
 }
 
 TEST(AccelChoice, ASoupNeverGetsRayStrips) {
@@ -66,15 +75,15 @@ TEST(AccelChoice, ASoupNeverGetsRayStrips) {
   EXPECT_LT(soup.triangles_per_vertex, kSoupTrianglesPerVertex);
   EXPECT_GT(sphere.triangles_per_vertex, 5.0);
   for (const std::size_t budget : {world_budget(6), world_budget(8), world_budget(10), world_budget(12), world_budget(100)}) {
-    const AccelChoice on_sphere = choose_accelerator(sphere, budget, 0.0, small_chunks(), true);
+    const AccelChoice on_sphere = choose(sphere, budget, 0.0);
     EXPECT_FALSE(candidate(on_sphere, "raystrips").failure_case);
     try {
-      const AccelChoice on_soup = choose_accelerator(soup, budget, 0.0, small_chunks(), true);
+      const AccelChoice on_soup = choose(soup, budget, 0.0);
       EXPECT_NE(on_soup.options.type, "raystrips") << budget;
       EXPECT_TRUE(candidate(on_soup, "raystrips").failure_case) << budget;
-      // Where the strips would have been chosen, the exact method next in line is.
-      if (on_sphere.options.type == "raystrips") {
-        EXPECT_EQ(on_soup.options.type, "grid") << budget;
+      // Where it fits (9.4 MB estimated), the grid is the exact method left.
+      if (budget == world_budget(10)) {
+        EXPECT_EQ(on_soup.options.type, "mlgrid") << budget;
       }
     } catch (const ConfigError& error) {
       EXPECT_NE(on_sphere.options.type, "embree") << budget << ": " << error.what();
@@ -90,20 +99,56 @@ TEST(AccelChoice, AStadiumNeverGetsAHashedGrid) {
   // Even where the grid is the only exact method left (strips ruled out as on a soup).
   SceneTraits crowded_soup = stadium;
   crowded_soup.triangles_per_vertex = soup.triangles_per_vertex;
-  EXPECT_EQ(choose_accelerator(soup, world_budget(10), 0.0, small_chunks(), true).options.type, "grid");
-  EXPECT_THROW(choose_accelerator(crowded_soup, world_budget(10), 0.0, small_chunks(), true), ConfigError);
+  EXPECT_EQ(choose(soup, world_budget(10), 0.0).options.type, "mlgrid");
+  EXPECT_THROW(choose(crowded_soup, world_budget(10), 0.0), ConfigError);
   for (const std::size_t budget : {world_budget(6), world_budget(10), world_budget(100)}) {
-    const AccelChoice choice = choose_accelerator(stadium, budget, 0.0, small_chunks(), true);
-    EXPECT_NE(choice.options.type, "grid");
-    EXPECT_TRUE(candidate(choice, "grid").failure_case);
+    const AccelChoice choice = choose(stadium, budget, 0.0);
+    EXPECT_NE(choice.options.type, "mlgrid");
+    EXPECT_TRUE(candidate(choice, "mlgrid").failure_case);
   }
+}
+
+// Chunks are runs of the source's order: cut from a sphere sorted along x they are slabs
+// that tile it; cut from the same triangles shuffled each spans the whole sphere, and a ray
+// descends into all ten. Auto ranks a chunked structure by that, and takes the whole grid
+// over chunked strips when the chunks overlap.
+TEST(AccelChoice, ChunksThatOverlapRankAChunkedStructureBelowAWholeOne) {
+  const Scene scene = make_builtin_scene("builtin:sphere:100k");
+  TriangleMesh sorted = scene.mesh;
+  const auto centroid_x = [&](const glm::uvec3& t) {
+    return sorted.positions[t.x].x + sorted.positions[t.y].x + sorted.positions[t.z].x;
+  };
+  std::sort(sorted.triangles.begin(), sorted.triangles.end(),
+            [&](const glm::uvec3& a, const glm::uvec3& b) { return centroid_x(a) < centroid_x(b); });
+  TriangleMesh shuffled = sorted;
+  for (std::size_t i = 0; i < shuffled.triangles.size(); ++i) {  // a fixed permutation: stride 7919, prime
+    shuffled.triangles[i] = sorted.triangles[(i * 7919) % sorted.triangles.size()];
+  }
+  const SceneTraits tiled = measure_scene_traits(MeshTriangleSource(sorted), kSmallChunk);
+  const SceneTraits overlapping = measure_scene_traits(MeshTriangleSource(shuffled), kSmallChunk);
+  const std::size_t chunks = (scene.mesh.triangle_count() + kSmallChunk - 1) / kSmallChunk;
+  EXPECT_EQ(tiled.chunks, chunks);
+  EXPECT_LT(tiled.chunk_overlap, 1.5);
+  EXPECT_GT(overlapping.chunk_overlap, 0.9 * double(chunks));
+  EXPECT_EQ(measure_scene_traits(MeshTriangleSource(sorted)).chunk_overlap, 1.0);  // never chunked
+
+  // Both fit 10 MB exact: tiled strips (0.33x Embree's speed) beat the grid (0.24x);
+  // strips through ten overlapping chunks (0.33 / 6.3) do not.
+  const AccelChoice on_tiled = choose(tiled, world_budget(10), 0.0);
+  const AccelChoice on_overlapping = choose(overlapping, world_budget(10), 0.0);
+  EXPECT_TRUE(candidate(on_tiled, "mlgrid").fits);
+  EXPECT_EQ(on_tiled.options.type, "raystrips") << on_tiled.summary;
+  EXPECT_EQ(on_overlapping.options.type, "mlgrid") << on_overlapping.summary;
+  EXPECT_LT(candidate(on_overlapping, "raystrips").estimated_speed, candidate(on_tiled, "raystrips").estimated_speed);
+  EXPECT_FALSE(candidate(on_tiled, "mlgrid").chunked);
+  EXPECT_TRUE(candidate(on_tiled, "raystrips").chunked);
 }
 
 TEST(AccelChoice, TheChosenHmqGridMeetsTheErrorBound) {
   const Scene scene = make_builtin_scene("builtin:sphere:100k");
   const MeshTriangleSource source(scene.mesh);
   for (const double bound : {1e-2, 1e-3, 2e-4}) {
-    const AccelChoice choice = choose_accelerator(measure_scene_traits(source), world_budget(8), bound, small_chunks(), false);
+    const AccelChoice choice = choose(measure_scene_traits(source), world_budget(8), bound, small_chunks(), false);
     ASSERT_EQ(choice.options.type, "hmq");
     const auto accelerator = build_world_accelerator(scene, choice.options);
     const std::optional<TriangleMesh> represented = accelerator->represented_mesh(scene.mesh);
@@ -116,7 +161,7 @@ TEST(AccelChoice, TheChosenHmqGridMeetsTheErrorBound) {
     EXPECT_GT(moved, bound / 8) << "the coarsest grid within the bound, not a finer one";
   }
   // A bound finer than 24 bits a side can reach on the scene is refused, not met loosely.
-  const AccelChoice exact = choose_accelerator(measure_scene_traits(source), world_budget(8), 1e-9, small_chunks(), false);
+  const AccelChoice exact = choose(measure_scene_traits(source), world_budget(8), 1e-9, small_chunks(), false);
   EXPECT_FALSE(candidate(exact, "hmq").meets_error);
   EXPECT_NE(exact.options.type, "hmq");
 }
@@ -134,7 +179,7 @@ TEST(AccelChoice, TheNearestSurfaceInViewIgnoresWhatTheCameraCannotSee) {
   ImageSpec image;
   image.width = 400;
   image.height = 300;
-  const SceneTraits traits = measure_scene_traits(source, &camera, &image);
+  const SceneTraits traits = measure_scene_traits(source, 0, &camera, &image);
   ASSERT_TRUE(traits.nearest_in_view);
   EXPECT_NEAR(*traits.nearest_in_view, 3.0, 1e-6);
   // Half a pixel: 3 x tan(20 degrees) / 300 lies between one pixel's two halves.
@@ -143,7 +188,7 @@ TEST(AccelChoice, TheNearestSurfaceInViewIgnoresWhatTheCameraCannotSee) {
   const Camera away{glm::vec3(0, 0, 3), glm::vec3(0, 0, 6), glm::vec3(0, 1, 0), 40.0f};
   TriangleMesh ahead = mesh;
   ahead.triangles = {{0, 1, 2}, {0, 2, 3}};
-  EXPECT_FALSE(measure_scene_traits(MeshTriangleSource(ahead), &away, &image).nearest_in_view);
+  EXPECT_FALSE(measure_scene_traits(MeshTriangleSource(ahead), 0, &away, &image).nearest_in_view);
   AccelGoal goal;
   goal.automatic = true;
   EXPECT_THROW(resolve_accelerator(AcceleratorOptions{}, goal, MeshTriangleSource(ahead), away, image, false),
@@ -176,7 +221,7 @@ TEST(AccelChoice, RenderPrintsTheChoiceAndItsStatsNameIt) {
   const std::string dir = (std::filesystem::temp_directory_path() / "wavetrace_tests").string();
   std::filesystem::create_directories(dir);
   const auto result = testing::run_wavetrace(
-      "render builtin:sphere:100k --accel auto --set accel.memory_budget=72MB --set build.chunk_triangles=10000 "
+      "render builtin:sphere:100k --accel auto --set accel.memory_budget=40MB --set build.chunk_triangles=10000 "
       "--size 64x48 --spp 1 --threads 2 --out " + dir + "/auto.exr --stats " + dir + "/auto.json");
   ASSERT_EQ(result.exit_code, 0) << result.output;
   EXPECT_NE(result.output.find("accel auto: hmq:width=8:epsilon="), std::string::npos) << result.output;
@@ -185,8 +230,10 @@ TEST(AccelChoice, RenderPrintsTheChoiceAndItsStatsNameIt) {
   EXPECT_EQ(stats["accel"]["type"], "hmq8");
   const nlohmann::json& chosen = stats["accel"]["auto"];
   EXPECT_EQ(chosen["candidates"].size(), 5u);
-  EXPECT_FALSE(chosen["candidates"][0]["fits"].get<bool>());
-  EXPECT_TRUE(chosen["candidates"][1]["chosen"].get<bool>());
+  EXPECT_FALSE(chosen["candidates"][0]["fits"].get<bool>());  // robust Embree: 46 MB estimated
+  for (const nlohmann::json& candidate : chosen["candidates"]) {
+    EXPECT_EQ(candidate["chosen"].get<bool>(), candidate["spec"].get<std::string>() == chosen["chosen"].get<std::string>());
+  }
   EXPECT_GT(chosen["pixel_distance"].get<double>(), 0.0);
   const double half_pixel = chosen["pixel_distance"].get<double>() * std::tan(glm::radians(20.0)) / 48.0;
   EXPECT_NEAR(chosen["max_error"].get<double>(), half_pixel, 1e-6 * half_pixel);
