@@ -6,13 +6,13 @@
 #include <fmt/format.h>
 
 #include "app/commands.hpp"
-#include "bench/accel_bench.hpp"
-#include "bench/image_bench.hpp"
-#include "bench/leak_bench.hpp"
-#include "bench/pipeline_bench.hpp"
-#include "bench/reorder_bench.hpp"
-#include "stages/render_setup.hpp"
-#include "stages/world_file.hpp"
+#include "wavetrace/bench/accel_bench.hpp"
+#include "wavetrace/bench/image_bench.hpp"
+#include "wavetrace/bench/leak_bench.hpp"
+#include "wavetrace/bench/pipeline_bench.hpp"
+#include "wavetrace/bench/reorder_bench.hpp"
+#include "wavetrace/stages/render_setup.hpp"
+#include "wavetrace/stages/world_file.hpp"
 
 namespace wavetrace {
 namespace {

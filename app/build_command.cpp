@@ -8,13 +8,13 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "accel/registry.hpp"
+#include "wavetrace/accel/registry.hpp"
 #include "app/commands.hpp"
-#include "memory/process_memory.hpp"
-#include "scene/lights.hpp"
-#include "stages/accelerator_spec.hpp"
-#include "stages/render_setup.hpp"
-#include "stages/world_file.hpp"
+#include "wavetrace/memory/process_memory.hpp"
+#include "wavetrace/scene/lights.hpp"
+#include "wavetrace/stages/accelerator_spec.hpp"
+#include "wavetrace/stages/render_setup.hpp"
+#include "wavetrace/stages/world_file.hpp"
 
 namespace wavetrace {
 namespace {

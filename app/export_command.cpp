@@ -6,10 +6,10 @@
 #include <fmt/format.h>
 
 #include "app/commands.hpp"
-#include "scene/ply_file.hpp"
-#include "scene/scene.hpp"
-#include "scene/triangle_source.hpp"
-#include "stages/config.hpp"
+#include "wavetrace/scene/ply_file.hpp"
+#include "wavetrace/scene/scene.hpp"
+#include "wavetrace/scene/triangle_source.hpp"
+#include "wavetrace/stages/config.hpp"
 
 namespace wavetrace {
 namespace {

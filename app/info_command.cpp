@@ -7,9 +7,9 @@
 
 #include "app/commands.hpp"
 #include "app/render_report.hpp"
-#include "scene/mesh_report.hpp"
-#include "scene/scene.hpp"
-#include "stages/world_file.hpp"
+#include "wavetrace/scene/mesh_report.hpp"
+#include "wavetrace/scene/scene.hpp"
+#include "wavetrace/stages/world_file.hpp"
 
 namespace wavetrace {
 namespace {

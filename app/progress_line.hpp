@@ -3,7 +3,7 @@
 
 #include <cstdio>
 
-#include "stages/pipeline.hpp"
+#include "wavetrace/stages/pipeline.hpp"
 
 namespace wavetrace {
 

@@ -7,16 +7,16 @@
 
 #include <fmt/format.h>
 
-#include "accel/registry.hpp"
+#include "wavetrace/accel/registry.hpp"
 #include "app/commands.hpp"
 #include "app/image_output.hpp"
 #include "app/progress_line.hpp"
 #include "app/render_report.hpp"
-#include "memory/process_memory.hpp"
-#include "scene/lights.hpp"
-#include "stages/accelerator_spec.hpp"
-#include "stages/render_setup.hpp"
-#include "stages/world_file.hpp"
+#include "wavetrace/memory/process_memory.hpp"
+#include "wavetrace/scene/lights.hpp"
+#include "wavetrace/stages/accelerator_spec.hpp"
+#include "wavetrace/stages/render_setup.hpp"
+#include "wavetrace/stages/world_file.hpp"
 
 namespace wavetrace {
 namespace {

@@ -5,9 +5,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "accel/accelerator.hpp"
-#include "scene/scene.hpp"
-#include "stages/render_setup.hpp"
+#include "wavetrace/accel/accelerator.hpp"
+#include "wavetrace/scene/scene.hpp"
+#include "wavetrace/stages/render_setup.hpp"
 
 namespace wavetrace {
 

@@ -5,7 +5,7 @@
 #include <cstdint>
 
 #include "fuzz/fuzz_input_file.hpp"
-#include "scene/mesh_io.hpp"
+#include "wavetrace/scene/mesh_io.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static wavetrace::fuzzing::FuzzInputFile file(WAVETRACE_FUZZ_EXTENSION);

@@ -5,7 +5,7 @@
 #include <cstdint>
 
 #include "fuzz/fuzz_input_file.hpp"
-#include "scene/scene_file.hpp"
+#include "wavetrace/scene/scene_file.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static wavetrace::fuzzing::FuzzInputFile file(".toml");

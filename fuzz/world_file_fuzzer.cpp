@@ -14,8 +14,8 @@
 #include <xxhash.h>
 
 #include "fuzz/fuzz_input_file.hpp"
-#include "memory/section_file_format.hpp"
-#include "stages/world_file.hpp"
+#include "wavetrace/memory/section_file_format.hpp"
+#include "wavetrace/stages/world_file.hpp"
 
 namespace {
 

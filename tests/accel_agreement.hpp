@@ -9,9 +9,9 @@
 
 #include <gtest/gtest.h>
 
-#include "accel/accelerator.hpp"
-#include "bench/ray_sets.hpp"
-#include "scene/scene.hpp"
+#include "wavetrace/accel/accelerator.hpp"
+#include "wavetrace/bench/ray_sets.hpp"
+#include "wavetrace/scene/scene.hpp"
 
 namespace wavetrace::testing {
 

@@ -8,9 +8,9 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "scene/builtin_scenes.hpp"
-#include "stages/accel_choice.hpp"
-#include "stages/render_setup.hpp"
+#include "wavetrace/scene/builtin_scenes.hpp"
+#include "wavetrace/stages/accel_choice.hpp"
+#include "wavetrace/stages/render_setup.hpp"
 #include "test_support.hpp"
 
 namespace wavetrace {

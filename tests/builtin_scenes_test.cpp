@@ -3,9 +3,9 @@
 
 #include <glm/geometric.hpp>
 
-#include "scene/builtin_scenes.hpp"
-#include "scene/mesh_report.hpp"
-#include "scene/subdivide.hpp"
+#include "wavetrace/scene/builtin_scenes.hpp"
+#include "wavetrace/scene/mesh_report.hpp"
+#include "wavetrace/scene/subdivide.hpp"
 #include "test_support.hpp"
 
 namespace wavetrace {

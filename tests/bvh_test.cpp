@@ -6,14 +6,14 @@
 #include <gtest/gtest.h>
 #include <glm/vector_relational.hpp>
 
-#include "accel/bvh/bvh_accelerator.hpp"
-#include "accel/bvh/sah_builder.hpp"
-#include "accel/registry.hpp"
-#include "bench/accel_bench.hpp"
-#include "bench/leak_bench.hpp"
-#include "bench/ray_sets.hpp"
-#include "scene/builtin_scenes.hpp"
-#include "scene/scene.hpp"
+#include "wavetrace/accel/bvh/bvh_accelerator.hpp"
+#include "wavetrace/accel/bvh/sah_builder.hpp"
+#include "wavetrace/accel/registry.hpp"
+#include "wavetrace/bench/accel_bench.hpp"
+#include "wavetrace/bench/leak_bench.hpp"
+#include "wavetrace/bench/ray_sets.hpp"
+#include "wavetrace/scene/builtin_scenes.hpp"
+#include "wavetrace/scene/scene.hpp"
 #include "test_support.hpp"
 
 namespace wavetrace {

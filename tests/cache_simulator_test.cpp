@@ -3,7 +3,7 @@
 
 #include <vector>
 
-#include "memory/cache_simulator.hpp"
+#include "wavetrace/memory/cache_simulator.hpp"
 
 namespace wavetrace {
 namespace {

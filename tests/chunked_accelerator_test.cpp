@@ -7,14 +7,14 @@
 
 #include <limits>
 
-#include "accel/chunked/chunked_accelerator.hpp"
-#include "accel/registry.hpp"
-#include "bench/ray_sets.hpp"
-#include "memory/pager.hpp"
-#include "scene/builtin_scenes.hpp"
-#include "stages/config.hpp"
-#include "stages/render_setup.hpp"
-#include "stages/tracing_arena.hpp"
+#include "wavetrace/accel/chunked/chunked_accelerator.hpp"
+#include "wavetrace/accel/registry.hpp"
+#include "wavetrace/bench/ray_sets.hpp"
+#include "wavetrace/memory/pager.hpp"
+#include "wavetrace/scene/builtin_scenes.hpp"
+#include "wavetrace/stages/config.hpp"
+#include "wavetrace/stages/render_setup.hpp"
+#include "wavetrace/stages/tracing_arena.hpp"
 #include "accel_agreement.hpp"
 
 namespace wavetrace {

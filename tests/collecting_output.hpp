@@ -4,8 +4,8 @@
 
 #include <vector>
 
-#include "memory/batch_pool.hpp"
-#include "stages/stage.hpp"
+#include "wavetrace/memory/batch_pool.hpp"
+#include "wavetrace/stages/stage.hpp"
 
 namespace wavetrace::testing {
 

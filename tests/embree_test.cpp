@@ -6,8 +6,8 @@
 
 #include <gtest/gtest.h>
 
-#include "accel/registry.hpp"
-#include "scene/builtin_scenes.hpp"
+#include "wavetrace/accel/registry.hpp"
+#include "wavetrace/scene/builtin_scenes.hpp"
 
 namespace wavetrace {
 

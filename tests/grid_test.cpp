@@ -3,13 +3,13 @@
 // resolution guard, and its memory report.
 #include <gtest/gtest.h>
 
-#include "accel/grid/array_grid.hpp"
-#include "accel/grid/hashed_grid.hpp"
-#include "accel/registry.hpp"
-#include "bench/accel_bench.hpp"
-#include "bench/leak_bench.hpp"
-#include "bench/ray_sets.hpp"
-#include "scene/builtin_scenes.hpp"
+#include "wavetrace/accel/grid/array_grid.hpp"
+#include "wavetrace/accel/grid/hashed_grid.hpp"
+#include "wavetrace/accel/registry.hpp"
+#include "wavetrace/bench/accel_bench.hpp"
+#include "wavetrace/bench/leak_bench.hpp"
+#include "wavetrace/bench/ray_sets.hpp"
+#include "wavetrace/scene/builtin_scenes.hpp"
 
 #include "accel_agreement.hpp"
 

@@ -2,14 +2,14 @@
 // normal of the triangle it found, and the trace stage adds its material.
 #include <gtest/gtest.h>
 
-#include "accel/hit_surface.hpp"
-#include "accel/registry.hpp"
-#include "bench/accel_bench.hpp"
-#include "bench/ray_sets.hpp"
-#include "scene/builtin_scenes.hpp"
-#include "stages/config.hpp"
-#include "stages/render_setup.hpp"
-#include "stages/trace.hpp"
+#include "wavetrace/accel/hit_surface.hpp"
+#include "wavetrace/accel/registry.hpp"
+#include "wavetrace/bench/accel_bench.hpp"
+#include "wavetrace/bench/ray_sets.hpp"
+#include "wavetrace/scene/builtin_scenes.hpp"
+#include "wavetrace/stages/config.hpp"
+#include "wavetrace/stages/render_setup.hpp"
+#include "wavetrace/stages/trace.hpp"
 
 namespace wavetrace {
 namespace {

@@ -5,10 +5,10 @@
 
 #include <gtest/gtest.h>
 
-#include "kernels/plucker.hpp"
-#include "kernels/random.hpp"
-#include "kernels/ray_box.hpp"
-#include "kernels/triangle_intersect.hpp"
+#include "wavetrace/kernels/plucker.hpp"
+#include "wavetrace/kernels/random.hpp"
+#include "wavetrace/kernels/ray_box.hpp"
+#include "wavetrace/kernels/triangle_intersect.hpp"
 
 namespace wavetrace {
 namespace {

@@ -7,11 +7,11 @@
 
 #include <glm/geometric.hpp>
 
-#include "kernels/checked_narrowing.hpp"
-#include "kernels/morton.hpp"
-#include "kernels/random.hpp"
-#include "kernels/ray_offset.hpp"
-#include "kernels/sampling.hpp"
+#include "wavetrace/kernels/checked_narrowing.hpp"
+#include "wavetrace/kernels/morton.hpp"
+#include "wavetrace/kernels/random.hpp"
+#include "wavetrace/kernels/ray_offset.hpp"
+#include "wavetrace/kernels/sampling.hpp"
 
 namespace wavetrace {
 namespace {

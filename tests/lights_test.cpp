@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "scene/lights.hpp"
+#include "wavetrace/scene/lights.hpp"
 
 namespace wavetrace {
 namespace {

@@ -3,8 +3,8 @@
 #include <gtest/gtest.h>
 
 #include "render_support.hpp"
-#include "scene/builtin_scenes.hpp"
-#include "stages/render_setup.hpp"
+#include "wavetrace/scene/builtin_scenes.hpp"
+#include "wavetrace/stages/render_setup.hpp"
 
 namespace wavetrace {
 namespace {

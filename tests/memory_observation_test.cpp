@@ -6,12 +6,12 @@
 
 #include <nlohmann/json.hpp>
 
-#include "accel/registry.hpp"
-#include "bench/ray_sets.hpp"
-#include "scene/builtin_scenes.hpp"
-#include "stages/memory_observation.hpp"
-#include "stages/render_setup.hpp"
-#include "stages/tracing_arena.hpp"
+#include "wavetrace/accel/registry.hpp"
+#include "wavetrace/bench/ray_sets.hpp"
+#include "wavetrace/scene/builtin_scenes.hpp"
+#include "wavetrace/stages/memory_observation.hpp"
+#include "wavetrace/stages/render_setup.hpp"
+#include "wavetrace/stages/tracing_arena.hpp"
 #include "test_support.hpp"
 
 namespace wavetrace {

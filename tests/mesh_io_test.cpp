@@ -5,8 +5,8 @@
 
 #include <gtest/gtest.h>
 
-#include "scene/mesh_io.hpp"
-#include "scene/mesh_report.hpp"
+#include "wavetrace/scene/mesh_io.hpp"
+#include "wavetrace/scene/mesh_report.hpp"
 #include "test_support.hpp"
 
 namespace wavetrace {

@@ -1,7 +1,7 @@
 // Topology census on small hand-made meshes with known answers.
 #include <gtest/gtest.h>
 
-#include "scene/mesh_report.hpp"
+#include "wavetrace/scene/mesh_report.hpp"
 
 namespace wavetrace {
 namespace {

@@ -6,9 +6,9 @@
 #include <thread>
 #include <unordered_map>
 
-#include "kernels/random.hpp"
-#include "memory/memory_probe.hpp"
-#include "memory/pager.hpp"
+#include "wavetrace/kernels/random.hpp"
+#include "wavetrace/memory/memory_probe.hpp"
+#include "wavetrace/memory/pager.hpp"
 
 namespace wavetrace {
 namespace {

@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "stages/render_setup.hpp"
+#include "wavetrace/stages/render_setup.hpp"
 
 namespace wavetrace {
 namespace {

@@ -7,9 +7,9 @@
 #include <cstring>
 #include <limits>
 
-#include "scene/builtin_scenes.hpp"
-#include "scene/ply_file.hpp"
-#include "scene/scene.hpp"
+#include "wavetrace/scene/builtin_scenes.hpp"
+#include "wavetrace/scene/ply_file.hpp"
+#include "wavetrace/scene/scene.hpp"
 #include "test_support.hpp"
 
 namespace wavetrace {

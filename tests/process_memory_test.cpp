@@ -5,7 +5,7 @@
 #include <cstring>
 #include <vector>
 
-#include "memory/process_memory.hpp"
+#include "wavetrace/memory/process_memory.hpp"
 
 namespace wavetrace {
 namespace {

@@ -3,8 +3,8 @@
 
 #include <gtest/gtest.h>
 
-#include "memory/batch_pool.hpp"
-#include "memory/ray_batch.hpp"
+#include "wavetrace/memory/batch_pool.hpp"
+#include "wavetrace/memory/ray_batch.hpp"
 
 namespace wavetrace {
 namespace {

@@ -9,17 +9,17 @@
 #include <map>
 #include <set>
 
-#include "accel/raystrips/ray_strip_format.hpp"
-#include "accel/raystrips/raystrips_accelerator.hpp"
-#include "accel/raystrips/strip_encode.hpp"
-#include "accel/raystrips/stripify.hpp"
-#include "accel/registry.hpp"
-#include "bench/accel_bench.hpp"
-#include "bench/leak_bench.hpp"
-#include "bench/ray_sets.hpp"
-#include "scene/builtin_scenes.hpp"
-#include "scene/scene.hpp"
-#include "stages/config.hpp"
+#include "wavetrace/accel/raystrips/ray_strip_format.hpp"
+#include "wavetrace/accel/raystrips/raystrips_accelerator.hpp"
+#include "wavetrace/accel/raystrips/strip_encode.hpp"
+#include "wavetrace/accel/raystrips/stripify.hpp"
+#include "wavetrace/accel/registry.hpp"
+#include "wavetrace/bench/accel_bench.hpp"
+#include "wavetrace/bench/leak_bench.hpp"
+#include "wavetrace/bench/ray_sets.hpp"
+#include "wavetrace/scene/builtin_scenes.hpp"
+#include "wavetrace/scene/scene.hpp"
+#include "wavetrace/stages/config.hpp"
 #include "accel_agreement.hpp"
 
 namespace wavetrace {

@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "accel/registry.hpp"
-#include "scene/lights.hpp"
-#include "stages/render_setup.hpp"
+#include "wavetrace/accel/registry.hpp"
+#include "wavetrace/scene/lights.hpp"
+#include "wavetrace/stages/render_setup.hpp"
 
 namespace wavetrace::testing {
 

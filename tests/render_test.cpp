@@ -7,10 +7,10 @@
 
 #include <gtest/gtest.h>
 
-#include "accel/registry.hpp"
-#include "scene/builtin_scenes.hpp"
-#include "scene/lights.hpp"
-#include "stages/render_setup.hpp"
+#include "wavetrace/accel/registry.hpp"
+#include "wavetrace/scene/builtin_scenes.hpp"
+#include "wavetrace/scene/lights.hpp"
+#include "wavetrace/stages/render_setup.hpp"
 
 namespace wavetrace {
 namespace {

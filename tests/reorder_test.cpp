@@ -8,18 +8,18 @@
 #include <map>
 #include <set>
 
-#include "accel/proxy/cluster_simplify.hpp"
-#include "accel/proxy/proxy.hpp"
-#include "accel/proxy/stochastic_simplify.hpp"
-#include "accel/registry.hpp"
-#include "bench/reorder_bench.hpp"
-#include "kernels/radix_sort.hpp"
-#include "kernels/random.hpp"
-#include "kernels/space_filling_curve.hpp"
-#include "scene/builtin_scenes.hpp"
-#include "scene/lights.hpp"
-#include "stages/render_setup.hpp"
-#include "stages/zsort.hpp"
+#include "wavetrace/accel/proxy/cluster_simplify.hpp"
+#include "wavetrace/accel/proxy/proxy.hpp"
+#include "wavetrace/accel/proxy/stochastic_simplify.hpp"
+#include "wavetrace/accel/registry.hpp"
+#include "wavetrace/bench/reorder_bench.hpp"
+#include "wavetrace/kernels/radix_sort.hpp"
+#include "wavetrace/kernels/random.hpp"
+#include "wavetrace/kernels/space_filling_curve.hpp"
+#include "wavetrace/scene/builtin_scenes.hpp"
+#include "wavetrace/scene/lights.hpp"
+#include "wavetrace/stages/render_setup.hpp"
+#include "wavetrace/stages/zsort.hpp"
 #include "collecting_output.hpp"
 
 namespace wavetrace {

@@ -6,8 +6,8 @@
 
 #include "collecting_output.hpp"
 #include "render_support.hpp"
-#include "scene/builtin_scenes.hpp"
-#include "stages/repack.hpp"
+#include "wavetrace/scene/builtin_scenes.hpp"
+#include "wavetrace/stages/repack.hpp"
 
 namespace wavetrace {
 namespace {

@@ -7,13 +7,13 @@
 #include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
 
-#include "accel/registry.hpp"
-#include "bench/leak_bench.hpp"
-#include "scene/builtin_scenes.hpp"
-#include "scene/lights.hpp"
-#include "scene/mesh_report.hpp"
-#include "scene/shapes.hpp"
-#include "stages/render_setup.hpp"
+#include "wavetrace/accel/registry.hpp"
+#include "wavetrace/bench/leak_bench.hpp"
+#include "wavetrace/scene/builtin_scenes.hpp"
+#include "wavetrace/scene/lights.hpp"
+#include "wavetrace/scene/mesh_report.hpp"
+#include "wavetrace/scene/shapes.hpp"
+#include "wavetrace/stages/render_setup.hpp"
 #include "render_support.hpp"
 #include "test_support.hpp"
 

@@ -6,13 +6,13 @@
 
 #include <glm/geometric.hpp>
 
-#include "accel/registry.hpp"
-#include "scene/builtin_scenes.hpp"
-#include "scene/lights.hpp"
-#include "scene/object_transform.hpp"
-#include "scene/scene_file.hpp"
-#include "scene/subdivide.hpp"
-#include "stages/render_setup.hpp"
+#include "wavetrace/accel/registry.hpp"
+#include "wavetrace/scene/builtin_scenes.hpp"
+#include "wavetrace/scene/lights.hpp"
+#include "wavetrace/scene/object_transform.hpp"
+#include "wavetrace/scene/scene_file.hpp"
+#include "wavetrace/scene/subdivide.hpp"
+#include "wavetrace/stages/render_setup.hpp"
 #include "test_support.hpp"
 
 namespace wavetrace {

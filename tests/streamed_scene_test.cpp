@@ -4,11 +4,11 @@
 
 #include <algorithm>
 
-#include "scene/builtin_scenes.hpp"
-#include "scene/lights.hpp"
-#include "scene/material_runs.hpp"
-#include "scene/shapes.hpp"
-#include "scene/triangle_source.hpp"
+#include "wavetrace/scene/builtin_scenes.hpp"
+#include "wavetrace/scene/lights.hpp"
+#include "wavetrace/scene/material_runs.hpp"
+#include "wavetrace/scene/shapes.hpp"
+#include "wavetrace/scene/triangle_source.hpp"
 
 namespace wavetrace {
 namespace {

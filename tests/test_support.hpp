@@ -10,7 +10,7 @@
 
 #include <glm/geometric.hpp>
 
-#include "scene/triangle_mesh.hpp"
+#include "wavetrace/scene/triangle_mesh.hpp"
 
 namespace wavetrace::testing {
 

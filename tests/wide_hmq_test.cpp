@@ -6,16 +6,16 @@
 #include <cmath>
 #include <string>
 
-#include "accel/hmq/hmq_accelerator.hpp"
-#include "accel/bvh/quantized_wide_node.hpp"
-#include "accel/registry.hpp"
+#include "wavetrace/accel/hmq/hmq_accelerator.hpp"
+#include "wavetrace/accel/bvh/quantized_wide_node.hpp"
+#include "wavetrace/accel/registry.hpp"
 #include "accel_agreement.hpp"
-#include "bench/accel_bench.hpp"
-#include "bench/leak_bench.hpp"
-#include "bench/ray_sets.hpp"
-#include "scene/builtin_scenes.hpp"
-#include "scene/scene.hpp"
-#include "stages/render_setup.hpp"
+#include "wavetrace/bench/accel_bench.hpp"
+#include "wavetrace/bench/leak_bench.hpp"
+#include "wavetrace/bench/ray_sets.hpp"
+#include "wavetrace/scene/builtin_scenes.hpp"
+#include "wavetrace/scene/scene.hpp"
+#include "wavetrace/stages/render_setup.hpp"
 #include "test_support.hpp"
 
 namespace wavetrace {

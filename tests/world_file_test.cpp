@@ -11,16 +11,16 @@
 
 #include <xxhash.h>
 
-#include "accel/registry.hpp"
-#include "accel/hmq/global_grid.hpp"
-#include "accel/hit_surface.hpp"
-#include "accel/section_archive.hpp"
-#include "memory/section_file.hpp"
-#include "memory/section_writer.hpp"
-#include "scene/builtin_scenes.hpp"
-#include "scene/lights.hpp"
-#include "stages/render_setup.hpp"
-#include "stages/world_file.hpp"
+#include "wavetrace/accel/registry.hpp"
+#include "wavetrace/accel/hmq/global_grid.hpp"
+#include "wavetrace/accel/hit_surface.hpp"
+#include "wavetrace/accel/section_archive.hpp"
+#include "wavetrace/memory/section_file.hpp"
+#include "wavetrace/memory/section_writer.hpp"
+#include "wavetrace/scene/builtin_scenes.hpp"
+#include "wavetrace/scene/lights.hpp"
+#include "wavetrace/stages/render_setup.hpp"
+#include "wavetrace/stages/world_file.hpp"
 #include "test_support.hpp"
 
 namespace wavetrace {

@@ -1,0 +1,88 @@
+// What the binary and the 8-wide BVH share per ray: the nearest hit so far, the leaf test
+// over an indexed face set, and writing the answer into the hit batch.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <vector>
+
+#include "wavetrace/accel/bvh/indexed_face_set.hpp"
+#include "wavetrace/accel/ray_loop.hpp"
+#include "wavetrace/kernels/triangle_intersect.hpp"
+#include "wavetrace/memory/ray_batch.hpp"
+
+namespace wavetrace {
+
+class LeafQuery {
+ public:
+  // `leaf_index` maps leaf slots to face-set slots; empty when the face set is in leaf order.
+  LeafQuery(const IndexedFaceSet& geometry, std::span<const std::uint32_t> leaf_index, const SingleRay& ray)
+      : tmin(ray.tmin),
+        tmax(ray.tmax),
+        geometry_(geometry),
+        leaf_index_(leaf_index.empty() ? nullptr : leaf_index.data()),
+        ray_(ray.sheared) {}
+
+  float tmin;
+  float tmax;  // shrinks to the nearest hit found
+
+  bool found() const { return found_ != kInvalidPrimitive; }
+
+  // Tests leaf slots [first, first + count); with kAnyHit stops at the first hit. Reports
+  // each index, triangle and vertex read to `probe`.
+  template <bool kAnyHit, typename Probe>
+  void test_leaf(std::uint32_t first, std::uint32_t count, Probe& probe) {
+    const glm::vec3* positions = geometry_.positions();
+    const glm::uvec3* triangles = geometry_.triangles();
+    for (std::uint32_t slot = first; slot < first + count; ++slot) {
+      if (leaf_index_) probe.read(leaf_index_ + slot, sizeof(std::uint32_t));
+      const std::uint32_t triangle = leaf_index_ ? leaf_index_[slot] : slot;
+      const glm::uvec3& tri = triangles[triangle];
+      if constexpr (Probe::kRecords) {
+        probe.read(&tri, sizeof tri);
+        for (int corner = 0; corner < 3; ++corner) probe.read(positions + tri[corner], sizeof(glm::vec3));
+      }
+      TriangleHit hit;
+      if (intersect_watertight(ray_, positions[tri.x], positions[tri.y], positions[tri.z], tmin, tmax, hit)) {
+        tmax = hit.t;
+        best_ = hit;
+        found_ = triangle;
+        if constexpr (kAnyHit) return;
+      }
+    }
+  }
+
+  // The answer in the mesh's triangle numbering (a miss if nothing was found); with
+  // kSurface (closest-hit queries) also the hit's point and normal.
+  template <bool kSurface, typename Probe>
+  void write(HitBatch& hits, std::uint32_t i, Probe& probe) const {
+    if (!found()) return hits.set_miss(i);
+    if constexpr (Probe::kRecords) {
+      if (const std::uint32_t* id = geometry_.input_id_address(found_)) probe.read(id, sizeof *id);
+    }
+    hits.set_hit(i, best_.t, geometry_.input_id(found_), best_.u, best_.v);
+    if constexpr (!kSurface) return;
+    const glm::uvec3& tri = geometry_.triangles()[found_];
+    const glm::vec3* positions = geometry_.positions();
+    hits.set_surface(i, positions[tri.x], positions[tri.y], positions[tri.z]);
+  }
+
+ private:
+  const IndexedFaceSet& geometry_;
+  const std::uint32_t* leaf_index_;
+  WatertightRay ray_;
+  std::uint32_t found_ = kInvalidPrimitive;
+  TriangleHit best_{std::numeric_limits<float>::infinity(), 0.0f, 0.0f};
+};
+
+// The byte ranges a BVH's traversal reads, for the pager.
+template <typename NodeArray, typename IndexArray>
+std::vector<std::span<const std::byte>> bvh_memory_spans(const NodeArray& nodes, const IndexArray& leaf_index,
+                                                         const IndexedFaceSet& geometry) {
+  std::vector<std::span<const std::byte>> spans = {std::as_bytes(std::span(nodes)), std::as_bytes(std::span(leaf_index))};
+  for (const auto& span : geometry.spans()) spans.push_back(span);
+  return spans;
+}
+
+}  // namespace wavetrace

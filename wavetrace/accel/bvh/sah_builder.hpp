@@ -1,0 +1,44 @@
+// Binned SAH builder (parallel, TBB): a binary tree over primitive bounding boxes. It is
+// a component: the BVH baseline flattens its tree into 32-byte nodes, and the compact
+// accelerators build their top levels with it.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "wavetrace/memory/cache_aligned_allocator.hpp"
+#include "wavetrace/scene/triangle_mesh.hpp"
+
+namespace wavetrace {
+
+// No tree is deeper than this (64 free SAH levels, then halving: 64 + 32 for 2^32 primitives).
+inline constexpr std::uint32_t kMaxTreeDepth = 96;
+
+struct SahOptions {
+  std::uint32_t max_leaf_size = 4;  // 1..16; a node above this is always split
+  std::uint32_t bins = 16;          // candidate split planes per axis, minus one
+  float traversal_cost = 1.0f;      // cost of visiting a node, relative to ...
+  float intersection_cost = 1.0f;   // ... testing one primitive
+};
+
+// A node of the built tree. Inner nodes have two children; leaves own the primitive
+// range [first, first + count) of BuildTree::primitive_order.
+struct BuildNode {
+  Bounds3 bounds;
+  std::uint32_t left = 0, right = 0;  // inner
+  std::uint32_t first = 0, count = 0;  // leaf: count > 0
+  bool leaf() const { return count > 0; }
+};
+
+struct BuildTree {
+  LargeArray<BuildNode> nodes;                 // root at index 0
+  LargeArray<std::uint32_t> primitive_order;   // input primitive ids in leaf order
+  std::size_t peak_bytes = 0;                  // the builder's own working memory at its peak
+  std::uint32_t depth() const;                 // levels from the root to the deepest leaf, root = 1
+};
+
+// Throws std::invalid_argument for an empty input or max_leaf_size outside 1..16.
+BuildTree build_sah_tree(std::span<const Bounds3> primitive_bounds, const SahOptions& options);
+
+}  // namespace wavetrace

@@ -1,0 +1,121 @@
+// Checks of a loaded tree before any ray walks it: a world file that passed its checksums may
+// still have been written by something other than wavetrace (the world-file fuzz target
+// writes such files), and a child index past the array, a cycle, or a tree deeper than the
+// walk's stack would otherwise be a crash or a hang, not an error naming the file.
+//
+// The shared rule: a child lies after its parent in the array (all three node layouts put
+// parents first, and the wide and quantized layouts inherit their order), so every walk ends;
+// depth is counted from the root and must stay under kMaxTreeDepth, which sizes every stack.
+//
+// Checked so: bvh (binary and 8-wide), the chunked top, hmq's float top and quantized 8-wide
+// tree with their leaf records (hmq/block_check.hpp), raystrips' tops (binary and quantized)
+// with their strips (raystrips/strip_check.hpp).
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "wavetrace/accel/bvh/bvh_node.hpp"
+#include "wavetrace/accel/bvh/quantized_wide_node.hpp"
+#include "wavetrace/accel/bvh/sah_builder.hpp"
+#include "wavetrace/accel/bvh/wide_bvh_node.hpp"
+#include "wavetrace/accel/section_archive.hpp"
+
+namespace wavetrace {
+
+// Depths of a tree's nodes, filled parent first; `link` fails unless the child follows it.
+class TreeDepths {
+ public:
+  TreeDepths(std::size_t nodes, const SectionLoader& in, std::string_view section)
+      : depth_(nodes, 0), in_(in), section_(section) {
+    if (nodes == 0) in.fail(section, "is empty");
+  }
+  void link(std::size_t parent, std::uint64_t child) {
+    if (child <= parent || child >= depth_.size()) {
+      in_.fail(section_, fmt::format("node {} names child {}, which does not lie after it among the {} nodes", parent,
+                                     child, depth_.size()));
+    }
+    const std::uint32_t depth = depth_[parent] + 1u;
+    if (depth >= kMaxTreeDepth) in_.fail(section_, fmt::format("is deeper than {} levels", kMaxTreeDepth));
+    depth_[child] = std::max<std::uint8_t>(depth_[child], static_cast<std::uint8_t>(depth));
+  }
+
+ private:
+  std::vector<std::uint8_t> depth_;
+  const SectionLoader& in_;
+  std::string_view section_;
+};
+
+// A binary tree of BvhNodes; `check_leaf(node)` fails for a leaf naming what does not exist.
+template <typename CheckLeaf>
+void check_tree(std::span<const BvhNode> nodes, const SectionLoader& in, std::string_view section, CheckLeaf&& check_leaf) {
+  TreeDepths depths(nodes.size(), in, section);
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    if (nodes[i].leaf()) {
+      check_leaf(nodes[i]);
+    } else {
+      depths.link(i, nodes[i].left());
+      depths.link(i, nodes[i].right());
+    }
+  }
+}
+
+// An 8-wide tree; `check_leaf(first, count)` fails for a leaf lane naming what does not
+// exist. A lane whose six bounds are +inf is never entered (wide_bvh_node.hpp) and not read.
+template <typename CheckLeaf>
+void check_tree(std::span<const WideBvhNode> nodes, const SectionLoader& in, std::string_view section,
+                CheckLeaf&& check_leaf) {
+  TreeDepths depths(nodes.size(), in, section);
+  constexpr float kInfinity = std::numeric_limits<float>::infinity();
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    const WideBvhNode& node = nodes[i];
+    for (int k = 0; k < WideBvhNode::kWidth; ++k) {
+      const bool unused = node.lower_x[k] == kInfinity && node.upper_x[k] == kInfinity && node.lower_y[k] == kInfinity &&
+                          node.upper_y[k] == kInfinity && node.lower_z[k] == kInfinity && node.upper_z[k] == kInfinity;
+      if (unused) continue;
+      if (node.count[k] == 0) depths.link(i, node.child[k]);
+      else check_leaf(node.child[k], node.count[k]);
+    }
+  }
+}
+
+// A quantized 8-wide tree (quantized_wide_node.hpp); `check_leaf(reference, weight)` fails
+// for a leaf child naming what does not exist. Empty slots (meta 0) are never entered.
+template <typename CheckLeaf>
+void check_tree(std::span<const QuantizedWideNode> nodes, const SectionLoader& in, std::string_view section,
+                CheckLeaf&& check_leaf) {
+  TreeDepths depths(nodes.size(), in, section);
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    const QuantizedWideNode& node = nodes[i];
+    std::uint64_t inner = 0, weight = 0;
+    for (int k = 0; k < QuantizedWideNode::kWidth; ++k) {
+      const std::uint8_t meta = node.meta[k];
+      if (meta == 0) continue;
+      if (meta == QuantizedWideNode::kInnerMeta) {
+        depths.link(i, node.child_base + inner++);
+      } else {
+        const std::uint64_t reference = node.leaf_base + weight;
+        // The walk marks leaf references with bit 31 (kWideLeafReference).
+        if (reference >= (std::uint64_t{1} << 31)) in.fail(section, fmt::format("node {} has a leaf reference past 2^31", i));
+        check_leaf(static_cast<std::uint32_t>(reference), meta);
+        weight += meta;
+      }
+    }
+  }
+}
+
+// A leaf's triangle slots [first, first + count) within `slots`, and (checked once for the
+// whole array by the caller) each slot naming a triangle.
+inline void check_leaf_slots(std::uint64_t first, std::uint64_t count, std::size_t slots, const SectionLoader& in,
+                             std::string_view section) {
+  if (count == 0 || first + count > slots) {
+    in.fail(section, fmt::format("has a leaf of triangle slots [{}, {}) beyond its {} slots", first, first + count, slots));
+  }
+}
+
+}  // namespace wavetrace

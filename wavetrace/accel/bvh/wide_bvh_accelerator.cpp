@@ -1,0 +1,269 @@
+// The 8-wide BVH: the binary SAH tree collapsed (each node adopts the largest-area inner
+// child's children until it has eight), traversed one ray at a time with all eight child
+// boxes tested in one AVX2 pass, nearest child first.
+#include "wavetrace/accel/bvh/wide_bvh_accelerator.hpp"
+#include "wavetrace/build_config.hpp"  // WAVETRACE_AVX2, WAVETRACE_FMA, WAVETRACE_BMI2
+
+#include <algorithm>
+#include <bit>
+#include <chrono>
+#include <limits>
+
+#if WAVETRACE_AVX2
+#include <immintrin.h>
+#endif
+
+#include "wavetrace/accel/bvh/bvh_build.hpp"
+#include "wavetrace/accel/ray_loop.hpp"
+#include "wavetrace/accel/section_archive.hpp"
+#include "wavetrace/accel/bvh/indexed_face_set.hpp"
+#include "wavetrace/accel/bvh/wide_bvh_node.hpp"
+#include "wavetrace/kernels/ray_box.hpp"
+#include "wavetrace/accel/bvh/leaf_query.hpp"
+#include "wavetrace/memory/cache_aligned_allocator.hpp"
+
+namespace wavetrace {
+namespace {
+
+constexpr float kInfinity = std::numeric_limits<float>::infinity();
+constexpr int kWidth = WideBvhNode::kWidth;
+
+float half_area(const Bounds3& b) {
+  const glm::vec3 e = b.extent();
+  return e.x * e.y + e.y * e.z + e.z * e.x;
+}
+
+// Per-ray constants of the eight-box test.
+struct WideRay {
+  glm::vec3 origin;
+  glm::vec3 inverse;
+  int zero_axes;  // bit a set: direction[a] == 0, that slab is tested by comparison
+};
+
+// Entry distances of the ray into the node's eight child boxes; returns the mask of the
+// lanes entered (bit k: child k), whose distances are valid.
+[[gnu::always_inline]] inline unsigned intersect_children(const WideBvhNode& node, const WideRay& ray, float tmin,
+                                                          float tmax, float distance[kWidth]) {
+#if WAVETRACE_AVX2
+  const float* lower[3] = {node.lower_x, node.lower_y, node.lower_z};
+  const float* upper[3] = {node.upper_x, node.upper_y, node.upper_z};
+  const __m256 infinity = _mm256_set1_ps(kInfinity);
+  __m256 near = _mm256_set1_ps(tmin);
+  __m256 far = infinity;
+  for (int axis = 0; axis < 3; ++axis) {
+    const __m256 lo = _mm256_load_ps(lower[axis]);
+    const __m256 hi = _mm256_load_ps(upper[axis]);
+    const __m256 origin = _mm256_set1_ps(ray.origin[axis]);
+    __m256 entry, exit;
+    if (ray.zero_axes & (1 << axis)) {
+      // The ray never moves along this axis: inside the slab for all t, or never.
+      const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(lo, origin, _CMP_LE_OQ), _mm256_cmp_ps(origin, hi, _CMP_LE_OQ));
+      entry = _mm256_blendv_ps(infinity, _mm256_set1_ps(-kInfinity), inside);
+      exit = _mm256_blendv_ps(_mm256_set1_ps(-kInfinity), infinity, inside);
+    } else {
+      const __m256 inverse = _mm256_set1_ps(ray.inverse[axis]);
+      const __m256 t0 = _mm256_mul_ps(_mm256_sub_ps(lo, origin), inverse);
+      const __m256 t1 = _mm256_mul_ps(_mm256_sub_ps(hi, origin), inverse);
+      entry = _mm256_min_ps(t0, t1);
+      exit = _mm256_max_ps(t0, t1);
+    }
+    near = _mm256_max_ps(near, entry);
+    far = _mm256_min_ps(far, exit);
+  }
+  far = _mm256_min_ps(_mm256_mul_ps(far, _mm256_set1_ps(kSlabFarScale)), _mm256_set1_ps(tmax));
+  _mm256_store_ps(distance, near);
+  // near < inf as well: an unused lane (bounds +inf) gives near = far = +inf when tmax is +inf.
+  const __m256 entered = _mm256_and_ps(_mm256_cmp_ps(near, far, _CMP_LE_OQ), _mm256_cmp_ps(near, infinity, _CMP_LT_OQ));
+  return static_cast<unsigned>(_mm256_movemask_ps(entered));
+#else
+  unsigned mask = 0;
+  for (int k = 0; k < kWidth; ++k) {
+    const BoxRay box{ray.origin, ray.inverse};
+    distance[k] = intersect_box(box, {node.lower_x[k], node.lower_y[k], node.lower_z[k]},
+                                {node.upper_x[k], node.upper_y[k], node.upper_z[k]}, tmin, tmax);
+    if (distance[k] != kInfinity) mask |= 1u << k;
+  }
+  return mask;
+#endif
+}
+
+class WideBvhAccelerator final : public Accelerator {
+ public:
+  explicit WideBvhAccelerator(SectionLoader& in) : geometry_(in) {
+    load_bvh(in, geometry_, "bvh8.nodes", nodes_, leaf_triangles_, build_);
+  }
+
+  void save(SectionWriter& out, const std::string& prefix) const override {
+    save_bvh(out, prefix, geometry_, "bvh8.nodes", nodes_, leaf_triangles_, build_);
+  }
+
+  WideBvhAccelerator(const TriangleMesh& mesh, const BvhOptions& options) : geometry_(mesh, options.triangle_order) {
+    const auto start = std::chrono::steady_clock::now();
+    const BuildTree tree = build_bvh_tree(geometry_, options);
+    build_leaf_triangles_.reserve(geometry_.triangle_count());
+    build_nodes_.reserve(tree.nodes.size() / 4 + 1);
+    collapse(tree, 0);
+    adopt_leaf_order(options, geometry_, build_leaf_triangles_);
+    nodes_ = StoredArray<WideBvhNode>(std::move(build_nodes_));
+    leaf_triangles_ = StoredArray<std::uint32_t>(std::move(build_leaf_triangles_));
+    build_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    build_.peak_bytes = bvh_build_peak_bytes(tree, geometry_, memory().total());
+  }
+
+  std::string name() const override { return "bvh8"; }
+
+  void intersect_closest(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
+    NullProbe probe;
+    traverse<false>(rays, hits, range, probe);
+  }
+  void intersect_any(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
+    NullProbe probe;
+    traverse<true>(rays, hits, range, probe);
+  }
+  bool probed() const override { return true; }
+  void intersect_closest_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
+                                RecordingProbe& probe) const override {
+    traverse<false>(rays, hits, range, probe);
+  }
+  void intersect_any_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
+                            RecordingProbe& probe) const override {
+    traverse<true>(rays, hits, range, probe);
+  }
+
+  MemoryReport memory() const override {
+    return {nodes_.size() * sizeof(WideBvhNode) + leaf_triangles_.size() * sizeof(std::uint32_t),
+            geometry_.geometry_bytes(), geometry_.id_map_bytes()};
+  }
+  BuildReport build() const override { return build_; }
+
+  std::vector<std::span<const std::byte>> memory_spans() const override {
+    return bvh_memory_spans(nodes_, leaf_triangles_, geometry_);
+  }
+
+ private:
+  // Writes the wide node for binary node `root` (and, depth-first, everything below it);
+  // returns its index. A binary leaf at the root becomes a wide node with one leaf lane.
+  std::uint32_t collapse(const BuildTree& tree, std::uint32_t root) {
+    std::vector<std::uint32_t> lanes;
+    if (tree.nodes[root].leaf()) {
+      lanes.push_back(root);
+    } else {
+      lanes = {tree.nodes[root].left, tree.nodes[root].right};
+      while (lanes.size() < kWidth) {
+        // Open the inner child with the largest surface: the one most rays would enter.
+        auto widest = lanes.end();
+        for (auto lane = lanes.begin(); lane != lanes.end(); ++lane) {
+          if (!tree.nodes[*lane].leaf() &&
+              (widest == lanes.end() || half_area(tree.nodes[*lane].bounds) > half_area(tree.nodes[*widest].bounds))) {
+            widest = lane;
+          }
+        }
+        if (widest == lanes.end()) break;
+        const BuildNode& opened = tree.nodes[*widest];
+        *widest = opened.left;
+        lanes.push_back(opened.right);
+      }
+    }
+    const auto index = static_cast<std::uint32_t>(build_nodes_.size());
+    build_nodes_.emplace_back();
+    WideBvhNode node{};
+    for (int k = 0; k < kWidth; ++k) {
+      node.lower_x[k] = node.lower_y[k] = node.lower_z[k] = kInfinity;
+      node.upper_x[k] = node.upper_y[k] = node.upper_z[k] = kInfinity;
+    }
+    for (std::size_t k = 0; k < lanes.size(); ++k) {
+      const BuildNode& child = tree.nodes[lanes[k]];
+      node.lower_x[k] = child.bounds.lower.x, node.lower_y[k] = child.bounds.lower.y, node.lower_z[k] = child.bounds.lower.z;
+      node.upper_x[k] = child.bounds.upper.x, node.upper_y[k] = child.bounds.upper.y, node.upper_z[k] = child.bounds.upper.z;
+      if (child.leaf()) {
+        node.child[k] = static_cast<std::uint32_t>(build_leaf_triangles_.size());
+        node.count[k] = static_cast<std::uint8_t>(child.count);
+        for (std::uint32_t i = 0; i < child.count; ++i) build_leaf_triangles_.push_back(tree.primitive_order[child.first + i]);
+      } else {
+        node.child[k] = collapse(tree, lanes[k]);
+        node.count[k] = 0;
+      }
+    }
+    build_nodes_[index] = node;
+    return index;
+  }
+
+  template <bool kAnyHit, typename Probe>
+  void traverse(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
+    struct StackEntry {
+      std::uint32_t child;
+      std::uint32_t count;
+      float distance;
+    };
+    // Each level pushes at most seven siblings.
+    StackEntry stack[kMaxTreeDepth * (kWidth - 1) + kWidth];
+    const WideBvhNode* nodes = nodes_.data();
+    for_each_ray(rays, hits, range, [&](const SingleRay& ray, std::uint32_t i) {
+      const glm::vec3& direction = ray.direction;
+      const WideRay box_ray{ray.origin, ray.box.inverse_direction,
+                            (direction.x == 0.0f) | (direction.y == 0.0f) << 1 | (direction.z == 0.0f) << 2};
+      LeafQuery query(geometry_, leaf_triangles_, ray);
+      const float tmin = query.tmin;
+      float& tmax = query.tmax;
+
+      std::uint32_t top = 0;
+      StackEntry current{0, 0, tmin};
+      while (true) {
+        if (current.count == 0) {
+          alignas(32) float distance[kWidth];
+          const WideBvhNode& node = nodes[current.child];
+          probe.read(&node, sizeof node);
+          unsigned mask = intersect_children(node, box_ray, tmin, tmax, distance);
+          if (mask != 0 && (mask & (mask - 1)) == 0) {  // one child entered: no sorting
+            const int k = std::countr_zero(mask);
+            current = {node.child[k], node.count[k], distance[k]};
+            continue;
+          }
+          StackEntry entered[kWidth];
+          int entered_count = 0;
+          for (; mask != 0; mask &= mask - 1) {
+            const int k = std::countr_zero(mask);
+            // Insertion by descending distance: the nearest ends last, to be taken first.
+            int slot = entered_count++;
+            while (slot > 0 && entered[slot - 1].distance < distance[k]) {
+              entered[slot] = entered[slot - 1];
+              --slot;
+            }
+            entered[slot] = {node.child[k], node.count[k], distance[k]};
+          }
+          if (entered_count > 0) {
+            for (int k = 0; k + 1 < entered_count; ++k) stack[top++] = entered[k];
+            current = entered[entered_count - 1];
+            continue;
+          }
+        } else {
+          query.test_leaf<kAnyHit>(current.child, current.count, probe);
+          if (kAnyHit && query.found()) break;
+        }
+        while (top > 0 && stack[top - 1].distance > tmax) --top;
+        if (top == 0) break;
+        current = stack[--top];
+      }
+      query.write<!kAnyHit>(hits, i, probe);
+    });
+  }
+
+  IndexedFaceSet geometry_;
+  StoredArray<WideBvhNode> nodes_;
+  StoredArray<std::uint32_t> leaf_triangles_;
+  LargeArray<WideBvhNode> build_nodes_;              // while collapsing; empty once built
+  LargeArray<std::uint32_t> build_leaf_triangles_;
+  BuildReport build_;
+};
+
+}  // namespace
+
+std::unique_ptr<Accelerator> load_wide_bvh_accelerator(SectionLoader& in) {
+  return std::make_unique<WideBvhAccelerator>(in);
+}
+
+std::unique_ptr<Accelerator> make_wide_bvh_accelerator(const TriangleMesh& mesh, const BvhOptions& options) {
+  return std::make_unique<WideBvhAccelerator>(mesh, options);
+}
+
+}  // namespace wavetrace

@@ -1,0 +1,407 @@
+// Chunked build and traversal. A batch is traced in rounds: each ray first lists the chunks
+// whose boxes it enters (top-level BVH), nearest first; round k hands every ray its k-th
+// chunk, unless its nearest hit so far lies before that chunk's box, and each chunk answers
+// its rays as one compacted batch, so sub-accelerators keep their batch (and packet) paths
+// and pay one virtual call per chunk and round, not per ray.
+#include "wavetrace/accel/chunked/chunked_accelerator.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <limits>
+#include <stdexcept>
+
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "wavetrace/accel/bvh/bvh_node.hpp"
+#include "wavetrace/accel/bvh/bvh_walk.hpp"
+#include "wavetrace/accel/bvh/tree_check.hpp"
+#include "wavetrace/accel/bvh/node_layout.hpp"
+#include "wavetrace/accel/bvh/sah_builder.hpp"
+#include "wavetrace/accel/section_archive.hpp"
+#include "wavetrace/kernels/ray_box.hpp"
+#include "wavetrace/memory/process_memory.hpp"
+
+namespace wavetrace {
+namespace {
+
+constexpr float kInfinity = std::numeric_limits<float>::infinity();
+
+struct Chunk {
+  std::size_t first = 0;  // the source's id of the chunk's triangle 0
+  std::size_t count = 0;
+  Bounds3 bounds;
+  std::unique_ptr<const TriangleMesh> mesh;  // kept only when the sub-accelerator reads it
+  std::unique_ptr<Accelerator> accelerator;
+};
+
+// A chunk a ray enters, and where.
+struct ChunkVisit {
+  float distance;
+  std::uint32_t chunk;
+};
+
+// Per-thread working memory of one traced range, grown to the largest range seen.
+struct RoundScratch {
+  std::unique_ptr<Batch> batch;
+  std::vector<ChunkVisit> visits;
+  std::vector<std::uint32_t> visit_begin, visit_next;  // per ray: its visits, the next one due
+  std::vector<float> nearest;                          // per ray: nearest hit so far (or tmax)
+  std::vector<std::uint32_t> due_chunk, chunk_start, cursor, order;
+
+  void reserve(std::size_t rays, std::size_t chunks) {
+    if (!batch || batch->rays.capacity() < rays) batch = std::make_unique<Batch>(std::max<std::size_t>(rays, 64));
+    visit_begin.resize(rays + 1);
+    visit_next.resize(rays);
+    nearest.resize(rays);
+    due_chunk.resize(rays);
+    order.resize(rays);
+    chunk_start.assign(chunks + 1, 0);
+  }
+};
+
+// Chunks built at the same time: one per worker thread, as many as half the memory the
+// machine has available now can hold at a build's measured 200 bytes per triangle.
+std::size_t chunks_built_at_once(std::size_t chunk_triangles) {
+  const std::size_t threads = static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
+  const std::size_t affordable = available_memory_bytes() / 2 / (chunk_triangles * 200);
+  return std::clamp<std::size_t>(affordable, 1, threads);
+}
+
+// A saved chunked world, under `PREFIX`: "kind" ("chunked", version 1), "common"
+// (section_archive.hpp), "chunked.top" (BvhNode, bvh_node.hpp; a leaf's first is a chunk's
+// index, its count 0x80000001), "chunked.chunks" (40 bytes a chunk:
+//   offset  size  field
+//        0     8  first: the source's id of the chunk's triangle 0, uint64
+//        8     8  count of triangles, uint64
+//       16    24  box: float lower x, y, z, upper x, y, z)
+// and each chunk's own accelerator under PREFIX + "chunk.N/" (N from 0, in decimal).
+struct SavedChunk {
+  std::uint64_t first, count;
+  Bounds3 bounds;
+};
+static_assert(sizeof(SavedChunk) == 40);
+constexpr std::uint32_t kChunkedSavedVersion = 1;
+
+class ChunkedAccelerator final : public Accelerator {
+ public:
+  ChunkedAccelerator(SectionLoader& in, const ChunkLoader& load_chunk) {
+    in.expect_kind("chunked", kChunkedSavedVersion);
+    StoredArray<SavedChunk> saved;
+    in.array("chunked.chunks", saved);
+    in.array("chunked.top", top_);
+    std::size_t triangles = 0;
+    archive_common_state(in, triangles, build_);
+    if (saved.empty() || top_.empty()) in.fail("chunked.chunks", "is empty: no chunk was saved");
+    check_tree(std::span<const BvhNode>(top_.data(), top_.size()), in, "chunked.top", [&](const BvhNode& leaf) {
+      if (leaf.first >= saved.size()) in.fail("chunked.top", "names a chunk that does not exist");
+    });
+    chunks_.resize(saved.size());
+    for (std::size_t c = 0; c < saved.size(); ++c) {
+      SectionLoader chunk_in(in.file(), in.prefix() + fmt::format("chunk.{}/", c));
+      chunks_[c] = Chunk{saved[c].first, saved[c].count, saved[c].bounds, nullptr, load_chunk(chunk_in)};
+    }
+  }
+
+  void save(SectionWriter& out, const std::string& prefix) const override {
+    out.add_value(prefix + "kind", saved_kind("chunked", kChunkedSavedVersion));
+    LargeArray<SavedChunk> saved;
+    for (const Chunk& chunk : chunks_) saved.push_back({chunk.first, chunk.count, chunk.bounds});
+    SectionSaver saver(out, prefix);
+    saver.array("chunked.chunks", StoredArray<SavedChunk>(std::move(saved)));
+    saver.array("chunked.top", top_);
+    std::size_t triangles = this->triangles();
+    archive_common_state(saver, triangles, build_);
+    for (std::size_t c = 0; c < chunks_.size(); ++c) {
+      chunks_[c].accelerator->save(out, prefix + fmt::format("chunk.{}/", c));
+    }
+  }
+
+  ChunkedAccelerator(const TriangleSource& source, std::size_t chunk_triangles, const ChunkBuilder& build_chunk,
+                     bool keeps_mesh) {
+    if (chunk_triangles < kMinChunkTriangles || chunk_triangles > kMaxChunkTriangles) {
+      throw std::invalid_argument(fmt::format("build.chunk_triangles = {}: must be in [{}, {}]", chunk_triangles,
+                                              kMinChunkTriangles, kMaxChunkTriangles));
+    }
+    if (source.triangle_count() >= kInvalidPrimitive) {
+      throw std::invalid_argument(fmt::format("{} triangles: hits name triangles with 32-bit ids, at most {}",
+                                              source.triangle_count(), kInvalidPrimitive - 1));
+    }
+    const auto start = std::chrono::steady_clock::now();
+    const std::vector<ChunkRange> ranges = plan_chunks(source.object_starts(), source.triangle_count(), chunk_triangles);
+    chunks_.resize(ranges.size());
+    std::size_t finished_bytes = 0;
+    for (std::size_t wave_begin = 0; wave_begin < ranges.size();) {
+      const std::size_t wave_end = std::min(ranges.size(), wave_begin + chunks_built_at_once(chunk_triangles));
+      // Extracted one after another (a PLY file's faces are read in order), then built at once.
+      std::vector<std::unique_ptr<const TriangleMesh>> meshes;
+      for (std::size_t c = wave_begin; c < wave_end; ++c) {
+        meshes.push_back(std::make_unique<const TriangleMesh>(source.extract(ranges[c].first, ranges[c].count)));
+      }
+      tbb::parallel_for(wave_begin, wave_end, [&](std::size_t c) {
+        const TriangleMesh& mesh = *meshes[c - wave_begin];
+        chunks_[c] = Chunk{ranges[c].first, ranges[c].count, mesh.bounds(), nullptr, build_chunk(mesh)};
+      });
+      // The wave's builds held their meshes, their temporaries and every chunk finished before.
+      std::size_t wave_bytes = 0;
+      for (std::size_t c = wave_begin; c < wave_end; ++c) {
+        wave_bytes += meshes[c - wave_begin]->bytes() + chunks_[c].accelerator->build().peak_bytes;
+      }
+      build_.peak_bytes = std::max(build_.peak_bytes, finished_bytes + wave_bytes);
+      for (std::size_t c = wave_begin; c < wave_end; ++c) {
+        finished_bytes += chunks_[c].accelerator->memory().total();
+        if (keeps_mesh) {
+          chunks_[c].mesh = std::move(meshes[c - wave_begin]);
+          finished_bytes += chunks_[c].mesh->bytes();
+        }
+      }
+      wave_begin = wave_end;
+    }
+    build_top();
+    build_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+
+  std::string name() const override { return chunks_.front().accelerator->name(); }
+
+  void intersect_closest(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
+    NullProbe probe;
+    trace<false>(rays, hits, range, probe, [](const Accelerator& sub, const RayBatch& r, HitBatch& h, RayRange g) {
+      sub.intersect_closest(r, h, g);
+    });
+  }
+  void intersect_any(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
+    NullProbe probe;
+    trace<true>(rays, hits, range, probe, [](const Accelerator& sub, const RayBatch& r, HitBatch& h, RayRange g) {
+      sub.intersect_any(r, h, g);
+    });
+  }
+  void intersect_coherent(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
+    NullProbe probe;
+    trace<false>(rays, hits, range, probe, [](const Accelerator& sub, const RayBatch& r, HitBatch& h, RayRange g) {
+      sub.intersect_coherent(r, h, g);
+    });
+  }
+  bool probed() const override { return chunks_.front().accelerator->probed(); }
+  void intersect_closest_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
+                                RecordingProbe& probe) const override {
+    trace<false>(rays, hits, range, probe, [&](const Accelerator& sub, const RayBatch& r, HitBatch& h, RayRange g) {
+      sub.intersect_closest_probed(r, h, g, probe);
+    });
+  }
+  void intersect_any_probed(const RayBatch& rays, HitBatch& hits, RayRange range, RecordingProbe& probe) const override {
+    trace<true>(rays, hits, range, probe, [&](const Accelerator& sub, const RayBatch& r, HitBatch& h, RayRange g) {
+      sub.intersect_any_probed(r, h, g, probe);
+    });
+  }
+
+  MemoryReport memory() const override {
+    MemoryReport report;
+    report.hierarchy = top_.size() * sizeof(BvhNode);
+    report.other = chunks_.size() * sizeof(Chunk);
+    for (const Chunk& chunk : chunks_) {
+      const MemoryReport part = chunk.accelerator->memory();
+      report.hierarchy += part.hierarchy;
+      report.geometry += part.geometry;
+      report.other += part.other;
+    }
+    return report;
+  }
+  BuildReport build() const override { return build_; }
+
+  std::string build_notes() const override {
+    std::size_t largest = 0;
+    for (const Chunk& chunk : chunks_) largest = std::max(largest, chunk.count);
+    std::string notes = fmt::format("{} chunks of up to {} triangles under a top BVH of {} nodes", chunks_.size(),
+                                    largest, top_.size());
+    const std::string first = chunks_.front().accelerator->build_notes();
+    if (!first.empty()) notes += "; chunk 0: " + first;
+    return notes;
+  }
+
+  // Every chunk snaps to the one global grid (make_world_accelerator): the first answers.
+  glm::vec3 represented_point(const glm::vec3& point) const override {
+    return chunks_.empty() ? point : chunks_.front().accelerator->represented_point(point);
+  }
+
+  std::optional<TriangleMesh> represented_mesh(const TriangleMesh& source) const override {
+    if (source.triangle_count() != triangles()) throw std::invalid_argument("represented_mesh: not the mesh of this world");
+    TriangleMesh result = source;
+    bool moved = false;
+    const MeshTriangleSource ranges(source);
+    for (const Chunk& chunk : chunks_) {
+      const TriangleMesh part = ranges.extract(chunk.first, chunk.count);
+      const std::optional<TriangleMesh> represented = chunk.accelerator->represented_mesh(part);
+      if (!represented) continue;
+      moved = true;
+      for (std::size_t t = 0; t < chunk.count; ++t) {
+        for (int k = 0; k < 3; ++k) {
+          result.positions[source.triangles[chunk.first + t][k]] = represented->positions[part.triangles[t][k]];
+        }
+      }
+    }
+    if (!moved) return std::nullopt;
+    return result;
+  }
+
+  std::vector<std::span<const std::byte>> memory_spans() const override {
+    std::vector<std::span<const std::byte>> spans = {top_.bytes()};
+    for (const Chunk& chunk : chunks_) {
+      for (const auto& span : chunk.accelerator->memory_spans()) spans.push_back(span);
+    }
+    return spans;
+  }
+
+ private:
+  std::size_t triangles() const {
+    std::size_t total = 0;
+    for (const Chunk& chunk : chunks_) total += chunk.count;
+    return total;
+  }
+
+  void build_top() {
+    std::vector<Bounds3> boxes;
+    for (const Chunk& chunk : chunks_) boxes.push_back(chunk.bounds);
+    SahOptions sah;
+    sah.max_leaf_size = 1;
+    const BuildTree tree = build_sah_tree(boxes, sah);
+    LargeArray<BvhNode> top;
+    flatten_tree(tree, node_order(tree, NodeLayout::depth_first), top,
+                 [&](const BuildNode& leaf) { return tree.primitive_order[leaf.first]; });
+    top_ = StoredArray<BvhNode>(std::move(top));
+  }
+
+  // The chunks ray i enters within [tmin, tmax], nearest first, appended to `visits`.
+  template <typename Probe>
+  void list_chunks(const RayBatch& rays, std::uint32_t i, std::vector<ChunkVisit>& visits, Probe& probe) const {
+    const glm::vec3 origin(rays.origin_x[i], rays.origin_y[i], rays.origin_z[i]);
+    const glm::vec3 direction(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]);
+    const BoxRay box_ray = make_box_ray(origin, direction);
+    const float tmin = rays.tmin[i], tmax = rays.tmax[i];
+    const std::size_t begin = visits.size();
+    walk_bvh(top_.data(), box_ray, tmin, tmax, probe, [&](const BvhNode& leaf) {
+      const float distance = intersect_box(box_ray, leaf.lower, leaf.upper, tmin, tmax);
+      if (distance != kInfinity) visits.push_back({distance, leaf.first});
+      return false;
+    });
+    // Rays enter few chunks: an insertion sort.
+    for (std::size_t a = begin + 1; a < visits.size(); ++a) {
+      const ChunkVisit visit = visits[a];
+      std::size_t b = a;
+      for (; b > begin && visits[b - 1].distance > visit.distance; --b) visits[b] = visits[b - 1];
+      visits[b] = visit;
+    }
+  }
+
+  template <bool kAnyHit, typename Probe, typename Query>
+  void trace(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe, Query&& query) const {
+    thread_local RoundScratch scratch;
+    const std::uint32_t n = range.size();
+    if (n == 0) return;
+    scratch.reserve(n, chunks_.size());
+    scratch.visits.clear();
+    for (std::uint32_t r = 0; r < n; ++r) {
+      const std::uint32_t i = range.begin + r;
+      hits.set_miss(i);
+      scratch.visit_begin[r] = static_cast<std::uint32_t>(scratch.visits.size());
+      scratch.visit_next[r] = scratch.visit_begin[r];
+      scratch.nearest[r] = rays.tmax[i];
+      if (rays.flags[i] & ray_flags::alive) list_chunks(rays, i, scratch.visits, probe);
+    }
+    scratch.visit_begin[n] = static_cast<std::uint32_t>(scratch.visits.size());
+    RayBatch& sub_rays = scratch.batch->rays;
+    HitBatch& sub_hits = scratch.batch->hits;
+    constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+    while (true) {
+      // Each ray's next chunk, unless its nearest hit lies before it (then no later one can do better).
+      std::fill(scratch.chunk_start.begin(), scratch.chunk_start.end(), 0u);
+      std::uint32_t due = 0;
+      for (std::uint32_t r = 0; r < n; ++r) {
+        std::uint32_t& next = scratch.visit_next[r];
+        scratch.due_chunk[r] = kNone;
+        if (next == scratch.visit_begin[r + 1]) continue;
+        const ChunkVisit& visit = scratch.visits[next];
+        if (visit.distance > scratch.nearest[r]) {
+          next = scratch.visit_begin[r + 1];
+          continue;
+        }
+        ++next;
+        scratch.due_chunk[r] = visit.chunk;
+        ++scratch.chunk_start[visit.chunk + 1];
+        ++due;
+      }
+      if (due == 0) return;
+      for (std::size_t c = 0; c < chunks_.size(); ++c) scratch.chunk_start[c + 1] += scratch.chunk_start[c];
+      // Rays grouped by chunk, in their batch order within each group (coherent rays stay coherent).
+      scratch.cursor.assign(scratch.chunk_start.begin(), scratch.chunk_start.end() - 1);
+      std::vector<std::uint32_t>& cursor = scratch.cursor;
+      for (std::uint32_t r = 0; r < n; ++r) {
+        if (scratch.due_chunk[r] == kNone) continue;
+        const std::uint32_t slot = cursor[scratch.due_chunk[r]]++;
+        scratch.order[slot] = r;
+        const std::uint32_t i = range.begin + r;
+        sub_rays.origin_x[slot] = rays.origin_x[i];
+        sub_rays.origin_y[slot] = rays.origin_y[i];
+        sub_rays.origin_z[slot] = rays.origin_z[i];
+        sub_rays.direction_x[slot] = rays.direction_x[i];
+        sub_rays.direction_y[slot] = rays.direction_y[i];
+        sub_rays.direction_z[slot] = rays.direction_z[i];
+        sub_rays.tmin[slot] = rays.tmin[i];
+        sub_rays.tmax[slot] = scratch.nearest[r];
+        sub_rays.kind[slot] = rays.kind[i];
+        sub_rays.flags[slot] = ray_flags::alive;
+      }
+      for (std::size_t c = 0; c < chunks_.size(); ++c) {
+        const std::uint32_t begin = scratch.chunk_start[c], end = scratch.chunk_start[c + 1];
+        if (begin == end) continue;
+        query(*chunks_[c].accelerator, sub_rays, sub_hits, RayRange{begin, end});
+        const auto first = static_cast<std::uint32_t>(chunks_[c].first);
+        for (std::uint32_t slot = begin; slot < end; ++slot) {
+          if (!sub_hits.is_hit(slot)) continue;
+          const std::uint32_t r = scratch.order[slot], i = range.begin + r;
+          if constexpr (kAnyHit) {
+            hits.primitive[i] = first + sub_hits.primitive[slot];
+            scratch.nearest[r] = -kInfinity;  // found: no further chunk is due
+          } else if (sub_hits.t[slot] < scratch.nearest[r]) {
+            hits.copy_hit(i, sub_hits, slot);
+            hits.primitive[i] = first + sub_hits.primitive[slot];
+            scratch.nearest[r] = sub_hits.t[slot];
+          }
+        }
+      }
+    }
+  }
+
+  std::vector<Chunk> chunks_;
+  StoredArray<BvhNode> top_;
+  BuildReport build_;
+};
+
+}  // namespace
+
+std::vector<ChunkRange> plan_chunks(std::span<const std::size_t> object_starts, std::size_t triangles,
+                                    std::size_t chunk_triangles) {
+  std::vector<ChunkRange> chunks;
+  for (std::size_t o = 0; o < object_starts.size(); ++o) {
+    const std::size_t begin = object_starts[o];
+    const std::size_t end = o + 1 < object_starts.size() ? object_starts[o + 1] : triangles;
+    const std::size_t size = end - begin;
+    const std::size_t pieces = (size + chunk_triangles - 1) / chunk_triangles;
+    for (std::size_t k = 0; k < pieces; ++k) {
+      const std::size_t first = begin + size * k / pieces, next = begin + size * (k + 1) / pieces;
+      chunks.push_back({first, next - first});
+    }
+  }
+  return chunks;
+}
+
+std::unique_ptr<Accelerator> load_chunked_accelerator(SectionLoader& in, const ChunkLoader& load_chunk) {
+  return std::make_unique<ChunkedAccelerator>(in, load_chunk);
+}
+
+std::unique_ptr<Accelerator> make_chunked_accelerator(const TriangleSource& source, std::size_t chunk_triangles,
+                                                      const ChunkBuilder& build_chunk, bool keeps_mesh) {
+  return std::make_unique<ChunkedAccelerator>(source, chunk_triangles, build_chunk, keeps_mesh);
+}
+
+}  // namespace wavetrace

@@ -1,0 +1,401 @@
+// Counting construction of the hashed grid (D bits, first-fit row displacement for O, counts
+// and prefix sums for H, reverse insertion for L) and 3D-DDA traversal that stops once the
+// nearest hit found lies before the next cell.
+#include "wavetrace/accel/grid/hashed_grid.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+
+#include "wavetrace/accel/grid/grid_walk.hpp"
+#include "wavetrace/accel/hit_surface.hpp"
+#include "wavetrace/accel/ray_loop.hpp"
+#include "wavetrace/kernels/checked_narrowing.hpp"
+#include "wavetrace/kernels/ray_box.hpp"
+#include "wavetrace/kernels/triangle_intersect.hpp"
+#include "wavetrace/memory/cache_aligned_allocator.hpp"
+
+namespace wavetrace {
+namespace {
+
+constexpr float kInfinity = std::numeric_limits<float>::infinity();
+
+struct CellRange {
+  glm::uvec3 lower, upper;  // inclusive
+};
+
+class HashedGridAccelerator final : public Accelerator {
+ public:
+  HashedGridAccelerator(const TriangleMesh& mesh, const HashedGridOptions& options) : mesh_(mesh) {
+    const auto start = std::chrono::steady_clock::now();
+    choose_resolution(options);
+    mark_cells();
+    displace_rows();
+    fill_lists();
+    build_macrocells(options.macrocell_factor);
+    build_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    build_.peak_bytes = memory().total() + row_scratch_bytes_ + slot_count_ * sizeof(std::uint32_t);  // + fill cursors
+  }
+
+  std::string name() const override { return macrocell_factor_ > 0 ? "mlgrid" : "grid"; }
+
+  void intersect_closest(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
+    NullProbe probe;
+    traverse<false>(rays, hits, range, probe);
+  }
+  void intersect_any(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
+    NullProbe probe;
+    traverse<true>(rays, hits, range, probe);
+  }
+  bool probed() const override { return true; }
+  void intersect_closest_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
+                                RecordingProbe& probe) const override {
+    traverse<false>(rays, hits, range, probe);
+  }
+  void intersect_any_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
+                            RecordingProbe& probe) const override {
+    traverse<true>(rays, hits, range, probe);
+  }
+
+  MemoryReport memory() const override {
+    MemoryReport report;
+    report.hierarchy = domain_.size() * sizeof(std::uint64_t) + offsets_.size() * sizeof(std::uint32_t) +
+                       starts_.size() * sizeof(std::uint32_t) + items_.size() * sizeof(std::uint32_t);
+    for (const MacrocellLevel& level : macrocells_) report.hierarchy += level.bits.size() * sizeof(std::uint64_t);
+    report.geometry = mesh_.positions.size() * sizeof(glm::vec3) + mesh_.triangles.size() * sizeof(glm::uvec3);
+    return report;
+  }
+  BuildReport build() const override { return build_; }
+  std::string build_notes() const override {
+    std::size_t occupied_cells = 0;
+    for (std::uint64_t word : domain_) occupied_cells += std::size_t(std::popcount(word));
+    std::string notes = fmt::format("{}x{}x{} cells, {} non-empty, {} slots in H, {:.2f} entries per triangle",
+                                    cells_.x, cells_.y, cells_.z, occupied_cells, slot_count_,
+                                    double(items_.size()) / double(mesh_.triangle_count()));
+    for (std::size_t k = 0; k < macrocells_.size(); ++k) {
+      notes += fmt::format("; macrocells level {}: {}x{}x{}", k + 1, macrocells_[k].cells.x, macrocells_[k].cells.y,
+                           macrocells_[k].cells.z);
+    }
+    if (capped_) notes += fmt::format("; resolution guard: density lowered to {:.3g} to stay under {} cells",
+                                      effective_density_, max_cells_);
+    return notes;
+  }
+
+  std::vector<std::span<const std::byte>> memory_spans() const override {
+    std::vector<std::span<const std::byte>> spans = {
+        std::as_bytes(std::span(domain_)), std::as_bytes(std::span(offsets_)), std::as_bytes(std::span(starts_)),
+        std::as_bytes(std::span(items_)), std::as_bytes(std::span(mesh_.positions)),
+        std::as_bytes(std::span(mesh_.triangles))};
+    for (const MacrocellLevel& level : macrocells_) spans.push_back(std::as_bytes(std::span(level.bits)));
+    return spans;
+  }
+
+ private:
+  void choose_resolution(const HashedGridOptions& options) {
+    bounds_ = mesh_.bounds();
+    const GridResolution resolution = hashed_grid_resolution(bounds_, mesh_.triangle_count(), options);
+    cells_ = resolution.cells;
+    capped_ = resolution.capped;
+    const glm::dvec3 size = resolution.size;
+    max_cells_ = options.max_cells;
+    effective_density_ = double(cells_.x) * cells_.y * cells_.z / double(mesh_.triangle_count());
+    cell_size_ = glm::vec3(size) / glm::vec3(cells_);
+    inverse_cell_size_ = 1.0f / cell_size_;
+    // Pad the box by a cell's thousandth so points on its upper faces fall inside.
+    upper_ = bounds_.lower + cell_size_ * glm::vec3(cells_) * (1.0f + 1e-6f) + cell_size_ * 1e-3f;
+  }
+
+  glm::uvec3 cell_of(const glm::vec3& point) const {
+    const glm::vec3 index = glm::floor((point - bounds_.lower) * inverse_cell_size_);
+    return glm::uvec3(glm::clamp(index, glm::vec3(0.0f), glm::vec3(cells_) - 1.0f));
+  }
+
+  // The cells triangle t's box overlaps, the box grown by a thousandth of a cell so that
+  // DDA rounding at cell faces never skips a cell holding a triangle it passes. Recomputed
+  // in each pass rather than stored: cheaper than 24 bytes per triangle of fresh memory.
+  CellRange range_of(std::size_t t) const {
+    const glm::uvec3& tri = mesh_.triangles[t];
+    const glm::vec3 a = mesh_.positions[tri.x], b = mesh_.positions[tri.y], c = mesh_.positions[tri.z];
+    const glm::vec3 slack = cell_size_ * 1e-3f;
+    return {cell_of(glm::min(a, glm::min(b, c)) - slack), cell_of(glm::max(a, glm::max(b, c)) + slack)};
+  }
+
+  std::size_t cell_index(std::uint32_t x, std::uint32_t y, std::uint32_t z) const {
+    return (std::size_t(z) * cells_.y + y) * cells_.x + x;
+  }
+
+  void mark_cells() {
+    const std::size_t cell_count = std::size_t(cells_.x) * cells_.y * cells_.z;
+    domain_.assign((cell_count + 63) / 64, 0);
+    tbb::parallel_for(std::size_t{0}, mesh_.triangle_count(), [&](std::size_t t) {
+      const CellRange r = range_of(t);
+      for (std::uint32_t z = r.lower.z; z <= r.upper.z; ++z) {
+        for (std::uint32_t y = r.lower.y; y <= r.upper.y; ++y) {
+          for (std::uint32_t x = r.lower.x; x <= r.upper.x; ++x) {
+            const std::size_t d = cell_index(x, y, z);
+            std::atomic_ref<std::uint64_t>(domain_[d / 64]).fetch_or(std::uint64_t{1} << (d % 64), std::memory_order_relaxed);
+          }
+        }
+      }
+    });
+  }
+
+  bool occupied(std::size_t d) const { return (domain_[d / 64] >> (d % 64)) & 1u; }
+
+  // First fit from the last row's offset, as the paper builds O: each row's set cells land on
+  // slots of the shared bit array bH that no earlier row took.
+  void displace_rows() {
+    offsets_.assign(std::size_t(cells_.y) * cells_.z, 0);
+    std::vector<std::uint64_t> taken(1024, 0);
+    const auto is_taken = [&](std::size_t slot) { return slot / 64 < taken.size() && ((taken[slot / 64] >> (slot % 64)) & 1u); };
+    std::vector<std::uint32_t> row;
+    std::size_t last_offset = 0, used_slots = 0;
+    for (std::uint32_t z = 0; z < cells_.z; ++z) {
+      for (std::uint32_t y = 0; y < cells_.y; ++y) {
+        row.clear();
+        // The row's D bits, a word at a time: rows are mostly empty.
+        const std::size_t first = cell_index(0, y, z), row_end = first + cells_.x;
+        for (std::size_t word = first / 64; word * 64 < row_end; ++word) {
+          std::uint64_t bits = domain_[word];
+          if (word * 64 < first) bits &= ~std::uint64_t{0} << (first - word * 64);
+          if ((word + 1) * 64 > row_end) bits &= ~std::uint64_t{0} >> ((word + 1) * 64 - row_end);
+          for (; bits != 0; bits &= bits - 1) row.push_back(std::uint32_t(word * 64 + std::countr_zero(bits) - first));
+        }
+        if (row.empty()) continue;  // never read: its D bits are all clear
+        std::size_t offset = last_offset;
+        while (std::any_of(row.begin(), row.end(), [&](std::uint32_t x) { return is_taken(offset + x); })) ++offset;
+        const std::size_t end = offset + row.back() + 1;
+        if ((end + 63) / 64 > taken.size()) taken.resize(std::max(taken.size() * 2, (end + 63) / 64), 0);
+        for (std::uint32_t x : row) taken[(offset + x) / 64] |= std::uint64_t{1} << ((offset + x) % 64);
+        offsets_[std::size_t(z) * cells_.y + y] = checked_uint32(offset, "grid row offset; lower accel.grid.max_cells");
+        used_slots = std::max(used_slots, end);
+        last_offset = offset;
+      }
+    }
+    slot_count_ = used_slots;
+    row_scratch_bytes_ = taken.size() * sizeof(std::uint64_t);
+  }
+
+  std::size_t slot_of(std::uint32_t x, std::uint32_t y, std::uint32_t z) const {
+    return offsets_[std::size_t(z) * cells_.y + y] + x;
+  }
+
+  // Counts per slot and prefix sums (H[slot] = where its list starts), then the lists.
+  void fill_lists() {
+    starts_.assign(slot_count_ + 1, 0);
+    tbb::parallel_for(std::size_t{0}, mesh_.triangle_count(), [&](std::size_t t) {
+      const CellRange r = range_of(t);
+      for (std::uint32_t z = r.lower.z; z <= r.upper.z; ++z) {
+        for (std::uint32_t y = r.lower.y; y <= r.upper.y; ++y) {
+          for (std::uint32_t x = r.lower.x; x <= r.upper.x; ++x) {
+            std::atomic_ref<std::uint32_t>(starts_[slot_of(x, y, z)]).fetch_add(1, std::memory_order_relaxed);
+          }
+        }
+      }
+    });
+    // Exclusive prefix sums: H[slot] becomes the start of its list, H[NH] the total.
+    std::uint64_t total = 0;
+    for (std::uint32_t& start : starts_) {
+      const std::uint32_t count = start;
+      start = static_cast<std::uint32_t>(total);
+      total += count;
+    }
+    if (total > std::numeric_limits<std::uint32_t>::max()) {
+      throw std::runtime_error("grid: more than 2^32 cell entries; lower accel.grid.density");
+    }
+    items_.resize(total);
+    // The paper inserts serially in reverse (L[--H[j]] = i) to leave each list ascending;
+    // in parallel, claim slots with atomic cursors, then sort each (short) list.
+    std::vector<std::uint32_t> cursor(starts_.begin(), starts_.end() - 1);
+    tbb::parallel_for(std::size_t{0}, mesh_.triangle_count(), [&](std::size_t t) {
+      const CellRange r = range_of(t);
+      for (std::uint32_t z = r.lower.z; z <= r.upper.z; ++z) {
+        for (std::uint32_t y = r.lower.y; y <= r.upper.y; ++y) {
+          for (std::uint32_t x = r.lower.x; x <= r.upper.x; ++x) {
+            items_[std::atomic_ref<std::uint32_t>(cursor[slot_of(x, y, z)]).fetch_add(1, std::memory_order_relaxed)] =
+                std::uint32_t(t);
+          }
+        }
+      }
+    });
+    tbb::parallel_for(std::size_t{0}, slot_count_, [&](std::size_t slot) {
+      std::sort(items_.begin() + starts_[slot], items_.begin() + starts_[slot + 1]);
+    });
+  }
+
+  // Macrocells (Wald et al. 2006, as the paper uses them): level k is a bit per block of
+  // factor^k fine cells, set when any cell in the block holds items; levels stop at one block.
+  void build_macrocells(std::uint32_t factor) {
+    macrocell_factor_ = factor;
+    if (factor < 2) return;
+    std::uint32_t span = 1;
+    glm::uvec3 cells = cells_;
+    while (macrocells_.size() < 4 && (cells.x > 1 || cells.y > 1 || cells.z > 1)) {
+      span *= factor;
+      MacrocellLevel level;
+      level.span = span;
+      level.cells = (cells_ + span - 1u) / span;
+      level.bits.assign((std::size_t(level.cells.x) * level.cells.y * level.cells.z + 63) / 64, 0);
+      for (std::size_t word = 0; word < domain_.size(); ++word) {
+        for (std::uint64_t bits = domain_[word]; bits != 0; bits &= bits - 1) {
+          const std::size_t d = word * 64 + std::size_t(std::countr_zero(bits));
+          const std::uint32_t x = std::uint32_t(d % cells_.x), y = std::uint32_t(d / cells_.x % cells_.y),
+                              z = std::uint32_t(d / (std::size_t(cells_.x) * cells_.y));
+          const std::size_t m = level.index(glm::uvec3(x, y, z) / span);
+          level.bits[m / 64] |= std::uint64_t{1} << (m % 64);
+        }
+      }
+      cells = level.cells;
+      macrocells_.push_back(std::move(level));
+    }
+  }
+
+  template <bool kAnyHit, typename Probe>
+  void traverse(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
+    const glm::vec3* positions = mesh_.positions.data();
+    const glm::uvec3* triangles = mesh_.triangles.data();
+    for_each_ray(rays, hits, range, [&](const SingleRay& single, std::uint32_t i) {
+      hits.set_miss(i);
+      const glm::vec3 &origin = single.origin, &direction = single.direction;
+      const float tmin = single.tmin;
+      float near = 0.0f, far = 0.0f;
+      if (!clip_to_box(single.box, bounds_.lower, upper_, tmin, single.tmax, near, far)) return;
+
+      GridWalk walk(bounds_.lower, cell_size_, origin, direction, glm::ivec3(cell_of(origin + direction * near)));
+      const WatertightRay& ray = single.sheared;
+      float best = single.tmax;
+      TriangleHit found{kInfinity, 0.0f, 0.0f};
+      std::uint32_t found_triangle = kInvalidPrimitive;
+      while (true) {
+        // In an empty macrocell, jump past its block: out through the face the ray leaves by.
+        const glm::uvec3 cell(walk.cell);
+        if (const MacrocellLevel* empty = coarsest_empty_macrocell(cell, probe)) {
+          const glm::ivec3 lower = glm::ivec3(cell / empty->span * empty->span);
+          const glm::ivec3 upper = glm::min(lower + int(empty->span) - 1, glm::ivec3(cells_) - 1);
+          float exit = kInfinity;
+          int exit_axis = 0;
+          for (int axis = 0; axis < 3; ++axis) {
+            if (walk.step[axis] == 0) continue;
+            const float t = walk.face_crossing(axis, walk.step[axis] > 0 ? upper[axis] + 1 : lower[axis]);
+            if (t < exit) exit = t, exit_axis = axis;
+          }
+          if (exit >= best || exit > far) break;
+          glm::ivec3 next = glm::clamp(glm::ivec3(cell_of(origin + direction * exit)), lower, upper);
+          next[exit_axis] = walk.step[exit_axis] > 0 ? upper[exit_axis] + 1 : lower[exit_axis] - 1;
+          if (next[exit_axis] < 0 || next[exit_axis] >= int(cells_[exit_axis])) break;
+          walk.enter(next);
+          continue;
+        }
+        const std::size_t d = cell_index(cell.x, cell.y, cell.z);
+        probe.read(&domain_[d / 64], sizeof(std::uint64_t));
+        if (occupied(d)) {
+          const std::size_t row = std::size_t(cell.z) * cells_.y + cell.y;
+          probe.read(&offsets_[row], sizeof(std::uint32_t));
+          const std::size_t slot = offsets_[row] + cell.x;
+          probe.read(&starts_[slot], 2 * sizeof(std::uint32_t));
+          for (std::uint32_t k = starts_[slot]; k < starts_[slot + 1]; ++k) {
+            const glm::uvec3& tri = triangles[items_[k]];
+            if constexpr (Probe::kRecords) {
+              probe.read(&items_[k], sizeof(std::uint32_t));
+              probe.read(&tri, sizeof tri);
+              for (int corner = 0; corner < 3; ++corner) probe.read(positions + tri[corner], sizeof(glm::vec3));
+            }
+            TriangleHit hit;
+            if (intersect_watertight(ray, positions[tri.x], positions[tri.y], positions[tri.z], tmin, best, hit)) {
+              best = hit.t;
+              found = hit;
+              found_triangle = items_[k];
+              if constexpr (kAnyHit) break;
+            }
+          }
+          if (kAnyHit && found_triangle != kInvalidPrimitive) break;
+        }
+        // Leave the cell: done once the nearest hit lies before the next cell begins.
+        const int axis = walk.exit_axis();
+        if (walk.next_crossing[axis] >= best || walk.next_crossing[axis] > far) break;
+        if (!walk.advance(axis, cells_)) break;
+      }
+      if (found_triangle != kInvalidPrimitive) {
+        hits.set_hit(i, found.t, found_triangle, found.u, found.v);
+        set_surface_from_mesh(hits, i, mesh_, found_triangle);
+      }
+    });
+  }
+
+  const TriangleMesh& mesh_;
+  Bounds3 bounds_;
+  glm::vec3 upper_{0.0f};
+  glm::uvec3 cells_{1};
+  glm::vec3 cell_size_{1.0f}, inverse_cell_size_{1.0f};
+  bool capped_ = false;
+  double effective_density_ = 0.0;
+  std::size_t max_cells_ = 0;
+  std::size_t slot_count_ = 0;
+  std::size_t row_scratch_bytes_ = 0;
+  struct MacrocellLevel {
+    std::uint32_t span = 1;  // fine cells per block side
+    glm::uvec3 cells{1};
+    std::vector<std::uint64_t> bits;
+    std::size_t index(const glm::uvec3& block) const { return (std::size_t(block.z) * cells.y + block.y) * cells.x + block.x; }
+    bool occupied(const glm::uvec3& block) const {
+      const std::size_t m = index(block);
+      return (bits[m / 64] >> (m % 64)) & 1u;
+    }
+  };
+  // The coarsest level whose block around `cell` is empty (levels nest, so checking from the
+  // finest up stops at the first occupied one); null when the finest block holds items.
+  template <typename Probe>
+  const MacrocellLevel* coarsest_empty_macrocell(const glm::uvec3& cell, Probe& probe) const {
+    const MacrocellLevel* empty = nullptr;
+    for (const MacrocellLevel& level : macrocells_) {
+      const std::size_t m = level.index(cell / level.span);
+      probe.read(&level.bits[m / 64], sizeof(std::uint64_t));
+      if (level.occupied(cell / level.span)) break;
+      empty = &level;
+    }
+    return empty;
+  }
+
+  std::uint32_t macrocell_factor_ = 0;
+  std::vector<MacrocellLevel> macrocells_;
+  LargeArray<std::uint64_t> domain_;   // D
+  LargeArray<std::uint32_t> offsets_;  // O
+  LargeArray<std::uint32_t> starts_;   // H
+  LargeArray<std::uint32_t> items_;    // L
+  BuildReport build_;
+};
+
+}  // namespace
+
+// Woo's heuristic: M_i = S_i · cbrt(ρN / V), capped so that Mx·My·Mz stays in the guard.
+GridResolution hashed_grid_resolution(const Bounds3& bounds, std::size_t triangles, const HashedGridOptions& options) {
+  GridResolution resolution;
+  const glm::vec3 extent = bounds.extent();
+  const float floor_extent = std::max(1e-6f * bounds.diagonal(), 1e-30f);
+  resolution.size = glm::dvec3(std::max(extent.x, floor_extent), std::max(extent.y, floor_extent),
+                               std::max(extent.z, floor_extent));
+  const glm::dvec3& size = resolution.size;
+  glm::uvec3& cells = resolution.cells;
+  double scale = std::cbrt(options.density * double(std::max<std::size_t>(triangles, 1)) / (size.x * size.y * size.z));
+  for (int attempt = 0; attempt < 64; ++attempt) {
+    for (int axis = 0; axis < 3; ++axis) {
+      cells[axis] = static_cast<std::uint32_t>(std::clamp(std::ceil(size[axis] * scale), 1.0, double(1 << 21)));
+    }
+    if (double(cells.x) * cells.y * cells.z <= double(options.max_cells)) break;
+    resolution.capped = true;
+    scale *= 0.97 * std::cbrt(double(options.max_cells) / (double(cells.x) * cells.y * cells.z));
+  }
+  return resolution;
+}
+
+std::unique_ptr<Accelerator> make_hashed_grid_accelerator(const TriangleMesh& mesh, const HashedGridOptions& options) {
+  return std::make_unique<HashedGridAccelerator>(mesh, options);
+}
+
+}  // namespace wavetrace

@@ -1,0 +1,182 @@
+// Leaf encoding: strips inside the leaf (greedy, no swaps: the table has no room for
+// them), the strip-or-indexed choice, and the min-max offsets of every vertex.
+#include "wavetrace/accel/hmq/leaf_codec.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <stdexcept>
+
+namespace wavetrace::hmq {
+namespace {
+
+std::uint32_t bits_for(std::uint32_t largest) { return largest == 0 ? 0 : std::bit_width(largest); }
+
+struct LeafStrip {
+  std::vector<std::uint32_t> vertices;   // mesh vertex ids, length + 2
+  std::vector<std::uint32_t> triangles;  // mesh triangle ids
+};
+
+// Greedy strips without swaps over at most 14 triangles: start at the triangle with the
+// fewest unused neighbours, leave it through its most constrained neighbour, go straight.
+std::vector<LeafStrip> strips_of_leaf(const TriangleMesh& mesh, std::span<const std::uint32_t> triangles) {
+  const std::size_t count = triangles.size();
+  auto shares_edge = [&](std::uint32_t t, std::uint32_t a, std::uint32_t b) {
+    const glm::uvec3& c = mesh.triangles[t];
+    int found = 0;
+    for (int k = 0; k < 3; ++k) found += c[k] == a || c[k] == b;
+    return found == 2 && a != b;
+  };
+  std::vector<bool> used(count, false);
+  auto unused_across = [&](std::uint32_t a, std::uint32_t b, std::size_t except) -> std::size_t {
+    for (std::size_t j = 0; j < count; ++j) {
+      if (!used[j] && j != except && shares_edge(triangles[j], a, b)) return j;
+    }
+    return count;
+  };
+  auto unused_degree = [&](std::size_t i) {
+    const glm::uvec3& c = mesh.triangles[triangles[i]];
+    int degree = 0;
+    for (int e = 0; e < 3; ++e) degree += unused_across(c[e], c[(e + 1) % 3], i) != count;
+    return degree;
+  };
+  std::vector<LeafStrip> strips;
+  for (std::size_t remaining = count; remaining > 0;) {
+    std::size_t start = count;
+    for (std::size_t i = 0; i < count; ++i) {
+      if (!used[i] && (start == count || unused_degree(i) < unused_degree(start))) start = i;
+    }
+    used[start] = true;
+    --remaining;
+    const glm::uvec3& c = mesh.triangles[triangles[start]];
+    int edge = -1;
+    std::size_t best = count;
+    for (int e = 0; e < 3; ++e) {
+      const std::size_t next = unused_across(c[e], c[(e + 1) % 3], start);
+      if (next != count && (best == count || unused_degree(next) < unused_degree(best))) best = next, edge = e;
+    }
+    if (edge < 0) edge = 0;
+    LeafStrip strip{{c[(edge + 2) % 3], c[edge], c[(edge + 1) % 3]}, {triangles[start]}};
+    while (remaining > 0) {
+      const std::size_t size = strip.vertices.size();
+      const std::size_t next = unused_across(strip.vertices[size - 2], strip.vertices[size - 1], count);
+      if (next == count) break;
+      used[next] = true;
+      --remaining;
+      const glm::uvec3& n = mesh.triangles[triangles[next]];
+      for (int k = 0; k < 3; ++k) {
+        if (n[k] != strip.vertices[size - 2] && n[k] != strip.vertices[size - 1]) {
+          strip.vertices.push_back(n[k]);
+          break;
+        }
+      }
+      strip.triangles.push_back(triangles[next]);
+    }
+    strips.push_back(std::move(strip));
+  }
+  std::stable_sort(strips.begin(), strips.end(),
+                   [](const LeafStrip& a, const LeafStrip& b) { return a.triangles.size() > b.triangles.size(); });
+  return strips;
+}
+
+}  // namespace
+
+void encode_leaf(const QuantizedMesh& quantized, std::span<const std::uint32_t> triangles, const GridBox& box,
+                 std::vector<std::byte>& out) {
+  if (triangles.empty() || triangles.size() > kMaxLeafTriangles) {
+    throw std::invalid_argument("hmq: a leaf holds 1 .. 14 triangles");
+  }
+  const TriangleMesh& mesh = *quantized.mesh;
+  const std::vector<LeafStrip> strips = strips_of_leaf(mesh, triangles);
+  std::vector<std::uint32_t> lengths, slot_vertex, leaf_triangles;
+  for (const LeafStrip& strip : strips) {
+    lengths.push_back(static_cast<std::uint32_t>(strip.triangles.size()));
+    slot_vertex.insert(slot_vertex.end(), strip.vertices.begin(), strip.vertices.end());
+    leaf_triangles.insert(leaf_triangles.end(), strip.triangles.begin(), strip.triangles.end());
+  }
+  const StripTable& table = StripTable::instance();
+  const std::uint32_t entry = table.find(lengths);
+  const StripLayoutEntry& layout = table.entry(entry);
+
+  // Unique vertices in first-use order, for the indexed form.
+  std::vector<std::uint32_t> unique, slot_index;
+  for (const std::uint32_t vertex : slot_vertex) {
+    const auto found = std::find(unique.begin(), unique.end(), vertex);
+    slot_index.push_back(static_cast<std::uint32_t>(found - unique.begin()));
+    if (found == unique.end()) unique.push_back(vertex);
+  }
+  // Offsets from the nearer plane of the leaf's grid box, per axis (the min-max trick).
+  auto offsets = [&](const std::vector<std::uint32_t>& vertices, int axis, std::uint32_t& bits) {
+    std::vector<std::uint32_t> values;
+    std::uint32_t largest = 0;
+    for (const std::uint32_t vertex : vertices) {
+      const int line = quantized.lines[vertex][axis];
+      const int from_lower = line - box.lower[axis], from_upper = box.upper[axis] - line;
+      if (from_lower < 0 || from_upper < 0) throw std::logic_error("hmq: a vertex outside its leaf's grid box");
+      const bool upper = from_upper < from_lower;
+      const auto offset = static_cast<std::uint32_t>(upper ? from_upper : from_lower);
+      largest = std::max(largest, offset);
+      values.push_back(offset << 1 | (upper ? 1u : 0u));
+    }
+    bits = bits_for(largest);
+    return values;
+  };
+  const std::uint32_t index_bits = bits_for(static_cast<std::uint32_t>(unique.size() - 1));
+  std::uint32_t axis_bits[3];
+  std::vector<std::uint32_t> streams[3];
+  for (int axis = 0; axis < 3; ++axis) {
+    streams[axis] = offsets(unique, axis, axis_bits[axis]);
+  }
+  std::size_t indexed_bytes = stream_bytes(index_bits, layout.slots), strip_bytes = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    indexed_bytes += stream_bytes(axis_bits[axis] + 1, static_cast<std::uint32_t>(unique.size()));
+    strip_bytes += stream_bytes(axis_bits[axis] + 1, layout.slots);
+  }
+  const bool indexed = indexed_bytes < strip_bytes;
+  if (!indexed) {
+    for (int axis = 0; axis < 3; ++axis) streams[axis] = offsets(slot_vertex, axis, axis_bits[axis]);
+  }
+  const std::uint32_t vertex_count = indexed ? static_cast<std::uint32_t>(unique.size()) : layout.slots;
+
+  std::uint32_t id_base = *std::min_element(leaf_triangles.begin(), leaf_triangles.end());
+  std::vector<std::uint32_t> id_delta, corners;
+  std::uint32_t largest_delta = 0;
+  for (std::uint32_t k = 0; k < leaf_triangles.size(); ++k) {
+    const std::uint32_t triangle = leaf_triangles[k];
+    id_delta.push_back(triangle - id_base);
+    largest_delta = std::max(largest_delta, triangle - id_base);
+    const std::uint32_t* slot = slot_vertex.data() + layout.first_slot[k];
+    auto corner_of = [&](std::uint32_t vertex) {
+      for (std::uint32_t c = 0; c < 3; ++c) {
+        if (slot[c] == vertex) return c;
+      }
+      throw std::logic_error("hmq: a leaf triangle does not have its mesh triangle's corners");
+    };
+    const glm::uvec3& c = mesh.triangles[triangle];
+    corners.push_back(3 * corner_of(c.y) + corner_of(c.z));
+  }
+  const std::uint32_t id_bits = bits_for(largest_delta);
+  if (id_bits > 31) throw std::length_error("hmq: a leaf's triangle ids span 2^31 or more");
+
+  std::uint64_t header = entry | std::uint64_t(indexed) << 9 | std::uint64_t(vertex_count) << 10 |
+                         std::uint64_t(axis_bits[0]) << 16 | std::uint64_t(axis_bits[1]) << 21 |
+                         std::uint64_t(axis_bits[2]) << 26 | std::uint64_t(indexed ? index_bits : 0) << 31 |
+                         std::uint64_t(id_bits) << 34;
+  for (int b = 0; b < 5; ++b) out.push_back(static_cast<std::byte>(header >> (8 * b)));
+  for (int b = 0; b < 4; ++b) out.push_back(static_cast<std::byte>(id_base >> (8 * b)));
+  for (int axis = 0; axis < 3; ++axis) append_stream(out, streams[axis], axis_bits[axis] + 1);
+  if (indexed) append_stream(out, slot_index, index_bits);
+  append_stream(out, id_delta, id_bits);
+  append_stream(out, corners, 3);
+}
+
+std::size_t leaf_record_bytes(const std::byte* record) {
+  const LeafHeader header = read_leaf_header(record);
+  const StripLayoutEntry& layout = StripTable::instance().entry(header.entry);
+  std::size_t bytes = kLeafHeaderBytes;
+  for (int axis = 0; axis < 3; ++axis) bytes += stream_bytes(header.axis_bits[axis] + 1, header.vertex_count);
+  if (header.indexed) bytes += stream_bytes(header.index_bits, layout.slots);
+  bytes += stream_bytes(header.id_bits, layout.triangles) + stream_bytes(3, layout.triangles);
+  return bytes;
+}
+
+}  // namespace wavetrace::hmq

@@ -1,0 +1,104 @@
+// HMQ leaf records (hmq_format.hpp): encoding a leaf's triangles as the smaller of strips
+// or indexed strips over quantized vertices, and decoding one on the fly during traversal.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "wavetrace/accel/hmq/global_grid.hpp"
+#include "wavetrace/accel/hmq/hmq_format.hpp"
+#include "wavetrace/accel/hmq/packed_stream.hpp"
+#include "wavetrace/accel/hmq/strip_table.hpp"
+#include "wavetrace/scene/triangle_mesh.hpp"
+
+namespace wavetrace::hmq {
+
+// What the encoder reads: the mesh's triangles and every vertex's global grid point.
+struct QuantizedMesh {
+  const TriangleMesh* mesh;
+  std::vector<glm::ivec3> lines;  // per mesh vertex
+};
+
+// The leaf's grid box: its decoded box re-snapped outward.
+struct GridBox {
+  glm::ivec3 lower, upper;
+};
+inline GridBox snap_outward(const GlobalGrid& grid, const Box& box) {
+  GridBox snapped;
+  for (int axis = 0; axis < 3; ++axis) {
+    snapped.lower[axis] = grid.floor_line(box.lower[axis], axis);
+    snapped.upper[axis] = grid.ceil_line(box.upper[axis], axis);
+  }
+  return snapped;
+}
+
+// Appends the record of `triangles` (1 .. 14 mesh triangle ids) to `out`.
+void encode_leaf(const QuantizedMesh& quantized, std::span<const std::uint32_t> triangles, const GridBox& box,
+                 std::vector<std::byte>& out);
+
+// A decoded leaf: vertex positions in columns (SoA, ready to gather into triangle lanes)
+// and which vertex each strip slot holds.
+struct DecodedLeaf {
+  LeafHeader header;
+  const StripLayoutEntry* layout;
+  alignas(32) float position[3][64];  // per axis, per vertex
+  alignas(32) std::uint32_t slot_vertex[64];  // indexed strips: the vertex of each slot; else unused
+  const std::byte* ids;      // the id stream
+  const std::byte* corners;  // the corner stream
+
+  std::uint32_t vertex_of_slot(std::uint32_t slot) const { return header.indexed ? slot_vertex[slot] : slot; }
+  glm::vec3 slot_position(std::uint32_t slot) const {
+    const std::uint32_t v = vertex_of_slot(slot);
+    return {position[0][v], position[1][v], position[2][v]};
+  }
+  std::uint32_t triangle_id(std::uint32_t k) const {
+    std::uint32_t delta[kMaxLeafTriangles];
+    read_stream(ids, header.id_bits, k + 1, delta);
+    return header.id_base + delta[k];
+  }
+  std::uint32_t corner_code(std::uint32_t k) const {
+    std::uint32_t codes[kMaxLeafTriangles];
+    read_stream(corners, 3, k + 1, codes);
+    return codes[k];
+  }
+};
+
+// Vertex v's grid line on an axis is the leaf box's plane its offset counts from (the
+// min-max trick), and its position the grid point of that line: origin + line * cell, the
+// float operations of GlobalGrid::point. A plain loop over the vertices, which GCC vectorizes.
+inline void decode_leaf(const std::byte* record, const GlobalGrid& grid, const GridBox& box, DecodedLeaf& leaf) {
+  leaf.header = read_leaf_header(record);
+  leaf.layout = &StripTable::instance().entry(leaf.header.entry);
+  const std::uint32_t vertices = leaf.header.vertex_count;
+  const std::byte* data = record + kLeafHeaderBytes;
+  for (int axis = 0; axis < 3; ++axis) {
+    const std::uint32_t bits = leaf.header.axis_bits[axis] + 1;
+    alignas(32) std::uint32_t values[64];
+    read_stream(data, bits, vertices, values);
+    data += stream_bytes(bits, vertices);
+    const int lower = box.lower[axis], upper = box.upper[axis];
+    const float origin = grid.origin[axis], cell = grid.cell[axis];
+    float* position = leaf.position[axis];
+    for (std::uint32_t i = 0; i < vertices; ++i) {
+      // In unsigned arithmetic (C++20 converts back modulo 2^32): the same lines for every
+      // record the encoder writes, and no signed overflow for one a crafted file holds.
+      const std::uint32_t offset = values[i] >> 1;
+      const int line = static_cast<int>((values[i] & 1u) ? std::uint32_t(upper) - offset : std::uint32_t(lower) + offset);
+      position[i] = origin + float(line) * cell;
+    }
+  }
+  const std::uint32_t slots = leaf.layout->slots;
+  if (leaf.header.indexed) {
+    read_stream(data, leaf.header.index_bits, slots, leaf.slot_vertex);
+    data += stream_bytes(leaf.header.index_bits, slots);
+  }
+  const std::uint32_t triangles = leaf.layout->triangles;
+  leaf.ids = data;
+  leaf.corners = data + stream_bytes(leaf.header.id_bits, triangles);
+}
+
+// Bytes the record at `record` occupies (for tests and statistics).
+std::size_t leaf_record_bytes(const std::byte* record);
+
+}  // namespace wavetrace::hmq

@@ -1,0 +1,145 @@
+// What both HMQ layouts do at a leaf: decode its record against its grid box, test its
+// triangles, keep the nearest hit in leaf terms, and write it out in the mesh's terms.
+#pragma once
+
+#include "wavetrace/build_config.hpp"  // WAVETRACE_AVX2, WAVETRACE_FMA, WAVETRACE_BMI2
+
+#include <algorithm>
+#include <bit>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+
+#include "wavetrace/accel/bvh/leaf_query.hpp"
+#include "wavetrace/accel/hit_surface.hpp"
+#include "wavetrace/accel/hmq/global_grid.hpp"
+#include "wavetrace/accel/hmq/hmq_format.hpp"
+#include "wavetrace/accel/hmq/leaf_codec.hpp"
+#include "wavetrace/kernels/triangle_intersect.hpp"
+#include "wavetrace/kernels/watertight_lanes.hpp"
+#include "wavetrace/memory/ray_batch.hpp"
+
+namespace wavetrace::hmq {
+
+// The nearest hit of one ray, kept in leaf terms until written.
+struct LeafHit {
+  float t = std::numeric_limits<float>::infinity();
+  float u = 0.0f, v = 0.0f;  // weights of the strip triangle's second and third corner
+  LeafHeader header{};
+  const std::byte* ids = nullptr;
+  const std::byte* corners = nullptr;
+  std::uint32_t triangle = 0;
+  glm::vec3 corner[3];  // the strip triangle's decoded corners, for the hit's point and normal
+  bool found = false;
+};
+
+// A leaf decoded once, with its triangles' corners gathered into lanes (eight triangles a
+// pass), ready to be tested by one ray or by each ray of a packet.
+struct LeafTriangles {
+  DecodedLeaf decoded;
+#if WAVETRACE_AVX2
+  TriangleLanes lanes[2];  // triangles 0-7 and 8-13
+#endif
+  glm::vec3 corner(std::uint32_t k, std::uint32_t c) const {
+    return decoded.slot_position(decoded.layout->first_slot[k] + c);
+  }
+};
+
+template <typename Probe>
+[[gnu::always_inline]] inline void prepare_leaf(const std::byte* record, const GlobalGrid& grid, const Box& box,
+                                                LeafTriangles& leaf, Probe& probe) {
+  if constexpr (Probe::kRecords) probe.read(record, leaf_record_bytes(record));
+  DecodedLeaf& decoded = leaf.decoded;
+  decode_leaf(record, grid, snap_outward(grid, box), decoded);
+#if WAVETRACE_AVX2
+  const StripLayoutEntry& layout = *decoded.layout;
+  const __m256i index_mask = _mm256_set1_epi32(63);  // lanes past the last triangle gather in bounds
+  for (std::uint32_t base = 0; base < layout.triangles; base += 8) {
+    __m128i first_bytes = _mm_setzero_si128();
+    std::memcpy(&first_bytes, layout.first_slot.data() + base, 8);
+    const __m256i first_slot = _mm256_cvtepu8_epi32(first_bytes);
+    TriangleLanes& lanes = leaf.lanes[base / 8];
+    for (int c = 0; c < 3; ++c) {
+      __m256i vertex = _mm256_and_si256(_mm256_add_epi32(first_slot, _mm256_set1_epi32(c)), index_mask);
+      if (decoded.header.indexed) {
+        vertex = _mm256_and_si256(_mm256_i32gather_epi32(reinterpret_cast<const int*>(decoded.slot_vertex), vertex, 4),
+                                  index_mask);
+      }
+      for (int axis = 0; axis < 3; ++axis) {
+        _mm256_store_ps(lanes.corner[c][axis], _mm256_i32gather_ps(decoded.position[axis], vertex, 4));
+      }
+    }
+  }
+#endif
+}
+
+// Tests a prepared leaf's triangles against one ray; a hit nearer than `tmax` shrinks it and
+// replaces `best` (with kAnyHit, the first one ends the test).
+template <bool kAnyHit>
+[[gnu::always_inline]] inline void test_leaf_triangles(const LeafTriangles& leaf, const WatertightRay& sheared,
+                                                       float tmin, float& tmax, LeafHit& best) {
+  const DecodedLeaf& decoded = leaf.decoded;
+  const std::uint32_t triangles = decoded.layout->triangles;
+  auto accept = [&](std::uint32_t k, const TriangleHit& hit) {
+    tmax = hit.t;
+    best = {hit.t, hit.u, hit.v, decoded.header, decoded.ids, decoded.corners, k,
+            {leaf.corner(k, 0), leaf.corner(k, 1), leaf.corner(k, 2)}, true};
+  };
+#if WAVETRACE_AVX2
+  // Candidates of each pass are taken in triangle order against the shrinking tmax, exactly
+  // as the scalar loop takes them (same hit, same ties).
+  for (std::uint32_t base = 0; base < triangles; base += 8) {
+    const std::uint32_t count = std::min<std::uint32_t>(8, triangles - base);
+    WatertightLanes result;
+    intersect_watertight_lanes(sheared, leaf.lanes[base / 8], (1u << count) - 1, tmin, tmax, result);
+    for (unsigned pending = result.candidates | result.on_edge; pending != 0; pending &= pending - 1) {
+      const int lane = std::countr_zero(pending);
+      const std::uint32_t k = base + lane;
+      TriangleHit hit;
+      if (result.on_edge >> lane & 1u) {
+        if (!intersect_watertight(sheared, leaf.corner(k, 0), leaf.corner(k, 1), leaf.corner(k, 2), tmin, tmax, hit)) {
+          continue;
+        }
+      } else {
+        if (result.signed_t[lane] > tmax * result.abs_determinant[lane]) continue;
+        hit = {result.t[lane], result.u[lane], result.v[lane]};
+      }
+      accept(k, hit);
+      if constexpr (kAnyHit) return;
+    }
+  }
+#else
+  for (std::uint32_t k = 0; k < triangles; ++k) {
+    TriangleHit hit;
+    if (intersect_watertight(sheared, leaf.corner(k, 0), leaf.corner(k, 1), leaf.corner(k, 2), tmin, tmax, hit)) {
+      accept(k, hit);
+      if constexpr (kAnyHit) return;
+    }
+  }
+#endif
+}
+
+// The leaf record at `record`, whose decoded box is `box`, against one ray.
+template <bool kAnyHit, typename Probe>
+[[gnu::always_inline]] inline void test_leaf_record(const std::byte* record, const GlobalGrid& grid, const Box& box,
+                                                    const WatertightRay& sheared, float tmin, float& tmax,
+                                                    LeafHit& best, Probe& probe) {
+  LeafTriangles leaf;
+  prepare_leaf(record, grid, box, leaf, probe);
+  test_leaf_triangles<kAnyHit>(leaf, sheared, tmin, tmax, best);
+}
+
+// With kSurface (closest hits, whose corners test_leaf_record kept) also the point and normal.
+template <bool kSurface>
+inline void write_leaf_hit(const LeafHit& best, HitBatch& hits, std::uint32_t i) {
+  if (!best.found) return hits.set_miss(i);
+  std::uint32_t delta[kMaxLeafTriangles], code[kMaxLeafTriangles];
+  read_stream(best.ids, best.header.id_bits, best.triangle + 1, delta);
+  read_stream(best.corners, 3, best.triangle + 1, code);
+  const float weight[3] = {1.0f - best.u - best.v, best.u, best.v};
+  hits.set_hit(i, best.t, best.header.id_base + delta[best.triangle], weight[code[best.triangle] / 3],
+               weight[code[best.triangle] % 3]);
+  if constexpr (kSurface) set_surface_from_strip(hits, i, best.corner, code[best.triangle]);
+}
+
+}  // namespace wavetrace::hmq

@@ -1,0 +1,153 @@
+// Simplify, judge, keep, and build the proxy's accelerator.
+#include "wavetrace/accel/proxy/proxy.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+
+#include "wavetrace/accel/proxy/cluster_simplify.hpp"
+#include "wavetrace/accel/proxy/stochastic_simplify.hpp"
+#include "wavetrace/kernels/random.hpp"
+#include "wavetrace/kernels/sampling.hpp"
+
+namespace wavetrace {
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+ProxyMethod parse_proxy_method(const std::string& text) {
+  if (text == "auto") return ProxyMethod::automatic;
+  if (text == "cluster") return ProxyMethod::cluster;
+  if (text == "stochastic") return ProxyMethod::stochastic;
+  throw std::invalid_argument("unknown proxy method '" + text + "' (known: auto, cluster, stochastic)");
+}
+
+std::string to_string(ProxyMethod method) {
+  switch (method) {
+    case ProxyMethod::automatic: return "auto";
+    case ProxyMethod::cluster: return "cluster";
+    case ProxyMethod::stochastic: return "stochastic";
+  }
+  return "?";
+}
+
+ProxyQuality measure_proxy_quality(const Accelerator& candidate, const Accelerator& scene_accelerator,
+                                   const Bounds3& scene_bounds, std::size_t rays) {
+  constexpr std::size_t kBatch = kDefaultBatchCapacity;
+  const float diagonal = scene_bounds.diagonal();
+  const std::size_t batches = (rays + kBatch - 1) / kBatch;
+  std::vector<std::size_t> agree(batches, 0), both(batches, 0), either(batches, 0);
+  std::vector<double> error(agree.size(), 0.0);
+  tbb::parallel_for(std::size_t{0}, agree.size(), [&](std::size_t b) {
+    RayBatch batch(kBatch);
+    HitBatch scene_hits(kBatch), candidate_hits(kBatch);
+    batch.count = std::min(kBatch, rays - b * kBatch);
+    for (std::size_t i = 0; i < batch.count; ++i) {
+      const auto id = static_cast<std::uint32_t>(b * kBatch + i);
+      const UnitPair xy = unit_pair(random_bits(id, 0, 0, RandomPurpose::simplification));
+      const UnitPair zd = unit_pair(random_bits(id, 0, 1, RandomPurpose::simplification));
+      const UnitPair d = unit_pair(random_bits(id, 0, 2, RandomPurpose::simplification));
+      const glm::vec3 origin = scene_bounds.lower + scene_bounds.extent() * glm::vec3(xy.first, xy.second, zd.first);
+      batch.set_geometry(i, origin, uniform_sphere(d.first, d.second), 0.0f, std::numeric_limits<float>::infinity());
+      batch.flags[i] = ray_flags::alive;
+      batch.kind[i] = RayKind::bounce;
+    }
+    scene_accelerator.intersect_closest(batch, scene_hits, batch.all());
+    candidate.intersect_closest(batch, candidate_hits, batch.all());
+    for (std::size_t i = 0; i < batch.count; ++i) {
+      const bool scene_hit = scene_hits.is_hit(i), candidate_hit = candidate_hits.is_hit(i);
+      agree[b] += scene_hit == candidate_hit;
+      either[b] += scene_hit || candidate_hit;
+      if (scene_hit && candidate_hit) {
+        ++both[b];
+        error[b] += std::fabs(double(scene_hits.t[i]) - double(candidate_hits.t[i])) / diagonal;
+      }
+    }
+  });
+  std::size_t agreed = 0, hit_both = 0, hit_either = 0;
+  double error_sum = 0.0;
+  for (std::size_t b = 0; b < batches; ++b) {
+    agreed += agree[b];
+    hit_both += both[b];
+    hit_either += either[b];
+    error_sum += error[b];
+  }
+  return {double(agreed) / double(std::max<std::size_t>(rays, 1)),
+          hit_either ? double(hit_both) / double(hit_either) : 1.0, hit_both ? error_sum / double(hit_both) : 0.0};
+}
+
+Proxy::Proxy(const TriangleMesh& mesh, const ProxyOptions& options, const Accelerator& scene_accelerator)
+    : scene_bounds_(mesh.bounds()) {
+  if (!(options.share > 0.0 && options.share <= 1.0)) {
+    throw SceneError(fmt::format("proxy share {} must be in (0, 1]", options.share));
+  }
+  const auto target = static_cast<std::size_t>(std::max(4.0, std::round(options.share * double(mesh.triangle_count()))));
+  const auto start = std::chrono::steady_clock::now();
+  // An empty result (everything collapsed or pruned away) marks a method that failed here.
+  const auto cleaned = [](TriangleMesh simplified) {
+    try {
+      validate_and_clean(simplified, "proxy");
+    } catch (const SceneError&) {
+      return TriangleMesh{};
+    }
+    return simplified;
+  };
+  double cell_size = 0.0;
+  const auto clustered = [&] {
+    ClusterSimplification simplified = simplify_by_clustering(mesh, target);
+    cell_size = simplified.cell_size;
+    return cleaned(std::move(simplified.mesh));
+  };
+  const auto pruned = [&] { return cleaned(simplify_stochastically(mesh, options.share)); };
+
+  if (options.method == ProxyMethod::automatic) {
+    TriangleMesh cluster_mesh = clustered(), stochastic_mesh = pruned();
+    report_.simplify_seconds = seconds_since(start);
+    const auto judge = [&](const TriangleMesh& candidate) -> std::optional<ProxyQuality> {
+      if (candidate.triangles.empty()) return std::nullopt;
+      const auto accelerator = make_accelerator(candidate, options.accelerator);
+      return measure_proxy_quality(*accelerator, scene_accelerator, scene_bounds_);
+    };
+    report_.cluster_quality = judge(cluster_mesh);
+    report_.stochastic_quality = judge(stochastic_mesh);
+    const bool cluster_wins = report_.cluster_quality &&
+                              (!report_.stochastic_quality ||
+                               report_.cluster_quality->hit_overlap >= report_.stochastic_quality->hit_overlap);
+    report_.method = cluster_wins ? ProxyMethod::cluster : ProxyMethod::stochastic;
+    mesh_ = std::move(cluster_wins ? cluster_mesh : stochastic_mesh);
+  } else {
+    report_.method = options.method;
+    mesh_ = options.method == ProxyMethod::cluster ? clustered() : pruned();
+    report_.simplify_seconds = seconds_since(start);
+  }
+  if (mesh_.triangles.empty()) throw SceneError("the proxy lost every triangle: raise proxy.share");
+  if (cell_size == 0.0) cell_size = simplify_by_clustering(mesh, target).cell_size;  // the scale of either method
+  surface_tolerance_ = static_cast<float>(cell_size);
+  const auto build_start = std::chrono::steady_clock::now();
+  accelerator_ = make_accelerator(mesh_, options.accelerator);
+  report_.build_seconds = seconds_since(build_start);
+  report_.triangles = mesh_.triangle_count();
+  if (options.method != ProxyMethod::automatic) {
+    report_.quality = measure_proxy_quality(*accelerator_, scene_accelerator, scene_bounds_);
+  } else {
+    report_.quality = report_.method == ProxyMethod::cluster ? *report_.cluster_quality : *report_.stochastic_quality;
+  }
+}
+
+Proxy::Proxy(TriangleMesh simplified, const Bounds3& scene_bounds, float surface_tolerance, const ProxyReport& report,
+             const AcceleratorOptions& accelerator)
+    : mesh_(std::move(simplified)), scene_bounds_(scene_bounds), report_(report), surface_tolerance_(surface_tolerance) {
+  if (mesh_.triangles.empty()) throw SceneError("the saved proxy has no triangles");
+  const auto build_start = std::chrono::steady_clock::now();
+  accelerator_ = make_accelerator(mesh_, accelerator);
+  report_.build_seconds = seconds_since(build_start);
+}
+
+}  // namespace wavetrace

@@ -1,0 +1,79 @@
+// The proxy of the reordering paper (§4.2): the scene simplified to a small share of its
+// triangles with an accelerator of its own, queried by approx_hit for approximate hit
+// points. Its box is the scene's, so a ray that misses the box misses the scene.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "wavetrace/accel/accelerator.hpp"
+#include "wavetrace/accel/registry.hpp"
+#include "wavetrace/scene/triangle_mesh.hpp"
+
+namespace wavetrace {
+
+// cluster: vertex clustering with quadrics (cluster_simplify.hpp). stochastic: stochastic
+// pruning (stochastic_simplify.hpp). auto: both, keeping the one whose hits overlap the
+// scene's more on test rays (the fallback for aggregate detail such as fur).
+enum class ProxyMethod { automatic, cluster, stochastic };
+ProxyMethod parse_proxy_method(const std::string& text);  // "auto" | "cluster" | "stochastic"
+std::string to_string(ProxyMethod method);
+
+struct ProxyOptions {
+  double share = 0.02;  // of the scene's triangles; the paper: 2% (0.0125%-8% workable)
+  ProxyMethod method = ProxyMethod::automatic;
+  AcceleratorOptions accelerator;
+};
+
+// How well a proxy stands in for the scene on rays from random points of the scene's box
+// in random directions (a stand-in for bounce rays).
+struct ProxyQuality {
+  double hit_agreement = 0.0;       // both hit or both miss
+  // Rays both hit over rays either hits: the agreement that matters for ordering, since
+  // rays missing both are common and easy.
+  double hit_overlap = 0.0;
+  double mean_distance_error = 0.0; // |t_proxy - t_scene| / scene diagonal, where both hit
+};
+
+struct ProxyReport {
+  ProxyMethod method = ProxyMethod::cluster;  // the one used
+  std::size_t triangles = 0;
+  double simplify_seconds = 0.0;
+  double build_seconds = 0.0;  // of the proxy's accelerator
+  ProxyQuality quality;
+  std::optional<ProxyQuality> cluster_quality, stochastic_quality;  // measured under auto
+};
+
+class Proxy {
+ public:
+  // `scene_accelerator` answers for the full mesh; it judges quality. Throws SceneError
+  // when the share is outside (0, 1].
+  Proxy(const TriangleMesh& mesh, const ProxyOptions& options, const Accelerator& scene_accelerator);
+  // A proxy simplified before (a saved world's): its accelerator is rebuilt from `simplified`,
+  // everything else is as it was.
+  Proxy(TriangleMesh simplified, const Bounds3& scene_bounds, float surface_tolerance, const ProxyReport& report,
+        const AcceleratorOptions& accelerator);
+
+  const Accelerator& accelerator() const { return *accelerator_; }
+  const Bounds3& scene_bounds() const { return scene_bounds_; }
+  const TriangleMesh& mesh() const { return mesh_; }
+  const ProxyReport& report() const { return report_; }
+  // How far the proxy's surface may lie from the scene's: about one simplification cell.
+  // A ray leaving the scene's surface would hit the proxy right there; approx_hit skips
+  // this distance from each origin so the approximate hit is the one further along.
+  float surface_tolerance() const { return surface_tolerance_; }
+
+ private:
+  TriangleMesh mesh_;
+  std::unique_ptr<Accelerator> accelerator_;
+  Bounds3 scene_bounds_;
+  ProxyReport report_;
+  float surface_tolerance_ = 0.0f;
+};
+
+// Hit agreement of `candidate` with `scene_accelerator` on `rays` test rays.
+ProxyQuality measure_proxy_quality(const Accelerator& candidate, const Accelerator& scene_accelerator,
+                                   const Bounds3& scene_bounds, std::size_t rays = 16384);
+
+}  // namespace wavetrace

@@ -1,0 +1,52 @@
+// `raystrips`: Lauterbach, Yoon and Manocha's Ray-Strips (2007). The mesh is cut by the
+// SAH into sub-meshes, each stripified; the strips carry an implicit spatial kd-tree
+// (ray_strip_format.hpp) and sit in the leaves of the baseline's SAH BVH (or, width 8, of
+// quantized 8-wide nodes). Triangles are
+// tested by Plücker edges shared along the strip (strip_traversal.hpp).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include "wavetrace/accel/accelerator.hpp"
+#include "wavetrace/accel/raystrips/stripify.hpp"
+#include "wavetrace/scene/triangle_mesh.hpp"
+
+namespace wavetrace {
+
+struct RayStripsOptions {
+  // Sub-mesh threshold (§4.2): the SAH tree is cut at its highest nodes holding at most
+  // this many triangles; each such sub-mesh is stripified on its own. 2 .. 65535.
+  std::uint32_t submesh_triangles = 256;
+  // OpenMesh's by default: on builtin:sphere:1M its strips are shorter (14.6 triangles
+  // against 33.4) but hardly ever turn (2% repeats against 31%), so the kd-tree boxes are
+  // tighter and tracing is 1.3x faster at about the same bytes per triangle.
+  StripifierKind stripifier = StripifierKind::openmesh;
+  // Most strips in one leaf of the top BVH; 1 is the paper's partition step (a leaf per
+  // strip). The SAH decides below this bound. 1 .. 16.
+  std::uint32_t strips_per_leaf = 1;
+  // The strip's kd-tree is descended until a span holds at most this many triangles, which
+  // are then tested together by shared edges (the paper: 2, a leaf; 6 fills the 8-lane
+  // edge test and measured 1.4x faster than 2). 2 .. 64.
+  std::uint32_t run_triangles = 6;
+  std::uint32_t bins = 16;  // SAH bins, for the sub-mesh cut and the top BVH
+  // The top over the strips: 2, the baseline's 32-byte binary nodes; 8, the quantized 8-wide
+  // nodes HMQ's wide layout has (accel/bvh/quantized_wide_node.hpp) and a 4-byte offset per
+  // top leaf. Packets (below) need the binary top.
+  std::uint32_t width = 2;
+  // Camera rays (intersect_coherent) as 2x2 packets (§5.3); below `packet_min_active`
+  // active rays in a strip, the packet falls back to single-ray strip traversal.
+  bool packets = true;
+  std::uint32_t packet_min_active = 2;  // 1 .. 4
+};
+
+// Throws std::invalid_argument for options outside their ranges. `mesh` must outlive
+// the accelerator only while it builds; the strips keep their own vertex copy.
+std::unique_ptr<Accelerator> make_raystrips_accelerator(const TriangleMesh& mesh, const RayStripsOptions& options);
+
+// The raystrips structure saved under the loader's prefix, traced in place (format in
+// raystrips_accelerator.cpp).
+class SectionLoader;
+std::unique_ptr<Accelerator> load_raystrips_accelerator(const SectionLoader& loader);
+
+}  // namespace wavetrace

@@ -1,0 +1,219 @@
+// One ray through one Ray-Strip (§5.1, Algorithm 1): the implicit kd-tree walked near
+// child first with the ray's [dmin, dmax] interval and the strip interval tracked on a
+// small stack, and the shared-edge intersection of a run of strip triangles (§5.2).
+//
+// Edge tests. Each vertex of the run is moved into the watertight test's ray space (origin
+// at the ray origin, sheared so the ray runs along +z; Woop et al. 2013), where the Plücker
+// side of the ray against an edge (p, q) is the 2D edge function f(p, q) = q.x p.y - q.y p.x.
+// A run of m triangles has m + 2 vertices and 2m + 1 edges: the strip edges (s[j], s[j+1])
+// and the diagonals (s[j], s[j+2]); triangle j uses f(s[j+1], s[j+2]), -f(s[j], s[j+2]) and
+// f(s[j], s[j+1]) as the weights of its corners, and is hit when the three signs agree. The
+// arithmetic is the watertight test's (an exact zero is redone in double), and f(q, p) is
+// exactly -f(p, q), so two triangles sharing an edge — in a strip or across strips — see
+// the same edge value and no ray slips between them. Runs are processed 6 triangles
+// (8 vertices, 7 + 6 edges) at a time in 8-lane vectors (AVX2).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include <glm/vec3.hpp>
+
+#include "wavetrace/accel/ray_loop.hpp"
+#include "wavetrace/accel/raystrips/ray_strip_format.hpp"
+#include "wavetrace/kernels/ray_box.hpp"
+#include "wavetrace/kernels/triangle_intersect.hpp"
+
+namespace wavetrace {
+
+// Slack on the kd-tree's plane distances: the float error of (plane - origin) * inverse.
+inline constexpr float kPlaneDistanceSlack = 2.0f * float_error_gamma(2);
+
+// A plane distance moved outward by that error bound: later (exit) or earlier (entry).
+inline float widen_exit(float t) { return t * (t > 0.0f ? 1.0f + kPlaneDistanceSlack : 1.0f - kPlaneDistanceSlack); }
+inline float widen_entry(float t) { return t * (t > 0.0f ? 1.0f - kPlaneDistanceSlack : 1.0f + kPlaneDistanceSlack); }
+
+inline constexpr std::uint32_t kRunVertices = 8;
+inline constexpr std::uint32_t kRunTriangles = kRunVertices - 2;
+
+// The nearest hit so far of one ray, in strip terms until it is written out.
+struct StripHit {
+  float t = std::numeric_limits<float>::infinity();
+  float weights[3] = {0.0f, 0.0f, 0.0f};  // of the strip corners, normalized
+  const std::byte* strip = nullptr;       // null: no hit
+  std::uint32_t triangle = 0;             // strip triangle
+};
+
+class StripRay {
+ public:
+  explicit StripRay(const SingleRay& ray) : tmin(ray.tmin), tmax(ray.tmax), box(ray.box), sheared_(ray.sheared) {}
+
+  float tmin;
+  float tmax;  // shrinks to the nearest hit found
+  BoxRay box;
+  StripHit hit;
+
+  bool found() const { return hit.strip != nullptr; }
+
+  // Walks the strip's kd-tree inside [dmin, dmax] (the part of the ray in the strip's frame,
+  // the box of its top leaf), testing runs of at most `run_triangles` triangles. With kAnyHit
+  // stops at the first hit.
+  template <bool kAnyHit, typename Probe>
+  void traverse(const ray_strip::StripView& strip, const Bounds3& frame, const glm::vec3* positions, float dmin,
+                float dmax, std::uint32_t run_triangles, Probe& probe) {
+    traverse_subtree<kAnyHit>(strip, frame, positions, 0, 0, ray_strip::leaf_count(strip.triangles()), dmin, dmax,
+                              run_triangles, probe);
+  }
+
+  // The same from kd-node `node` spanning leaves [first, first + leaves).
+  template <bool kAnyHit, typename Probe>
+  void traverse_subtree(const ray_strip::StripView& strip, const Bounds3& frame, const glm::vec3* positions,
+                        std::uint32_t node,
+                        std::uint32_t first, std::uint32_t leaves, float dmin, float dmax, std::uint32_t run_triangles,
+                        Probe& probe) {
+    using namespace ray_strip;
+    struct Pending {
+      std::uint32_t node, first, leaves;
+      float dmin, dmax;
+    };
+    Pending stack[18];  // 65535 triangles: 16 levels of nodes
+    std::uint32_t top = 0;
+    const std::uint32_t triangles = strip.triangles();
+    dmax = std::min(dmax, tmax);
+    while (true) {
+      // Descend while the span holds more triangles than one run tests.
+      while (leaves >= 2 && std::min(2 * (first + leaves), triangles) - 2 * first > run_triangles) {
+        probe.read(strip.split_steps(node), 2);
+        probe.read(strip.data() + strip.layout().node_bits + node, 1);
+        const std::uint8_t bits = strip.node_bits(node);
+        const int axis = bits & kAxisMask;
+        const SplitPlanes planes = decode_split(strip.split_steps(node), frame, axis);
+        const float split[2] = {planes.lower_child_max, planes.upper_child_min};
+        const bool reverse = (bits & kReverse) != 0;
+        const std::uint32_t first_leaves = (leaves + 1) / 2;
+        const Pending strip_first{node + 1, first, first_leaves, 0, 0};
+        const Pending strip_second{node + first_leaves, first + first_leaves, leaves - first_leaves, 0, 0};
+        const Pending& lower = reverse ? strip_second : strip_first;
+        const Pending& upper = reverse ? strip_first : strip_second;
+        const float inverse = box.inverse_direction[axis];
+        const bool positive = !std::signbit(inverse);
+        const Pending& near = positive ? lower : upper;
+        const Pending& far = positive ? upper : lower;
+        const float near_exit = widen_exit(((positive ? split[0] : split[1]) - box.origin[axis]) * inverse);
+        const float far_entry = widen_entry(((positive ? split[1] : split[0]) - box.origin[axis]) * inverse);
+        // NaN (a ray in the plane) compares false both ways: both children stay in.
+        const bool near_hit = !(near_exit < dmin);
+        const bool far_hit = !(far_entry > dmax);
+        if (near_hit) {
+          if (far_hit) stack[top++] = {far.node, far.first, far.leaves, far_entry > dmin ? far_entry : dmin, dmax};
+          node = near.node, first = near.first, leaves = near.leaves;
+          dmax = near_exit < dmax ? near_exit : dmax;
+        } else if (far_hit) {
+          node = far.node, first = far.first, leaves = far.leaves;
+          dmin = far_entry > dmin ? far_entry : dmin;
+        } else {
+          goto pop;
+        }
+      }
+      test_run<kAnyHit>(strip, positions, 2 * first, std::min(2 * (first + leaves), triangles), probe);
+      if (kAnyHit && found()) return;
+    pop:
+      while (top > 0 && stack[top - 1].dmin > tmax) --top;
+      if (top == 0) return;
+      --top;
+      node = stack[top].node, first = stack[top].first, leaves = stack[top].leaves;
+      dmin = stack[top].dmin;
+      dmax = std::min(stack[top].dmax, tmax);
+    }
+  }
+
+  // Tests strip triangles [begin, end) by shared edges, 6 at a time.
+  template <bool kAnyHit, typename Probe>
+  void test_run(const ray_strip::StripView& strip, const glm::vec3* positions, std::uint32_t begin, std::uint32_t end,
+                Probe& probe) {
+    for (std::uint32_t chunk = begin; chunk < end; chunk += kRunTriangles) {
+      test_chunk<kAnyHit>(strip, positions, chunk, std::min(end - chunk, kRunTriangles), probe);
+      if (kAnyHit && found()) return;
+    }
+  }
+
+ private:
+  // Eight float lanes (GCC/Clang vector extensions: AVX2 here, plain scalar code elsewhere).
+  using Lanes = float __attribute__((vector_size(32)));
+  using LaneMask = std::int32_t __attribute__((vector_size(32)));
+
+  // Lane j takes lane j + 1 (j + 2); the last lanes repeat lane 7.
+  static Lanes next(Lanes v) { return __builtin_shufflevector(v, v, 1, 2, 3, 4, 5, 6, 7, 7); }
+  static Lanes after_next(Lanes v) { return __builtin_shufflevector(v, v, 2, 3, 4, 5, 6, 7, 7, 7); }
+
+  static float edge_in_double(float px, float py, float qx, float qy) {
+    return static_cast<float>(double(qx) * double(py) - double(qy) * double(px));
+  }
+
+  // Triangles [first, first + count), count <= 6: lane j of every vector is vertex s[first + j]
+  // (vertices past the run repeat the last one), edge (s[j], s[j+1]) or (s[j], s[j+2]), or
+  // triangle j.
+  template <bool kAnyHit, typename Probe>
+  void test_chunk(const ray_strip::StripView& strip, const glm::vec3* positions, std::uint32_t first,
+                  std::uint32_t count, Probe& probe) {
+    const std::uint32_t vertices = count + 2;
+    probe.read(strip.vertex_address(first), vertices * ((strip.widths() & ray_strip::kShortIndices) ? 2 : 4));
+    Lanes px, py, pz;
+    for (std::uint32_t i = 0; i < kRunVertices; ++i) {
+      const glm::vec3& p = positions[strip.vertex(first + std::min(i, vertices - 1))];
+      if constexpr (Probe::kRecords) {
+        if (i < vertices) probe.read(&p, sizeof p);
+      }
+      px[i] = p[sheared_.kx] - sheared_.origin[sheared_.kx];
+      py[i] = p[sheared_.ky] - sheared_.origin[sheared_.ky];
+      pz[i] = p[sheared_.kz] - sheared_.origin[sheared_.kz];
+    }
+    const Lanes x = px - sheared_.shear_x * pz;
+    const Lanes y = py - sheared_.shear_y * pz;
+    const Lanes z = sheared_.shear_z * pz;
+    // f(p, q) = q.x p.y - q.y p.x for the strip edges and the diagonals.
+    const Lanes x1 = next(x), y1 = next(y), x2 = after_next(x), y2 = after_next(y);
+    Lanes strip_edge = x1 * y - y1 * x;
+    Lanes diagonal = x2 * y - y2 * x;
+    const LaneMask zero = (strip_edge == 0.0f) | (diagonal == 0.0f);
+    bool any_zero = false;
+    for (std::uint32_t j = 0; j < kRunVertices; ++j) any_zero |= zero[j] != 0;
+    if (any_zero) {  // an exact zero is decided in double, per edge, as the watertight test does
+      for (std::uint32_t j = 0; j < count + 1; ++j) {
+        if (strip_edge[j] == 0.0f) strip_edge[j] = edge_in_double(x[j], y[j], x[j + 1], y[j + 1]);
+        if (j < count && diagonal[j] == 0.0f) diagonal[j] = edge_in_double(x[j], y[j], x[j + 2], y[j + 2]);
+      }
+    }
+    const Lanes w0 = next(strip_edge), w1 = -diagonal, w2 = strip_edge;
+    const LaneMask negative = (w0 < 0.0f) | (w1 < 0.0f) | (w2 < 0.0f);
+    const LaneMask positive = (w0 > 0.0f) | (w1 > 0.0f) | (w2 > 0.0f);
+    const Lanes determinant = w0 + w1 + w2;
+    const Lanes scaled_t = w0 * z + w1 * next(z) + w2 * after_next(z);
+    // t * det against [tmin, tmax] * |det| without dividing; the sign of det flips t * det.
+    const LaneMask flip = determinant < 0.0f;
+    const Lanes abs_determinant = flip ? -determinant : determinant;
+    const Lanes signed_t = flip ? -scaled_t : scaled_t;
+    const LaneMask accepted = ~(negative & positive) & (determinant != 0.0f) & (signed_t >= tmin * abs_determinant) &
+                              (signed_t <= tmax * abs_determinant);
+    for (std::uint32_t j = 0; j < count; ++j) {
+      if (!accepted[j]) continue;
+      const float inverse = 1.0f / determinant[j];
+      const float t = scaled_t[j] * inverse;
+      if (t > tmax) continue;
+      tmax = t;
+      hit.strip = strip.data();
+      hit.triangle = first + j;
+      hit.t = t;
+      hit.weights[0] = w0[j] * inverse;
+      hit.weights[1] = w1[j] * inverse;
+      hit.weights[2] = w2[j] * inverse;
+      if constexpr (kAnyHit) return;
+    }
+  }
+
+  WatertightRay sheared_;
+};
+
+}  // namespace wavetrace

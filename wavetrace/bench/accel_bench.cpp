@@ -1,0 +1,334 @@
+// Builds, times and checks each accelerator against the Embree reference.
+#include "wavetrace/bench/accel_bench.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include <fmt/format.h>
+#include <glm/geometric.hpp>
+
+#include "wavetrace/memory/process_memory.hpp"
+#include "wavetrace/stages/render_setup.hpp"
+#include "wavetrace/stages/tracing_arena.hpp"
+
+namespace wavetrace {
+namespace {
+
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  const std::size_t n = values.size();
+  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+void compare(const RaySet& rays, const std::vector<std::unique_ptr<HitBatch>>& hits,
+             const std::vector<std::unique_ptr<HitBatch>>& reference, float diagonal, AccelBenchResult& result) {
+  std::size_t agree = 0, both = 0, same_primitive = 0, total = 0;
+  double error_sum = 0.0, error_max = 0.0;
+  for (std::size_t b = 0; b < rays.batches.size(); ++b) {
+    for (std::size_t i = 0; i < rays.batches[b]->count; ++i) {
+      ++total;
+      const bool hit = hits[b]->is_hit(i), expected = reference[b]->is_hit(i);
+      agree += hit == expected;
+      if (!hit || !expected || rays.any_hit()) continue;
+      ++both;
+      same_primitive += hits[b]->primitive[i] == reference[b]->primitive[i];
+      const double error = std::fabs(double(hits[b]->t[i]) - double(reference[b]->t[i])) / diagonal;
+      error_sum += error;
+      error_max = std::max(error_max, error);
+    }
+  }
+  result.hit_agreement = total ? double(agree) / double(total) : 1.0;
+  if (!rays.any_hit()) {
+    result.prim_agreement = both ? double(same_primitive) / double(both) : 1.0;
+    result.t_error_max = error_max;
+    result.t_error_mean = both ? error_sum / double(both) : 0.0;
+  }
+}
+
+}  // namespace
+
+AcceleratorSpec parse_accelerator_spec(const std::string& text, const Config& base) {
+  Config config = base;
+  apply_accelerator_spec(config, text);
+  return {text, accelerator_options(config), accel_goal(config), std::nullopt};
+}
+
+void resolve_accelerator_spec(AcceleratorSpec& spec, const Scene& scene, const Config& base) {
+  if (!spec.goal.automatic && !(spec.goal.hmq_epsilon_pixel && spec.options.type == "hmq")) return;
+  if (scene.streamed()) throw ConfigError(fmt::format("--accel {}: needs the scene's mesh", spec.label));
+  const RenderPlan plan = plan_render(base);
+  const MeshTriangleSource source(scene.mesh);
+  const ResolvedAccelerator resolved = resolve_accelerator(spec.options, spec.goal, source,
+                                                           resolve_camera(plan.camera, scene), plan.image, false);
+  spec.options = resolved.options;
+  spec.auto_choice = resolved.choice;
+  spec.label = resolved.choice ? fmt::format("{} ({})", spec.label, resolved.choice->spec)
+                               : fmt::format("{} ({:.4g})", spec.label, spec.options.hmq.epsilon);
+  spec.goal = AccelGoal{};
+}
+
+// For a lossy accelerator: the distance of each hit point (origin + t direction) from the
+// point with the same barycentrics on the mesh's triangle, against the largest vertex move.
+void measure_surface_error(const TriangleMesh& mesh, const Accelerator& accelerator, const RaySet& rays,
+                           const std::vector<std::unique_ptr<HitBatch>>& hits, AccelBenchResult& result) {
+  const std::optional<TriangleMesh> represented = accelerator.represented_mesh(mesh);
+  if (!represented) return;
+  double moved = 0.0;
+  for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
+    moved = std::max(moved, double(glm::length(represented->positions[v] - mesh.positions[v])));
+  }
+  double worst = 0.0;
+  for (std::size_t b = 0; b < rays.batches.size(); ++b) {
+    const RayBatch& batch = *rays.batches[b];
+    const HitBatch& hit = *hits[b];
+    for (std::size_t i = 0; i < batch.count; ++i) {
+      if (!hit.is_hit(i)) continue;
+      const glm::dvec3 origin(batch.origin_x[i], batch.origin_y[i], batch.origin_z[i]);
+      const glm::dvec3 direction(batch.direction_x[i], batch.direction_y[i], batch.direction_z[i]);
+      const glm::uvec3& corners = mesh.triangles[hit.primitive[i]];
+      const double u = hit.u[i], v = hit.v[i];
+      const glm::dvec3 on_mesh = (1.0 - u - v) * glm::dvec3(mesh.positions[corners.x]) +
+                                 u * glm::dvec3(mesh.positions[corners.y]) + v * glm::dvec3(mesh.positions[corners.z]);
+      worst = std::max(worst, glm::length(origin + double(hit.t[i]) * direction - on_mesh));
+    }
+  }
+  result.surface_error_max = worst;
+  result.vertex_error_max = moved;
+}
+
+// A probed pass per budget (or one cache-only pass), each with a fresh pool and caches.
+std::vector<MemoryRun> memory_runs(const Accelerator& accelerator, const RaySet& rays, const AccelBenchRequest& request,
+                                   int threads) {
+  std::vector<std::string> budgets = request.budgets;
+  if (budgets.empty()) budgets.push_back(request.memory.budget ? std::string("config") : std::string());
+  std::vector<MemoryRun> runs;
+  for (const std::string& label : budgets) {
+    MemoryPlan plan = request.memory;
+    if (!label.empty() && label != "config") plan.budget = parse_memory_budget(label);
+    MemoryObservation observation(plan, accelerator.memory_spans(), threads);
+    const auto start = std::chrono::steady_clock::now();
+    trace_ray_set_probed(accelerator, rays, observation.observers());
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::vector<StageStats> stages(1);
+    stages[0].name = "trace";
+    observation.report(stages);
+    MemoryRun run;
+    run.budget = label;
+    for (const auto& span : accelerator.memory_spans()) run.world_bytes += span.size();
+    run.pager = stages[0].pager;
+    run.cache = stages[0].cache;
+    run.instrumented_mrays_per_s = double(rays.count()) / seconds * 1e-6;
+    runs.push_back(std::move(run));
+  }
+  return runs;
+}
+
+AccelBenchReport run_accel_bench(const Scene& scene, const AccelBenchRequest& request) {
+  TracingArena arena(request.threads);
+  AccelBenchReport report;
+  report.scene = scene.name;
+  report.triangles = scene.triangle_count;
+  report.rays = to_string(request.rays);
+  report.reference = request.reference.label;
+  report.threads = arena.threads();
+  report.repeats = request.repeats;
+  report.packets = request.packets && request.rays == RaySetKind::primary;
+  report.memory_observed = request.memory.enabled() || !request.budgets.empty();
+  const float diagonal = scene.bounds.diagonal();
+  const bool has_mesh = !scene.mesh.triangles.empty();
+  if (request.world != nullptr && !has_mesh) report.reference = "the world itself (it holds no mesh)";
+
+  arena.execute([&] {
+    const std::unique_ptr<Accelerator> built_reference =
+        has_mesh ? make_accelerator(scene.mesh, request.reference.options) : nullptr;
+    const Accelerator* reference = built_reference ? built_reference.get() : request.world;
+    const RaySet rays = make_ray_set(request.rays, scene, *reference, request.count, kDefaultBatchCapacity,
+                                     request.world_lights);
+    report.ray_count = rays.count();
+    const auto reference_hits = trace_ray_set(*reference, rays);
+    std::size_t reference_hit_count = 0;
+    for (std::size_t b = 0; b < rays.batches.size(); ++b) {
+      for (std::size_t i = 0; i < rays.batches[b]->count; ++i) reference_hit_count += reference_hits[b]->is_hit(i);
+    }
+    report.reference_hit_rate = double(reference_hit_count) / double(std::max<std::size_t>(1, report.ray_count));
+
+    const std::size_t subjects = request.world != nullptr ? 1 : request.accelerators.size();
+    for (std::size_t subject = 0; subject < subjects; ++subject) {
+      AccelBenchResult result;
+      std::unique_ptr<Accelerator> built;
+      if (request.world != nullptr) {
+        result.label = request.world_label;
+        result.build = request.world->build();
+        result.build.seconds = request.world_load_seconds;  // the world's load stands for its build
+      } else {
+        const AcceleratorSpec& spec = request.accelerators[subject];
+        result.label = spec.label;
+        result.auto_choice = spec.auto_choice;
+        // The build's peak resident memory, from the OS: the peak window starts here, so it
+        // holds what the process already had (scene, rays, reference) plus the build's own.
+        const bool windowed = reset_peak_resident_memory();
+        const std::size_t resident_before = read_resident_memory().current_bytes;
+        built = build_world_accelerator(scene, spec.options);
+        const std::size_t peak = read_resident_memory().peak_bytes;
+        if (windowed) result.build_peak_rss_above_start_bytes = peak > resident_before ? peak - resident_before : 0;
+        result.build = built->build();
+      }
+      const Accelerator* accelerator = built ? built.get() : request.world;
+      result.memory = accelerator->memory();
+      result.bytes_per_triangle = double(result.memory.total()) / double(scene.triangle_count);
+      result.build_notes = accelerator->build_notes();
+      std::vector<std::unique_ptr<HitBatch>> hits;
+      for (int run = 0; run < std::max(1, request.repeats); ++run) {
+        const auto start = std::chrono::steady_clock::now();
+        hits = trace_ray_set(*accelerator, rays, report.packets);
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        result.mrays_per_s_runs.push_back(double(report.ray_count) / seconds * 1e-6);
+      }
+      result.mrays_per_s = median(result.mrays_per_s_runs);
+      compare(rays, hits, reference_hits, diagonal, result);
+      if (!rays.any_hit() && has_mesh) measure_surface_error(scene.mesh, *accelerator, rays, hits, result);
+      result.probed = accelerator->probed();
+      if (report.memory_observed && result.probed) {
+        result.memory_runs = memory_runs(*accelerator, rays, request, report.threads);
+      }
+      report.results.push_back(std::move(result));
+    }
+  });
+  return report;
+}
+
+// Absent (null) where the accelerator cannot be observed or nothing was asked: never zeros.
+nlohmann::json memory_runs_json(const AccelBenchReport& report, const AccelBenchResult& r) {
+  if (!report.memory_observed || !r.probed) return nullptr;
+  nlohmann::json runs = nlohmann::json::array();
+  for (const MemoryRun& run : r.memory_runs) {
+    nlohmann::json entry = {{"budget", run.budget},
+                            {"world_bytes", run.world_bytes},
+                            {"instrumented_mrays_per_s", run.instrumented_mrays_per_s}};
+    if (run.pager) entry["pager"] = {{"page_bytes", run.pager->page_bytes},
+                                     {"budget_bytes", run.pager->budget_bytes},
+                                     {"accesses", run.pager->counters.accesses},
+                                     {"faults", run.pager->counters.faults},
+                                     {"bytes_loaded", run.pager->counters.bytes_loaded},
+                                     {"simulated_io_seconds", run.pager->counters.simulated_io_seconds}};
+    if (run.cache) entry["cache"] = {{"preset", run.cache->geometry.name},
+                                     {"line_bytes", run.cache->geometry.line_bytes},
+                                     {"capacity_bytes", run.cache->geometry.capacity_bytes},
+                                     {"ways", run.cache->geometry.ways},
+                                     {"accesses", run.cache->counters.accesses},
+                                     {"misses", run.cache->counters.misses}};
+    runs.push_back(entry);
+  }
+  return runs;
+}
+
+nlohmann::json to_json(const AccelBenchReport& report) {
+  nlohmann::json results = nlohmann::json::array();
+  for (const AccelBenchResult& r : report.results) {
+    const auto optional = [](const std::optional<double>& value) {
+      return value ? nlohmann::json(*value) : nlohmann::json(nullptr);
+    };
+    results.push_back({{"accel", r.label},
+                       {"bytes", r.memory.total()},
+                       {"bytes_per_triangle", r.bytes_per_triangle},
+                       {"parts", {{"hierarchy", r.memory.hierarchy}, {"geometry", r.memory.geometry}, {"other", r.memory.other}}},
+                       {"build_seconds", r.build.seconds},
+                       {"build_peak_accounted_bytes", r.build.peak_bytes},
+                       {"build_peak_rss_above_start_bytes", r.build_peak_rss_above_start_bytes},
+                       {"build_notes", r.build_notes},
+                       {"mrays_per_s", r.mrays_per_s},
+                       {"mrays_per_s_runs", r.mrays_per_s_runs},
+                       {"hit_agreement", r.hit_agreement},
+                       {"prim_agreement", optional(r.prim_agreement)},
+                       {"surface_error_max", optional(r.surface_error_max)},
+                       {"vertex_error_max", optional(r.vertex_error_max)},
+                       {"t_error_max", optional(r.t_error_max)},
+                       {"t_error_mean", optional(r.t_error_mean)},
+                       {"memory_runs", memory_runs_json(report, r)},
+                       {"auto", r.auto_choice ? to_json(*r.auto_choice) : nlohmann::json(nullptr)}});
+  }
+  return {{"scene", {{"source", report.scene}, {"triangles", report.triangles}}},
+          {"reference", report.reference},
+          {"rays", {{"kind", report.rays}, {"count", report.ray_count}, {"reference_hit_rate", report.reference_hit_rate}}},
+          {"threads", report.threads},
+          {"repeats", report.repeats},
+          {"packets", report.packets},
+          {"results", results}};
+}
+
+std::string to_csv(const AccelBenchReport& report) {
+  std::string csv =
+      "scene,triangles,rays,count,threads,accel,bytes,bytes_per_triangle,hierarchy,geometry,other,build_seconds,"
+      "build_peak_accounted_bytes,build_peak_rss_above_start_bytes,mrays_per_s,hit_agreement,prim_agreement,t_error_max,t_error_mean\n";
+  const auto optional = [](const std::optional<double>& v) { return v ? fmt::format("{:.9g}", *v) : std::string(); };
+  for (const AccelBenchResult& r : report.results) {
+    csv += fmt::format("{},{},{},{},{},{},{},{:.3f},{},{},{},{:.4f},{},{},{:.4f},{:.9g},{},{},{}\n", report.scene,
+                       report.triangles, report.rays, report.ray_count, report.threads, r.label, r.memory.total(),
+                       r.bytes_per_triangle, r.memory.hierarchy, r.memory.geometry, r.memory.other, r.build.seconds,
+                       r.build.peak_bytes, r.build_peak_rss_above_start_bytes, r.mrays_per_s, r.hit_agreement, optional(r.prim_agreement),
+                       optional(r.t_error_max), optional(r.t_error_mean));
+  }
+  return csv;
+}
+
+std::string memory_table(const AccelBenchReport& report) {
+  const double rays = double(std::max<std::size_t>(report.ray_count, 1));
+  std::string table = fmt::format("\nsimulated memory (pager and cache counts are exact with 1 thread):\n{:<24} {:>7} {:>9} {:>10} "
+                                  "{:>10} {:>10} {:>11} {:>10} {:>12} {:>11}\n",
+                                  "accel", "budget", "world MB", "budget MB", "faults", "faults/ray", "loaded MB",
+                                  "sim I/O s", "misses/ray", "instr Mr/s");
+  for (const AccelBenchResult& r : report.results) {
+    if (!r.probed) {
+      table += fmt::format("{:<24} cannot be observed: no counters\n", r.label);
+      continue;
+    }
+    for (const MemoryRun& run : r.memory_runs) {
+      const auto& pager = run.pager;
+      table += fmt::format(
+          "{:<24} {:>7} {:>9.1f} {:>10} {:>10} {:>10} {:>11} {:>10} {:>12} {:>11.3f}\n", r.label,
+          run.budget.empty() ? "-" : run.budget, double(run.world_bytes) * 1e-6,
+          pager ? fmt::format("{:.1f}", double(pager->budget_bytes) * 1e-6) : "-",
+          pager ? fmt::format("{}", pager->counters.faults) : "-",
+          pager ? fmt::format("{:.4f}", double(pager->counters.faults) / rays) : "-",
+          pager ? fmt::format("{:.1f}", double(pager->counters.bytes_loaded) * 1e-6) : "-",
+          pager ? fmt::format("{:.2f}", pager->counters.simulated_io_seconds) : "-",
+          run.cache ? fmt::format("{:.3f}", double(run.cache->counters.misses) / rays) : "-",
+          run.instrumented_mrays_per_s);
+    }
+  }
+  return table;
+}
+
+std::string to_table(const AccelBenchReport& report) {
+  std::string table = fmt::format(
+      "{}: {} triangles; {} {} rays{} ({:.1f}% hit the reference, {}); {} threads; median of {} runs\n", report.scene,
+      report.triangles, report.ray_count, report.rays, report.packets ? " as 2x2 packets" : "",
+      100.0 * report.reference_hit_rate, report.reference, report.threads, report.repeats);
+  table += fmt::format("{:<24} {:>9} {:>8} {:>8} {:>8} {:>9} {:>11} {:>8} {:>10} {:>10} {:>10} {:>10}\n", "accel",
+                       "MB", "B/tri", "hier", "geom", "build s", "peak RSS MB", "Mrays/s", "vs first", "hit agr", "prim agr",
+                       "t err max");
+  const double first = report.results.empty() ? 0.0 : report.results.front().mrays_per_s;
+  const double triangles = double(report.triangles);
+  for (const AccelBenchResult& r : report.results) {
+    table += fmt::format("{:<24} {:>9.1f} {:>8.1f} {:>8.1f} {:>8.1f} {:>9.3f} {:>11.1f} {:>8.2f} {:>9.2f}x {:>9.4f}% {:>9} {:>10}\n",
+                         r.label, double(r.memory.total()) * 1e-6, r.bytes_per_triangle,
+                         double(r.memory.hierarchy) / triangles, double(r.memory.geometry) / triangles, r.build.seconds,
+                         double(r.build_peak_rss_above_start_bytes) * 1e-6, r.mrays_per_s, first > 0 ? r.mrays_per_s / first : 0.0,
+                         100.0 * r.hit_agreement,
+                         r.prim_agreement ? fmt::format("{:.4f}%", 100.0 * *r.prim_agreement) : std::string("-"),
+                         r.t_error_max ? fmt::format("{:.2e}", *r.t_error_max) : std::string("-"));
+  }
+  for (const AccelBenchResult& r : report.results) {
+    if (!r.build_notes.empty()) table += fmt::format("{}: {}\n", r.label, r.build_notes);
+  }
+  for (const AccelBenchResult& r : report.results) {
+    if (!r.surface_error_max) continue;
+    table += fmt::format("{}: hit points lie at most {:.3g} from the mesh's triangles (vertices moved at most {:.3g})\n",
+                         r.label, *r.surface_error_max, *r.vertex_error_max);
+  }
+  if (report.memory_observed) table += memory_table(report);
+  return table;
+}
+
+}  // namespace wavetrace

@@ -1,0 +1,111 @@
+// `wavetrace bench accel`: every accelerator built and timed on the same rays in one run,
+// with its accuracy measured against Embree on those rays.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "wavetrace/accel/registry.hpp"
+#include "wavetrace/bench/ray_sets.hpp"
+#include "wavetrace/scene/scene.hpp"
+#include "wavetrace/stages/accel_choice.hpp"
+#include "wavetrace/stages/accelerator_spec.hpp"
+#include "wavetrace/stages/config.hpp"
+#include "wavetrace/stages/memory_observation.hpp"
+
+namespace wavetrace {
+
+// "TYPE[:key=value]..." where each key is accel.TYPE.key, e.g. "bvh:layout=veb:leaf_size=8",
+// "embree:mode=robust"; "auto[:memory_budget=..][:max_error=..]" sets accel.type = auto and
+// its accel.* keys; other keys come from `base`. Throws ConfigError naming bad parts.
+struct AcceleratorSpec {
+  std::string label;
+  AcceleratorOptions options;
+  AccelGoal goal;  // auto or a pixel epsilon: resolved on the scene by resolve_accelerator_spec
+  std::optional<AccelChoice> auto_choice;  // once resolved: what auto chose and why
+};
+AcceleratorSpec parse_accelerator_spec(const std::string& text, const Config& base);
+// Resolves auto or hmq:epsilon=pixel against `scene`, its camera (or camera.* of `base`) and
+// render.width x render.height of `base`; the label then names what it came to, as
+// "auto (hmq:width=8:epsilon=0.00123)". Other specs are left as they are.
+void resolve_accelerator_spec(AcceleratorSpec& spec, const Scene& scene, const Config& base);
+
+// One probed pass of the ray set: the pager at one budget and/or the simulated cache, and
+// the trace speed with the probes on (the uninstrumented speed is the result's own).
+struct MemoryRun {
+  std::string budget;          // as given ("20%"), empty without a pager
+  std::size_t world_bytes = 0;
+  std::optional<PagerStats> pager;
+  std::optional<CacheStats> cache;
+  double instrumented_mrays_per_s = 0.0;
+};
+
+struct AccelBenchResult {
+  std::string label;
+  MemoryReport memory;
+  double bytes_per_triangle = 0.0;
+  BuildReport build;  // its peak_bytes: the build's own accounting (Embree's: its allocation monitor)
+  // The build's peak resident memory read from the OS (VmHWM, reset before the build) above
+  // what the process held when it began; 0 where the peak cannot be reset.
+  std::size_t build_peak_rss_above_start_bytes = 0;
+  std::string build_notes;
+  std::vector<double> mrays_per_s_runs;
+  double mrays_per_s = 0.0;      // median of the runs
+  double hit_agreement = 0.0;    // same hit / miss as the reference
+  std::optional<double> prim_agreement;  // same primitive where both hit (closest-hit sets only)
+  std::optional<double> t_error_max;     // |t - t_ref| / scene diagonal where both hit
+  std::optional<double> t_error_mean;
+  // Lossy accelerators (Accelerator::represented_mesh): how far its hit points lie from the
+  // mesh's own triangle at the same barycentrics, and the bound it promises (the largest
+  // distance any vertex moved). Closest-hit sets only.
+  std::optional<double> surface_error_max;
+  std::optional<double> vertex_error_max;
+  bool probed = false;                 // false: the accelerator's reads cannot be observed (Embree)
+  std::vector<MemoryRun> memory_runs;  // one per budget, when memory observation was asked for
+  std::optional<AccelChoice> auto_choice;  // the spec was auto: its candidates and reasons
+};
+
+struct AccelBenchReport {
+  std::string scene;
+  std::size_t triangles = 0;
+  std::string reference;
+  std::string rays;
+  std::size_t ray_count = 0;
+  int threads = 0;
+  int repeats = 0;
+  bool packets = false;
+  double reference_hit_rate = 0.0;  // share of rays Embree finds a hit (occluded, for shadow rays)
+  bool memory_observed = false;     // memory runs were asked for
+  std::vector<AccelBenchResult> results;
+};
+
+struct AccelBenchRequest {
+  std::vector<AcceleratorSpec> accelerators;
+  AcceleratorSpec reference{"embree", AcceleratorOptions{}, AccelGoal{}, std::nullopt};  // accuracy is measured against it
+  RaySetKind rays = RaySetKind::primary;
+  std::size_t count = 1 << 20;
+  int threads = 0;
+  int repeats = 3;
+  bool packets = false;  // primary rays through intersect_coherent (packets where an accelerator has them)
+  // Pager settings and cache; `budgets` (e.g. "100%", "20%") replace memory.budget when given.
+  MemoryPlan memory;
+  std::vector<std::string> budgets;
+  // A saved world (bench accel --scene FILE.wtw): measured instead of `accelerators`, with
+  // its load in place of a build; the reference is built from its geometry when it has some,
+  // else the world answers for itself (accuracy then compares it with itself).
+  const Accelerator* world = nullptr;
+  const LightSampler* world_lights = nullptr;
+  std::string world_label;
+  double world_load_seconds = 0.0;
+};
+
+AccelBenchReport run_accel_bench(const Scene& scene, const AccelBenchRequest& request);
+
+nlohmann::json to_json(const AccelBenchReport& report);
+std::string to_csv(const AccelBenchReport& report);
+std::string to_table(const AccelBenchReport& report);
+
+}  // namespace wavetrace

@@ -1,0 +1,28 @@
+// Opening or building a benchmark's world once.
+#include "wavetrace/bench/render_world.hpp"
+
+#include <fmt/format.h>
+
+namespace wavetrace {
+
+RenderWorld::RenderWorld(const RenderPlan& base, bool needs_proxy) {
+  if (is_world_file(base.scene.source)) {
+    saved_ = load_world(base.scene.source, world_paging(base), base.pipeline.threads);
+    if (needs_proxy && !saved_->proxy) {
+      throw ConfigError(fmt::format("{} was saved without a proxy, which hit-point heuristics need: build it with --proxy",
+                                    base.scene.source));
+    }
+    return;
+  }
+  if (base.memory.file_backing) throw ConfigError("memory.backing = file pages a world file: give one (wavetrace build)");
+  built_scene_ = load_scene(base.scene);
+  built_accelerator_ = build_world_accelerator(built_scene_, base.accelerator);
+  built_lights_ = std::make_unique<LightSampler>(represented_lights(built_scene_, *built_accelerator_));
+  if (needs_proxy) built_proxy_ = std::make_unique<Proxy>(built_scene_.mesh, base.proxy, *built_accelerator_);
+}
+
+World RenderWorld::world() const {
+  return World{scene(), accelerator(), saved_ ? *saved_->lights : *built_lights_, proxy(), file_pager()};
+}
+
+}  // namespace wavetrace

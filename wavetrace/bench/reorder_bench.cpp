@@ -1,0 +1,195 @@
+// One scene, accelerator and proxy shared by every heuristic's render.
+#include "wavetrace/bench/reorder_bench.hpp"
+
+#include <fmt/format.h>
+
+#include "wavetrace/bench/render_world.hpp"
+#include "wavetrace/stages/render_setup.hpp"
+
+namespace wavetrace {
+namespace {
+
+const StageStats* find_stage(const PipelineRun& run, std::string_view name) {
+  for (const StageStats& stage : run.stages) {
+    if (stage.name == name) return &stage;
+  }
+  return nullptr;
+}
+
+}  // namespace
+
+ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<ReorderHeuristic>& heuristics) {
+  if (heuristics.empty()) throw ConfigError("--heuristics names no heuristic");
+  const RenderPlan base = plan_render(config);
+  if (base.rules.max_depth < 3) {
+    throw ConfigError(fmt::format("render.max_depth = {}: the reorder benchmark path traces to depth 3 or more",
+                                  base.rules.max_depth));
+  }
+  bool hit_points = false;
+  for (ReorderHeuristic heuristic : heuristics) hit_points = hit_points || uses_hit_points(heuristic);
+  const RenderWorld opened(base, hit_points);
+  const Scene& scene = opened.scene();
+  const Accelerator* accelerator = &opened.accelerator();
+  const Proxy* proxy = opened.proxy();
+  FilePager* file_pager = opened.file_pager();
+  const LoadedWorld* saved = opened.saved();
+  const Camera camera = resolve_camera(base.camera, scene);
+  const World world = opened.world();
+
+  ReorderBenchReport report;
+  report.scene = scene.name;
+  report.triangles = scene.triangle_count;
+  if (saved) report.world_bytes = saved->file->file_bytes();
+  report.accel = accelerator->name();
+  report.curve = to_string(base.reorder.curve);
+  report.image = fmt::format("{}x{}, {} spp, depth {}", base.image.width, base.image.height,
+                             base.image.samples_per_pixel, base.rules.max_depth);
+  if (proxy) {
+    const ProxyReport& p = proxy->report();
+    report.proxy = fmt::format("{} triangles ({:.4g}% of the scene) by {} on {}; hit overlap {:.1f}%", p.triangles,
+                               100.0 * double(p.triangles) / double(report.triangles), to_string(p.method),
+                               proxy->accelerator().name(), 100.0 * p.quality.hit_overlap);
+  }
+  report.memory = "off";
+  if (base.memory.budget) {
+    report.memory = "pager " + config.text("memory.budget") + " of " + std::to_string(base.memory.page_bytes >> 10) +
+                    " KiB pages";
+    if (file_pager != nullptr) {
+      report.memory += fmt::format(" (simulated, and real: {} of {} pages read with O_DIRECT into a {:.1f} MiB pool)",
+                                   base.scene.source, file_pager->page_count(), double(file_pager->budget_bytes()) / (1 << 20));
+      report.page_count = file_pager->page_count();
+    }
+  }
+  if (base.memory.cache) report.memory += (base.memory.budget ? ", cache " : "cache ") + base.memory.cache->name;
+
+  std::vector<float> first_image;
+  for (ReorderHeuristic heuristic : heuristics) {
+    Config variant = config;
+    variant.set_value("reorder.heuristic", to_string(heuristic));
+    const RenderPlan plan = plan_render(variant);
+    const RenderOutput output = render_image(plan, world, camera);
+    report.threads = output.run.threads;
+
+    ReorderBenchResult result;
+    result.heuristic = to_string(heuristic);
+    result.render_seconds = output.run.seconds;
+    result.closest_mrays_per_s = output.closest_mrays_per_s;
+    result.shadow_mrays_per_s = output.any_mrays_per_s;
+    const double thread_seconds = output.run.seconds * output.run.threads;
+    if (const StageStats* trace = find_stage(output.run, "trace")) {
+      result.trace_seconds = trace->seconds;
+      result.trace_mrays_per_s = trace->mrays_per_s();
+      result.rays_traced = trace->rays_in;
+      if (trace->pager) {
+        result.page_faults = trace->pager->counters.faults;
+        result.bytes_loaded = trace->pager->counters.bytes_loaded;
+        result.simulated_io_seconds = trace->pager->counters.simulated_io_seconds;
+      }
+      if (trace->cache) result.cache_misses = trace->cache->counters.misses;
+      if (trace->disk) {
+        result.disk_faults = trace->disk->counters.faults;
+        result.disk_bytes_read = trace->disk->counters.bytes_read;
+        result.disk_read_seconds = trace->disk->counters.read_seconds;
+      }
+    }
+    if (const StageStats* approx = find_stage(output.run, "approx_hit")) {
+      result.approx_hit_seconds = approx->seconds;
+      result.rays_retired_by_approx_hit = approx->rays_in - approx->rays_out;
+      // The proxy's traffic counts too: it is the price of the ordering.
+      if (approx->pager && result.page_faults) {
+        *result.page_faults += approx->pager->counters.faults;
+        *result.bytes_loaded += approx->pager->counters.bytes_loaded;
+        *result.simulated_io_seconds += approx->pager->counters.simulated_io_seconds;
+      }
+      if (approx->cache && result.cache_misses) *result.cache_misses += approx->cache->counters.misses;
+    }
+    if (const StageStats* zsort = find_stage(output.run, "zsort")) result.sort_seconds = zsort->seconds;
+    result.overhead_share = (result.approx_hit_seconds + result.sort_seconds) / thread_seconds;
+    if (first_image.empty()) first_image = output.image;
+    result.image_identical = output.image == first_image;
+    report.results.push_back(result);
+  }
+  return report;
+}
+
+nlohmann::json to_json(const ReorderBenchReport& report) {
+  const auto optional = [](const auto& value) { return value ? nlohmann::json(*value) : nlohmann::json(nullptr); };
+  nlohmann::json results = nlohmann::json::array();
+  for (const ReorderBenchResult& r : report.results) {
+    results.push_back({{"heuristic", r.heuristic},
+                       {"render_seconds", r.render_seconds},
+                       {"trace_seconds", r.trace_seconds},
+                       {"trace_mrays_per_s", r.trace_mrays_per_s},
+                       {"closest_mrays_per_s", r.closest_mrays_per_s},
+                       {"shadow_mrays_per_s", r.shadow_mrays_per_s},
+                       {"approx_hit_seconds", r.approx_hit_seconds},
+                       {"sort_seconds", r.sort_seconds},
+                       {"overhead_share", r.overhead_share},
+                       {"rays_traced", r.rays_traced},
+                       {"rays_retired_by_approx_hit", r.rays_retired_by_approx_hit},
+                       {"page_faults", optional(r.page_faults)},
+                       {"bytes_loaded", optional(r.bytes_loaded)},
+                       {"simulated_io_seconds", optional(r.simulated_io_seconds)},
+                       {"cache_misses", optional(r.cache_misses)},
+                       {"disk_faults", optional(r.disk_faults)},
+                       {"disk_bytes_read", optional(r.disk_bytes_read)},
+                       {"disk_read_seconds", optional(r.disk_read_seconds)},
+                       {"image_identical", r.image_identical}});
+  }
+  return {{"scene", {{"source", report.scene}, {"triangles", report.triangles}}},
+          {"accel", report.accel},
+          {"curve", report.curve},
+          {"image", report.image},
+          {"threads", report.threads},
+          {"proxy", optional(report.proxy)},
+          {"memory", report.memory},
+          {"world_bytes", report.world_bytes},
+          {"page_count", report.page_count},
+          {"results", results}};
+}
+
+std::string to_table(const ReorderBenchReport& report) {
+  std::string table = fmt::format("{}: {} triangles; {} on {}; {} curve; {} threads; memory {}\n", report.scene,
+                                  report.triangles, report.image, report.accel, report.curve, report.threads, report.memory);
+  if (report.proxy) table += "proxy: " + *report.proxy + "\n";
+  const bool disk = !report.results.empty() && report.results.front().disk_faults.has_value();
+  table += fmt::format("{:<11} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>8} {:>9} {:>10} {:>9} {:>11} {:>11} {:>9} {:>10}",
+                       "heuristic", "render s", "trace s", "Mr/s/thr", "closest", "shadow", "approx s", "sort s",
+                       "overhead", "faults", "sim I/O s", "misses", "vs first", "speedup", "identical");
+  table += disk ? fmt::format(" {:>11} {:>9} {:>9} {:>9} {:>10}\n", "disk faults", "disk MB", "read s", "disk vs 1st",
+                              "rays/page")
+                : "\n";
+  const ReorderBenchResult* first = report.results.empty() ? nullptr : &report.results.front();
+  const auto optional = [](const auto& value, const char* format) {
+    return value ? fmt::format(fmt::runtime(format), *value) : std::string("-");
+  };
+  const auto ratio = [](const std::optional<std::uint64_t>& base, const std::optional<std::uint64_t>& value) {
+    return base && value && *value > 0 ? fmt::format("{:.2f}x", double(*base) / double(*value)) : std::string("-");
+  };
+  for (const ReorderBenchResult& r : report.results) {
+    table += fmt::format("{:<11} {:>9.3f} {:>9.3f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.3f} {:>8.3f} {:>8.1f}% {:>10} {:>9} {:>11} {:>11} "
+                         "{:>8.2f}x {:>10}",
+                         r.heuristic, r.render_seconds, r.trace_seconds, r.trace_mrays_per_s, r.closest_mrays_per_s,
+                         r.shadow_mrays_per_s, r.approx_hit_seconds,
+                         r.sort_seconds, 100.0 * r.overhead_share, optional(r.page_faults, "{}"),
+                         optional(r.simulated_io_seconds, "{:.1f}"), optional(r.cache_misses, "{}"),
+                         ratio(first->page_faults, r.page_faults), first->render_seconds / r.render_seconds,
+                         r.image_identical ? "yes" : "NO");
+    if (disk) {
+      table += fmt::format(" {:>11} {:>9.1f} {:>9.2f} {:>9} {:>10.0f}", optional(r.disk_faults, "{}"),
+                           double(r.disk_bytes_read.value_or(0)) * 1e-6, r.disk_read_seconds.value_or(0.0),
+                           ratio(first->disk_faults, r.disk_faults),
+                           double(r.rays_traced) / double(std::max<std::size_t>(report.page_count, 1)));
+    }
+    table += "\n";
+  }
+  table += "Mr/s/thr: trace's rays per busy thread-second (closest: camera and bounce rays; shadow: any-hit rays)\n"
+           "vs first: the first heuristic's page faults over this one's; speedup: its render seconds over this one's\n";
+  if (disk) {
+    table += "disk: real faults of trace (pages read from the world file with O_DIRECT), their bytes and measured read\n"
+             "seconds (inside render s); rays/page: rays traced per page of the world file\n";
+  }
+  return table;
+}
+
+}  // namespace wavetrace

@@ -1,0 +1,62 @@
+// `wavetrace bench reorder`: the same path-traced image rendered once per reordering
+// heuristic in one run, with each render's stage times, the simulated memory traffic of
+// trace and approx_hit when [memory] asks for it, and whether the image equals the
+// `none` image bit for bit (the reordering paper's Table III, on our scenes).
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "wavetrace/stages/config.hpp"
+#include "wavetrace/stages/reorder_keys.hpp"
+
+namespace wavetrace {
+
+struct ReorderBenchResult {
+  std::string heuristic;
+  double render_seconds = 0.0;
+  double trace_seconds = 0.0;       // thread-seconds in trace
+  double trace_mrays_per_s = 0.0;   // per trace thread-second
+  double closest_mrays_per_s = 0.0; // camera and bounce rays alone
+  double shadow_mrays_per_s = 0.0;  // shadow rays alone
+  double approx_hit_seconds = 0.0;
+  double sort_seconds = 0.0;        // the zsort stage: keys, sort, gather
+  double overhead_share = 0.0;      // (approx_hit + zsort) / all thread-seconds
+  std::uint64_t rays_traced = 0;
+  std::uint64_t rays_retired_by_approx_hit = 0;
+  std::optional<std::uint64_t> page_faults;
+  std::optional<std::uint64_t> bytes_loaded;
+  std::optional<double> simulated_io_seconds;
+  std::optional<std::uint64_t> cache_misses;
+  // Real paging of a world file (memory.backing = file): pages read from disk, measured.
+  std::optional<std::uint64_t> disk_faults;
+  std::optional<std::uint64_t> disk_bytes_read;
+  std::optional<double> disk_read_seconds;
+  bool image_identical = false;  // to the first heuristic's image (none, when listed first)
+};
+
+struct ReorderBenchReport {
+  std::string scene;
+  std::size_t triangles = 0;
+  std::string accel;
+  std::string curve;
+  std::string image;  // WxH, spp, depth
+  int threads = 0;
+  std::optional<std::string> proxy;  // method, triangles, quality
+  std::string memory;                // pager and cache settings, or "off"
+  std::uint64_t world_bytes = 0;     // the world file's size, when the scene is one
+  std::size_t page_count = 0;        // the world's pages, when paged (real or simulated)
+  std::vector<ReorderBenchResult> results;
+};
+
+// `config` holds every other setting (scene, accel, render, proxy, memory); each heuristic
+// gets reorder.heuristic and the chain it needs. Throws ConfigError for a depth under 3.
+ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<ReorderHeuristic>& heuristics);
+
+nlohmann::json to_json(const ReorderBenchReport& report);
+std::string to_table(const ReorderBenchReport& report);
+
+}  // namespace wavetrace

@@ -1,0 +1,45 @@
+// A std::allocator replacement for large arrays: blocks start on a cache line, and blocks
+// of 2 MiB or more start on a 2 MiB boundary and are advised to use transparent huge
+// pages (this machine's THP mode is "madvise"), which cuts the page faults of first touch
+// by 512x; in a VM each fault is costly (about 12% of a BVH build here).
+#pragma once
+
+#include <cstddef>
+#include <cstdlib>
+#include <new>
+#include <vector>
+
+#include <sys/mman.h>
+
+#include "wavetrace/memory/aligned_buffer.hpp"
+
+namespace wavetrace {
+
+inline constexpr std::size_t kHugePageBytes = std::size_t{2} << 20;
+
+inline void* allocate_large_array(std::size_t bytes) {
+  const bool huge = bytes >= kHugePageBytes;
+  const std::size_t alignment = huge ? kHugePageBytes : kColumnAlignment;
+  void* memory = std::aligned_alloc(alignment, align_up(bytes, alignment));
+  if (memory == nullptr) throw std::bad_alloc();
+  if (huge) madvise(memory, align_up(bytes, alignment), MADV_HUGEPAGE);  // advice only: failure is harmless
+  return memory;
+}
+
+template <typename T>
+struct CacheAlignedAllocator {
+  using value_type = T;
+  CacheAlignedAllocator() = default;
+  template <typename U>
+  CacheAlignedAllocator(const CacheAlignedAllocator<U>&) {}
+
+  T* allocate(std::size_t count) { return static_cast<T*>(allocate_large_array(count * sizeof(T))); }
+  void deallocate(T* pointer, std::size_t) { std::free(pointer); }
+  template <typename U>
+  bool operator==(const CacheAlignedAllocator<U>&) const { return true; }
+};
+
+template <typename T>
+using LargeArray = std::vector<T, CacheAlignedAllocator<T>>;
+
+}  // namespace wavetrace

@@ -1,0 +1,268 @@
+// The real pager: a PROT_NONE reservation for the file's range, page slots in a memfd
+// mapped over it on demand, a SIGSEGV handler for reads no probe announced.
+#include "wavetrace/memory/file_pager.hpp"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <bit>
+#include <cerrno>
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <stdexcept>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/mman.h>
+#include <unistd.h>
+
+#include <fmt/format.h>
+
+namespace wavetrace {
+namespace {
+
+// The pagers whose ranges the SIGSEGV handler serves; a fault elsewhere goes to the handler
+// installed before ours (or the default: a crash, as without us).
+constexpr std::size_t kMaxPagers = 16;
+std::array<std::atomic<FilePager*>, kMaxPagers> active_pagers{};
+std::once_flag handler_installed;
+struct sigaction previous_action {};
+
+void chain_to_previous(int signal, siginfo_t* info, void* context) {
+  if (previous_action.sa_flags & SA_SIGINFO) {
+    if (previous_action.sa_sigaction != nullptr) return previous_action.sa_sigaction(signal, info, context);
+  } else if (previous_action.sa_handler != SIG_IGN && previous_action.sa_handler != SIG_DFL &&
+             previous_action.sa_handler != nullptr) {
+    return previous_action.sa_handler(signal);
+  }
+  // Default action: restore it and return, so the faulting read repeats and crashes as usual.
+  ::signal(SIGSEGV, SIG_DFL);
+}
+
+void on_segmentation_fault(int signal, siginfo_t* info, void* context) {
+  for (auto& slot : active_pagers) {
+    FilePager* pager = slot.load(std::memory_order_acquire);
+    if (pager != nullptr && pager->handle_fault(info->si_addr)) return;
+  }
+  chain_to_previous(signal, info, context);
+}
+
+void install_handler() {
+  std::call_once(handler_installed, [] {
+    struct sigaction action {};
+    action.sa_sigaction = on_segmentation_fault;
+    action.sa_flags = SA_SIGINFO | SA_NODEFER;
+    sigemptyset(&action.sa_mask);
+    if (sigaction(SIGSEGV, &action, &previous_action) != 0) {
+      throw std::runtime_error(fmt::format("cannot install the pager's SIGSEGV handler: {}", std::strerror(errno)));
+    }
+  });
+}
+
+constexpr std::size_t kNoClient = ~std::size_t{0};
+thread_local std::size_t current_client = kNoClient;
+
+// Replaces a range with fresh PROT_NONE address space (no memory behind it).
+bool reserve_range(void* address, std::size_t bytes) {
+  return ::mmap(address, bytes, PROT_NONE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE | MAP_FIXED, -1, 0) != MAP_FAILED;
+}
+
+}  // namespace
+
+FilePager::ClientScope::ClientScope(std::size_t client) : previous_(current_client) { current_client = client; }
+FilePager::ClientScope::~ClientScope() { current_client = previous_; }
+
+FilePager::FilePager(const std::string& path, std::uint64_t file_bytes, std::size_t page_bytes, std::size_t budget_bytes,
+                     std::size_t clients)
+    : path_(path), file_bytes_(file_bytes), page_bytes_(page_bytes) {
+  if (!std::has_single_bit(page_bytes) || page_bytes < 4096) {
+    throw std::invalid_argument(fmt::format("page size {} bytes: real paging needs a power of two of 4096 or more", page_bytes));
+  }
+  page_shift_ = static_cast<unsigned>(std::countr_zero(page_bytes));
+  const std::size_t pages = (file_bytes + page_bytes - 1) / page_bytes;
+  if (pages >= kNone) throw std::invalid_argument(fmt::format("{}: {} pages of {} bytes is too many", path, pages, page_bytes));
+  reserved_bytes_ = pages * page_bytes;
+  slots_ = std::clamp<std::size_t>(budget_bytes / page_bytes, 1, std::max<std::size_t>(pages, 1));
+  // Each resident page is a mapping of its own, and a hole between two is another: the
+  // kernel's limit on mappings bounds the pool.
+  constexpr std::size_t kMaxSlots = 30000;
+  if (slots_ > kMaxSlots) {
+    throw std::invalid_argument(fmt::format(
+        "{}: a budget of {} pages of {} KiB is over the {} pages real paging can map; use larger pages "
+        "(memory.page_bytes)", path, slots_, page_bytes >> 10, kMaxSlots));
+  }
+  direct_fd_ = ::open(path.c_str(), O_RDONLY | O_DIRECT | O_CLOEXEC);
+  if (direct_fd_ < 0) throw std::runtime_error(fmt::format("{}: cannot open for direct reads: {}", path, std::strerror(errno)));
+  pool_fd_ = ::memfd_create("wavetrace-page-pool", MFD_CLOEXEC);
+  if (pool_fd_ < 0 || ::ftruncate(pool_fd_, off_t(slots_ * page_bytes)) != 0) {
+    const std::string reason = std::strerror(errno);
+    ::close(direct_fd_);
+    if (pool_fd_ >= 0) ::close(pool_fd_);
+    throw std::runtime_error(fmt::format("{}: cannot create a page pool of {} bytes: {}", path, slots_ * page_bytes, reason));
+  }
+  void* range = ::mmap(nullptr, reserved_bytes_, PROT_NONE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
+  staging_ = static_cast<std::byte*>(std::aligned_alloc(4096, page_bytes));
+  if (range == MAP_FAILED || staging_ == nullptr) {
+    ::close(direct_fd_);
+    ::close(pool_fd_);
+    if (range != MAP_FAILED) ::munmap(range, reserved_bytes_);
+    std::free(staging_);
+    throw std::runtime_error(fmt::format("{}: cannot reserve {} bytes of address space", path, reserved_bytes_));
+  }
+  base_ = static_cast<std::byte*>(range);
+  slot_of_.assign(pages, kNone);
+  previous_.assign(pages, kNone);
+  next_.assign(pages, kNone);
+  for (std::size_t s = slots_; s-- > 0;) free_slots_.push_back(static_cast<std::uint32_t>(s));
+  clients_.resize(clients + 1);
+
+  install_handler();
+  for (auto& slot : active_pagers) {
+    FilePager* expected = nullptr;
+    if (slot.compare_exchange_strong(expected, this)) return;
+  }
+  release();
+  throw std::runtime_error(fmt::format("{}: more than {} paged files open at once", path, kMaxPagers));
+}
+
+FilePager::~FilePager() { release(); }
+
+void FilePager::release() {
+  for (auto& slot : active_pagers) {
+    FilePager* expected = this;
+    slot.compare_exchange_strong(expected, nullptr);
+  }
+  if (base_ != nullptr) ::munmap(base_, reserved_bytes_);
+  base_ = nullptr;
+  if (direct_fd_ >= 0) ::close(direct_fd_);
+  if (pool_fd_ >= 0) ::close(pool_fd_);
+  direct_fd_ = pool_fd_ = -1;
+  std::free(staging_);
+  staging_ = nullptr;
+}
+
+std::size_t FilePager::client_index() const {
+  return current_client < clients_.size() - 1 ? current_client : clients_.size() - 1;
+}
+
+void FilePager::unlink_locked(std::uint32_t page) {
+  const std::uint32_t before = previous_[page], after = next_[page];
+  (before == kNone ? head_ : next_[before]) = after;
+  (after == kNone ? tail_ : previous_[after]) = before;
+  previous_[page] = next_[page] = kNone;
+}
+
+void FilePager::push_front_locked(std::uint32_t page) {
+  previous_[page] = kNone;
+  next_[page] = head_;
+  if (head_ != kNone) previous_[head_] = page;
+  head_ = page;
+  if (tail_ == kNone) tail_ = page;
+}
+
+void FilePager::evict_locked(std::uint32_t page) {
+  unlink_locked(page);
+  // From here a reader of this page faults and waits for the mutex; its slot is free again.
+  reserve_range(base_ + (std::size_t(page) << page_shift_), page_bytes_);
+  free_slots_.push_back(slot_of_[page]);
+  slot_of_[page] = kNone;
+}
+
+std::string FilePager::load_locked(std::uint32_t page) {
+  if (free_slots_.empty()) evict_locked(tail_);
+  const std::uint32_t slot = free_slots_.back();
+  const std::uint64_t offset = std::uint64_t(page) << page_shift_;
+  const std::size_t bytes = static_cast<std::size_t>(std::min<std::uint64_t>(page_bytes_, file_bytes_ - offset));
+  // O_DIRECT wants whole blocks: read the page's full size (a section file's size is a
+  // multiple of 4096, so the read ends at or before the file's end on a block boundary).
+  const std::size_t request = (bytes + 4095) / 4096 * 4096;
+  const auto start = std::chrono::steady_clock::now();
+  std::size_t done = 0;
+  while (done < bytes) {
+    const ssize_t got = ::pread(direct_fd_, staging_ + done, request - done, off_t(offset + done));
+    if (got < 0 && errno == EINTR) continue;
+    if (got <= 0) {
+      return fmt::format("{}: reading page {} (bytes {}..{}) failed: {}", path_, page, offset, offset + bytes,
+                         got < 0 ? std::strerror(errno) : "the file ends early");
+    }
+    done += std::size_t(got);
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (bytes < page_bytes_) std::memset(staging_ + bytes, 0, page_bytes_ - bytes);
+  // The page enters the pool through the kernel (pwrite), then appears at its address
+  // read-only in one mmap: no reader ever sees it half written.
+  for (std::size_t written = 0; written < page_bytes_;) {
+    const ssize_t put = ::pwrite(pool_fd_, staging_ + written, page_bytes_ - written, off_t(std::size_t(slot) * page_bytes_ + written));
+    if (put < 0 && errno == EINTR) continue;
+    if (put <= 0) return fmt::format("{}: the page pool refused page {}: {}", path_, page, std::strerror(errno));
+    written += std::size_t(put);
+  }
+  void* at = base_ + (std::size_t(page) << page_shift_);
+  // MAP_POPULATE maps every 4 KiB of the page now: one call instead of a minor fault each.
+  if (::mmap(at, page_bytes_, PROT_READ, MAP_SHARED | MAP_FIXED | MAP_POPULATE, pool_fd_,
+             off_t(std::size_t(slot) * page_bytes_)) == MAP_FAILED) {
+    return fmt::format("{}: mapping page {} failed: {}", path_, page, std::strerror(errno));
+  }
+  free_slots_.pop_back();
+  slot_of_[page] = slot;
+  push_front_locked(page);
+  DiskCounters& counters = clients_[client_index()];
+  ++counters.faults;
+  counters.bytes_read += bytes;
+  counters.read_seconds += seconds;
+  return {};
+}
+
+void FilePager::touch(const void* address) {
+  if (!contains(address)) return;
+  const auto page = static_cast<std::uint32_t>(std::size_t(static_cast<const std::byte*>(address) - base_) >> page_shift_);
+  std::lock_guard lock(mutex_);
+  if (slot_of_[page] != kNone) {
+    if (head_ != page) {
+      unlink_locked(page);
+      push_front_locked(page);
+    }
+    return;
+  }
+  if (std::string error = load_locked(page); !error.empty()) throw std::runtime_error(error);
+}
+
+bool FilePager::handle_fault(const void* address) noexcept {
+  if (!contains(address)) return false;
+  const auto page = static_cast<std::uint32_t>(std::size_t(static_cast<const std::byte*>(address) - base_) >> page_shift_);
+  std::lock_guard lock(mutex_);
+  if (slot_of_[page] != kNone) return true;  // another thread loaded it while this one waited
+  const std::string error = load_locked(page);
+  if (!error.empty()) {
+    // No exception can leave a signal handler: say what failed and stop.
+    const std::string line = "wavetrace: " + error + "\n";
+    [[maybe_unused]] const ssize_t ignored = ::write(STDERR_FILENO, line.data(), line.size());
+    std::_Exit(3);
+  }
+  return true;
+}
+
+void FilePager::reset() {
+  std::lock_guard lock(mutex_);
+  while (tail_ != kNone) evict_locked(tail_);
+  for (DiskCounters& counters : clients_) counters = {};
+}
+
+DiskCounters FilePager::counters(std::size_t client) const {
+  std::lock_guard lock(mutex_);
+  return clients_.at(client);
+}
+
+DiskCounters FilePager::total() const {
+  std::lock_guard lock(mutex_);
+  DiskCounters sum;
+  for (const DiskCounters& c : clients_) {
+    sum.faults += c.faults;
+    sum.bytes_read += c.bytes_read;
+    sum.read_seconds += c.read_seconds;
+  }
+  return sum;
+}
+
+}  // namespace wavetrace

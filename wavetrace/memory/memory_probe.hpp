@@ -1,0 +1,93 @@
+// Probes: what traversal code reports about each memory read (address, bytes). Traversal
+// is a template over the probe type; with NullProbe every report compiles to nothing, so
+// the uninstrumented trace pays no cost. RecordingProbe feeds the pager and/or a cache.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include <bit>
+#include <optional>
+
+#include "wavetrace/memory/cache_simulator.hpp"
+#include "wavetrace/memory/file_pager.hpp"
+#include "wavetrace/memory/pager.hpp"
+
+namespace wavetrace {
+
+struct NullProbe {
+  static constexpr bool kRecords = false;
+  void read(const void*, std::size_t) {}
+};
+
+// What a run observes: the shared page pool and one simulated cache per thread, each
+// optional. `client` numbers the stage whose reads are counted apart.
+struct MemoryObservers {
+  Pager* pager = nullptr;
+  CacheBank* caches = nullptr;
+  FilePager* file_pager = nullptr;  // real paging: reads keep its LRU order and load its pages
+  bool any() const { return pager != nullptr || caches != nullptr || file_pager != nullptr; }
+};
+
+// One thread's probe for one batch: lives on the stack of the stage call.
+class RecordingProbe {
+ public:
+  static constexpr bool kRecords = true;
+
+  RecordingProbe(const MemoryObservers& observers, std::size_t client, std::size_t thread)
+      : pager_(observers.pager),
+        cache_(observers.caches ? &observers.caches->for_thread(thread % observers.caches->threads()) : nullptr),
+        file_pager_(observers.file_pager),
+        client_(client) {
+    if (file_pager_ != nullptr) {
+      file_page_shift_ = static_cast<unsigned>(std::countr_zero(file_pager_->page_bytes()));
+      client_scope_.emplace(client);  // faults this thread takes count to this stage
+    }
+  }
+  RecordingProbe(const RecordingProbe&) = delete;
+  RecordingProbe& operator=(const RecordingProbe&) = delete;
+  ~RecordingProbe() {
+    if (pager_ != nullptr && repeated_page_reads_ > 0) pager_->add_accesses(repeated_page_reads_, client_);
+  }
+
+  void read(const void* address, std::size_t bytes) {
+    if (cache_ != nullptr) cache_->access(address, bytes, client_);
+    if (file_pager_ != nullptr) {
+      // The page is loaded now, before the read it announces; a page change is a touch.
+      const auto first = reinterpret_cast<std::uintptr_t>(address) >> file_page_shift_;
+      const auto last = (reinterpret_cast<std::uintptr_t>(address) + bytes - 1) >> file_page_shift_;
+      if (first != last_file_page_) file_pager_->touch(address);
+      if (last != first) file_pager_->touch(static_cast<const std::byte*>(address) + bytes - 1);
+      last_file_page_ = last;
+    }
+    if (pager_ == nullptr) return;
+    const std::uint32_t first = pager_->page_of(address);
+    const std::uint32_t last = pager_->page_of(static_cast<const std::byte*>(address) + bytes - 1);
+    read_page(first);
+    if (last != first) read_page(last);  // reads are far smaller than a page: two at most
+  }
+
+ private:
+  // A read of the page this thread read last needs no LRU update: it is still the most
+  // recent page (exactly so with one thread; with more, another thread may have moved it).
+  void read_page(std::uint32_t page) {
+    if (page == last_page_ && page != Pager::kNoPage) {
+      ++repeated_page_reads_;
+      return;
+    }
+    pager_->touch(page, client_);
+    last_page_ = page;
+  }
+
+  Pager* pager_;
+  CacheSimulator* cache_;
+  FilePager* file_pager_;
+  std::size_t client_;
+  unsigned file_page_shift_ = 0;
+  std::uintptr_t last_file_page_ = ~std::uintptr_t{0};
+  std::optional<FilePager::ClientScope> client_scope_;
+  std::uint32_t last_page_ = Pager::kNoPage;
+  std::uint64_t repeated_page_reads_ = 0;
+};
+
+}  // namespace wavetrace

@@ -1,0 +1,156 @@
+// Structure-of-arrays ray and hit batches: rays are entities, columns are components.
+// Every column is 64-byte aligned and holds `capacity` elements; `count` are in use.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+
+#include "wavetrace/memory/aligned_buffer.hpp"
+
+namespace wavetrace {
+
+inline constexpr std::uint32_t kInvalidPrimitive = std::numeric_limits<std::uint32_t>::max();
+inline constexpr std::size_t kDefaultBatchCapacity = 4096;
+
+enum class RayKind : std::uint8_t { camera = 0, bounce = 1, shadow = 2 };
+
+// Bits of RayBatch::flags.
+namespace ray_flags {
+inline constexpr std::uint8_t alive = 1u << 0;
+inline constexpr std::uint8_t missed_scene_box = 1u << 1;
+inline constexpr std::uint8_t continues = 1u << 2;  // shade kept the path going: spawn bounces it
+}  // namespace ray_flags
+
+// A half-open range of ray indices inside one batch: the unit accelerators answer.
+struct RayRange {
+  std::uint32_t begin = 0;
+  std::uint32_t end = 0;
+  std::uint32_t size() const { return end - begin; }
+};
+
+class RayBatch {
+ public:
+  explicit RayBatch(std::size_t capacity = kDefaultBatchCapacity);
+
+  std::size_t capacity() const { return capacity_; }
+  std::size_t count = 0;
+
+  // Always present.
+  float* origin_x;
+  float* origin_y;
+  float* origin_z;
+  float* direction_x;
+  float* direction_y;
+  float* direction_z;
+  float* tmin;
+  float* tmax;
+  std::uint32_t* pixel;
+  std::uint32_t* sample;
+  std::uint16_t* depth;
+  RayKind* kind;
+  float* throughput_r;
+  float* throughput_g;
+  float* throughput_b;
+  std::uint8_t* flags;
+
+  // Optional columns, allocated on first request and kept when a pooled batch is reused.
+  bool has_approx_hit() const { return approx_hit_x != nullptr; }
+  void enable_approx_hit();
+  bool has_sort_key() const { return sort_key != nullptr; }
+  void enable_sort_key();
+  float* approx_hit_x = nullptr;
+  float* approx_hit_y = nullptr;
+  float* approx_hit_z = nullptr;
+  std::uint64_t* sort_key = nullptr;
+
+  // Writes a ray's origin, direction and [tmin, tmax]; other columns are untouched.
+  void set_geometry(std::size_t i, const glm::vec3& origin, const glm::vec3& direction, float ray_tmin, float ray_tmax) {
+    origin_x[i] = origin.x;
+    origin_y[i] = origin.y;
+    origin_z[i] = origin.z;
+    direction_x[i] = direction.x;
+    direction_y[i] = direction.y;
+    direction_z[i] = direction.z;
+    tmin[i] = ray_tmin;
+    tmax[i] = ray_tmax;
+  }
+
+  // Copies every present column of ray `from` of `source` into slot `to` of this batch.
+  void copy_ray(std::size_t to, const RayBatch& source, std::size_t from);
+
+  RayRange all() const { return {0, static_cast<std::uint32_t>(count)}; }
+
+ private:
+  std::size_t capacity_;
+  AlignedBuffer storage_;
+  AlignedBuffer approx_hit_storage_;
+  AlignedBuffer sort_key_storage_;
+};
+
+// Closest-hit results per ray; any-hit queries set primitive to a valid id when occluded.
+// Closest-hit queries also write what shading needs, so that shade and spawn never read the
+// mesh: the hit point (from the barycentrics on the triangle as the accelerator stores it),
+// its geometric normal, and (written by the trace stage) its material.
+class HitBatch {
+ public:
+  explicit HitBatch(std::size_t capacity = kDefaultBatchCapacity);
+  std::size_t capacity() const { return capacity_; }
+
+  float* t;
+  std::uint32_t* primitive;  // kInvalidPrimitive on a miss
+  float* u;
+  float* v;
+  // Closest hits only: a + (b - a) u + (c - a) v and cross(b - a, c - a) of the hit
+  // triangle's corners a, b, c in the mesh's winding (unnormalized: its direction gives the
+  // front face); the material index of the triangle.
+  float* point_x;
+  float* point_y;
+  float* point_z;
+  float* normal_x;
+  float* normal_y;
+  float* normal_z;
+  std::uint32_t* material;
+
+  bool is_hit(std::size_t ray) const { return primitive[ray] != kInvalidPrimitive; }
+  void set_hit(std::size_t ray, float hit_t, std::uint32_t hit_primitive, float hit_u, float hit_v) {
+    t[ray] = hit_t;
+    primitive[ray] = hit_primitive;
+    u[ray] = hit_u;
+    v[ray] = hit_v;
+  }
+  void set_miss(std::size_t ray) { set_hit(ray, std::numeric_limits<float>::infinity(), kInvalidPrimitive, 0.0f, 0.0f); }
+  // The point and normal of a closest hit whose u, v are set, from the triangle's corners.
+  // Spawn once computed exactly this from the mesh; the same arithmetic keeps images equal.
+  void set_surface(std::size_t ray, const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
+    const glm::vec3 ab = b - a, ac = c - a;
+    const glm::vec3 point = a + ab * u[ray] + ac * v[ray];
+    point_x[ray] = point.x;
+    point_y[ray] = point.y;
+    point_z[ray] = point.z;
+    const glm::vec3 normal = glm::cross(ab, ac);
+    normal_x[ray] = normal.x;
+    normal_y[ray] = normal.y;
+    normal_z[ray] = normal.z;
+  }
+  glm::vec3 point(std::size_t ray) const { return {point_x[ray], point_y[ray], point_z[ray]}; }
+  glm::vec3 normal(std::size_t ray) const { return {normal_x[ray], normal_y[ray], normal_z[ray]}; }
+  // Copies every column of hit `from` of `source` into slot `to`.
+  void copy_hit(std::size_t to, const HitBatch& source, std::size_t from);
+
+ private:
+  std::size_t capacity_;
+  AlignedBuffer storage_;
+};
+
+// What travels between stages: a ray batch and the hits of its rays.
+struct Batch {
+  explicit Batch(std::size_t capacity = kDefaultBatchCapacity) : rays(capacity), hits(capacity) {}
+  RayBatch rays;
+  HitBatch hits;
+};
+
+}  // namespace wavetrace

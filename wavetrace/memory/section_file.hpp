@@ -1,0 +1,89 @@
+// A section file opened for use in place: its header, table and every section's checksum
+// checked first, then its sections handed out as spans, either of a read-only mapping
+// (the OS pages it) or of a FilePager's range (real paging under a budget). Every problem
+// is a SectionFileError naming the file and what is wrong with it.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "wavetrace/memory/file_pager.hpp"
+#include "wavetrace/memory/pager.hpp"
+#include "wavetrace/memory/section_file_format.hpp"
+
+namespace wavetrace {
+
+class SectionFileError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct PagingRequest {
+  std::size_t page_bytes = std::size_t{128} << 10;
+  MemoryBudget budget;  // a share of the file's bytes, or bytes
+  std::size_t clients = 1;
+};
+
+struct SectionInfo {
+  std::string name;
+  std::uint64_t offset = 0, size = 0;
+  std::uint32_t element_bytes = 1;
+};
+
+class SectionFile {
+ public:
+  // Without `paging` the file is mapped whole (read-only, shared); with it, its pages are
+  // read on demand into a pool of the budget's size. Throws SectionFileError.
+  static std::shared_ptr<const SectionFile> open(const std::string& path,
+                                                 const std::optional<PagingRequest>& paging = std::nullopt);
+  ~SectionFile();
+  SectionFile(const SectionFile&) = delete;
+  SectionFile& operator=(const SectionFile&) = delete;
+
+  const std::string& path() const { return path_; }
+  std::uint64_t file_bytes() const { return file_bytes_; }
+  const std::vector<SectionInfo>& sections() const { return sections_; }
+  bool has(std::string_view name) const;
+  double verify_seconds() const { return verify_seconds_; }
+  // The real pager, when the file is paged; null when it is mapped.
+  FilePager* pager() const { return pager_.get(); }
+
+  // A section's bytes in place; throws SectionFileError when it is missing.
+  std::span<const std::byte> bytes(std::string_view name) const;
+  // A section as an array of T: its element size must be sizeof(T).
+  template <typename T>
+  std::span<const T> array(std::string_view name) const {
+    const std::span<const std::byte> raw = checked(name, sizeof(T));
+    return {reinterpret_cast<const T*>(raw.data()), raw.size() / sizeof(T)};
+  }
+  // A section holding exactly one T, copied out.
+  template <typename T>
+  T value(std::string_view name) const {
+    const std::span<const T> items = array<T>(name);
+    if (items.size() != 1) fail(name, "holds " + std::to_string(items.size()) + " values where one was expected");
+    return items[0];
+  }
+  [[noreturn]] void fail(std::string_view section, const std::string& problem) const;
+
+ private:
+  SectionFile() = default;
+  std::span<const std::byte> checked(std::string_view name, std::size_t element_bytes) const;
+  const SectionInfo* find(std::string_view name) const;
+
+  std::string path_;
+  std::uint64_t file_bytes_ = 0;
+  std::vector<SectionInfo> sections_;  // sorted by name
+  const std::byte* base_ = nullptr;
+  void* mapping_ = nullptr;  // the whole-file mapping, when not paged
+  std::unique_ptr<FilePager> pager_;
+  double verify_seconds_ = 0.0;
+};
+
+}  // namespace wavetrace

@@ -1,0 +1,51 @@
+// Writes a section file (section_file_format.hpp) front to back: each section's bytes go
+// to the file as they are added, with their checksum, so a saved world never needs a
+// second copy of itself in memory; the table and header are written by finish().
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+#include <type_traits>
+#include <vector>
+
+#include "wavetrace/memory/section_file_format.hpp"
+
+namespace wavetrace {
+
+class SectionWriter {
+ public:
+  // Creates (or truncates) `path`; throws std::runtime_error naming it when it cannot.
+  explicit SectionWriter(std::string path);
+  ~SectionWriter();
+  SectionWriter(const SectionWriter&) = delete;
+  SectionWriter& operator=(const SectionWriter&) = delete;
+
+  // Adds a section; names are unique and at most 63 bytes (std::invalid_argument otherwise).
+  void add(std::string_view name, std::span<const std::byte> bytes, std::uint32_t element_bytes = 1);
+  template <typename T>
+  void add_array(std::string_view name, std::span<const T> items) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    add(name, std::as_bytes(items), sizeof(T));
+  }
+  template <typename T>
+  void add_value(std::string_view name, const T& value) {
+    add_array(name, std::span<const T>(&value, 1));
+  }
+
+  // Writes the table and header and closes the file; until then the file is not valid
+  // (its header is zero), so an interrupted save is refused when read.
+  void finish();
+
+ private:
+  void write_at(std::uint64_t offset, const void* data, std::size_t bytes);
+
+  std::string path_;
+  int fd_ = -1;
+  std::uint64_t position_ = 0;
+  std::vector<section_file::TableEntry> table_;
+};
+
+}  // namespace wavetrace

@@ -1,0 +1,64 @@
+// Gradient noise with hashed lattice gradients and a quintic fade.
+#include "wavetrace/scene/noise.hpp"
+
+#include <cmath>
+
+#include "wavetrace/kernels/random.hpp"
+
+namespace wavetrace {
+namespace {
+
+float fade(float t) { return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f); }
+
+float lattice_gradient_dot(int x, int y, int z, std::uint32_t seed, const glm::vec3& offset) {
+  const std::uint64_t key = (std::uint64_t(std::uint32_t(x)) * 0x9E3779B1u) ^
+                            (std::uint64_t(std::uint32_t(y)) << 21) ^ (std::uint64_t(std::uint32_t(z)) << 42) ^
+                            (std::uint64_t(seed) << 13);
+  // One of the 12 cube-edge directions, as in improved Perlin noise.
+  switch (mix64(key) % 12) {
+    case 0: return offset.x + offset.y;
+    case 1: return -offset.x + offset.y;
+    case 2: return offset.x - offset.y;
+    case 3: return -offset.x - offset.y;
+    case 4: return offset.x + offset.z;
+    case 5: return -offset.x + offset.z;
+    case 6: return offset.x - offset.z;
+    case 7: return -offset.x - offset.z;
+    case 8: return offset.y + offset.z;
+    case 9: return -offset.y + offset.z;
+    case 10: return offset.y - offset.z;
+    default: return -offset.y - offset.z;
+  }
+}
+
+float lerp(float a, float b, float t) { return a + (b - a) * t; }
+
+}  // namespace
+
+float gradient_noise(const glm::vec3& point, std::uint32_t seed) {
+  const glm::vec3 cell(std::floor(point.x), std::floor(point.y), std::floor(point.z));
+  const int x = static_cast<int>(cell.x), y = static_cast<int>(cell.y), z = static_cast<int>(cell.z);
+  const glm::vec3 f = point - cell;
+  const float u = fade(f.x), v = fade(f.y), w = fade(f.z);
+  float corners[8];
+  for (int c = 0; c < 8; ++c) {
+    const int dx = c & 1, dy = (c >> 1) & 1, dz = (c >> 2) & 1;
+    corners[c] = lattice_gradient_dot(x + dx, y + dy, z + dz, seed,
+                                      f - glm::vec3(float(dx), float(dy), float(dz)));
+  }
+  const float x00 = lerp(corners[0], corners[1], u), x10 = lerp(corners[2], corners[3], u);
+  const float x01 = lerp(corners[4], corners[5], u), x11 = lerp(corners[6], corners[7], u);
+  return lerp(lerp(x00, x10, v), lerp(x01, x11, v), w);
+}
+
+float fractal_noise(const glm::vec3& point, int octaves, std::uint32_t seed) {
+  float sum = 0.0f, amplitude = 0.5f, frequency = 1.0f;
+  for (int octave = 0; octave < octaves; ++octave) {
+    sum += amplitude * gradient_noise(point * frequency, seed + 101u * octave);
+    amplitude *= 0.5f;
+    frequency *= 2.0f;
+  }
+  return sum;
+}
+
+}  // namespace wavetrace

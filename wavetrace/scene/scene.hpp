@@ -1,0 +1,67 @@
+// A renderable scene: one flattened triangle mesh, its materials, the light the sky
+// gives, and the camera its author suggests.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "wavetrace/scene/camera.hpp"
+#include "wavetrace/scene/material_runs.hpp"
+#include "wavetrace/scene/procedural_scene.hpp"
+#include "wavetrace/scene/triangle_mesh.hpp"
+
+namespace wavetrace {
+
+// Lambertian reflection plus optional emission (emitting from the front face only).
+struct Material {
+  glm::vec3 albedo{0.7f};
+  glm::vec3 emission{0.0f};
+  bool emissive() const { return emission.x > 0.0f || emission.y > 0.0f || emission.z > 0.0f; }
+};
+
+struct Scene {
+  std::string name;
+  // The flattened mesh; empty when the scene is streamed (`stream` makes its triangles a
+  // range at a time) or was released once an accelerator that keeps its own geometry was built.
+  TriangleMesh mesh;
+  std::shared_ptr<const TriangleSource> stream;  // set when streamed
+  // What stays known without the mesh: counts, bounds, each triangle's material.
+  std::size_t triangle_count = 0;
+  std::size_t vertex_count = 0;
+  Bounds3 bounds;
+  MaterialRuns material_runs;
+  std::vector<Material> materials;
+  glm::vec3 background{0.0f};    // radiance of every ray that leaves the scene
+  std::optional<Camera> camera;  // the scene author's view, if any
+  // A box whose every inside point is enclosed by a closed shell of the scene's triangles
+  // (builtin:room's walls): rays from it can never escape, whatever else the scene holds.
+  std::optional<Bounds3> enclosure;
+  MeshCleanup cleanup;
+  std::size_t subdivision_levels = 0;
+  std::size_t non_manifold_faces_dropped = 0;
+
+  bool streamed() const { return stream != nullptr; }
+  // Frees the mesh (and its per-triangle materials); counts, bounds and runs stay.
+  void release_mesh();
+  // Sets counts, bounds and material runs from the mesh.
+  void describe_mesh();
+};
+
+struct SceneRequest {
+  std::string source = "builtin:default";  // a mesh file, a scene file (.toml) or builtin:NAME[:TRIANGLES]
+  int subdivide = 0;                       // Loop subdivision levels applied after loading
+  // A builtin is left as its generators, a binary PLY file as its vertices and a reader of
+  // its faces (Scene::stream), rather than assembled into one mesh, for a chunked build that
+  // reads it a range at a time. Ignored for other files and when subdividing.
+  bool streamed = false;
+};
+
+// Loads a mesh or scene file or generates a builtin, subdivides, validates; throws
+// SceneError. Subdivision moves the walls of an enclosure, so it drops the enclosure.
+Scene load_scene(const SceneRequest& request);
+
+}  // namespace wavetrace

@@ -1,0 +1,45 @@
+// A scene's triangles as a source a chunked build reads a range at a time: an in-memory mesh,
+// or a procedural scene that generates each range on demand and never holds the whole.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "wavetrace/scene/material_runs.hpp"
+#include "wavetrace/scene/triangle_mesh.hpp"
+
+namespace wavetrace {
+
+class TriangleSource {
+ public:
+  virtual ~TriangleSource() = default;
+  virtual std::size_t triangle_count() const = 0;
+  virtual Bounds3 bounds() const = 0;
+  // Where each object's triangles begin, ascending from 0: chunks are cut there too, so that
+  // no chunk's box spans two objects.
+  virtual std::vector<std::size_t> object_starts() const = 0;
+  // Triangles [first, first + count) as a mesh of their own: vertices renumbered from 0,
+  // triangle i of the result is triangle first + i of the source, material_of_triangle empty.
+  virtual TriangleMesh extract(std::size_t first, std::size_t count) const = 0;
+  // Each triangle's material (scene indices); a source without materials has only material 0.
+  virtual MaterialRuns material_runs() const { return MaterialRuns::from_triangles({}, triangle_count()); }
+  // Every triangle whose material is `wanted` (by index), with material_of_triangle: what
+  // a light sampler needs without the rest of the scene.
+  virtual TriangleMesh triangles_with_materials(const std::vector<bool>& wanted) const;
+};
+
+// The ranges of a mesh that is already in memory (read in place; it must outlive the source).
+class MeshTriangleSource final : public TriangleSource {
+ public:
+  explicit MeshTriangleSource(const TriangleMesh& mesh) : mesh_(mesh) {}
+  std::size_t triangle_count() const override { return mesh_.triangle_count(); }
+  Bounds3 bounds() const override { return mesh_.bounds(); }
+  std::vector<std::size_t> object_starts() const override { return {0}; }
+  TriangleMesh extract(std::size_t first, std::size_t count) const override;
+
+ private:
+  const TriangleMesh& mesh_;
+};
+
+}  // namespace wavetrace

@@ -1,0 +1,64 @@
+// generate: camera rays for every (pixel, sample) of the image, in scanline or Z-curve
+// pixel order, a batch at a time.
+#pragma once
+
+#include <algorithm>
+#include <atomic>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "wavetrace/memory/ray_batch.hpp"
+#include "wavetrace/scene/camera.hpp"
+
+namespace wavetrace {
+
+enum class PixelOrder { scanline, zcurve };
+PixelOrder parse_pixel_order(const std::string& text);
+
+struct ImageSpec {
+  std::uint32_t width = 640;
+  std::uint32_t height = 480;
+  std::uint32_t samples_per_pixel = 8;
+  // Samples are numbered from seed * samples_per_pixel: each path's draws hang on its
+  // (pixel, sample), so another seed draws independent samples of the same image.
+  std::uint32_t seed = 0;
+  std::uint32_t pixel_count() const { return width * height; }
+};
+
+class GenerateStage {
+ public:
+  GenerateStage(const Camera& camera, const ImageSpec& image, PixelOrder order);
+
+  std::string name() const { return "generate"; }
+  std::uint64_t total_rays() const { return total_; }
+  std::uint64_t generated() const { return std::min(next_.load(std::memory_order_relaxed), total_); }
+  bool exhausted() const { return generated() >= total_; }
+
+  // Claims the next camera rays, up to `capacity`: their first index and count (0 when
+  // every ray is claimed). Thread-safe, so generate runs on any number of threads at once.
+  struct Claim {
+    std::uint64_t first = 0;
+    std::size_t count = 0;
+  };
+  Claim claim(std::size_t capacity);
+  // Writes the claimed rays into `rays` and sets its count: a pure function of the indices.
+  void fill_range(RayBatch& rays, const Claim& claimed) const;
+  // Both: fills `rays` with the next camera rays (up to its capacity); returns how many.
+  std::size_t fill(RayBatch& rays);
+
+  // The camera ray of (pixel, sample) into slot `slot`: a pure function of the two, so
+  // the megakernel, which walks pixels its own way, makes the very rays fill makes.
+  void write_camera_ray(RayBatch& rays, std::size_t slot, std::uint32_t pixel, std::uint32_t sample) const;
+  const ImageSpec& image() const { return image_; }
+
+ private:
+  CameraFrame frame_;
+  ImageSpec image_;
+  float inverse_width_, inverse_height_;
+  std::vector<std::uint32_t> pixel_order_;  // empty: scanline
+  std::uint64_t total_;
+  std::atomic<std::uint64_t> next_{0};
+};
+
+}  // namespace wavetrace

@@ -1,0 +1,51 @@
+// The [memory] section made real: a pager over the world's spans and a bank of simulated
+// caches, observing the stages that query accelerators (trace; approx_hit with the proxy),
+// each counted apart.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "wavetrace/memory/cache_simulator.hpp"
+#include "wavetrace/memory/memory_probe.hpp"
+#include "wavetrace/memory/pager.hpp"
+#include "wavetrace/stages/config.hpp"
+#include "wavetrace/stages/stage_counters.hpp"
+
+namespace wavetrace {
+
+struct MemoryPlan {
+  std::optional<MemoryBudget> budget;  // no pager without one
+  bool file_backing = false;           // memory.backing = file: a world file really paged under the budget
+  std::size_t page_bytes = std::size_t{4} << 20;
+  IoModel io;
+  std::optional<CacheGeometry> cache;  // no cache simulation without one
+  bool enabled() const { return budget.has_value() || cache.has_value(); }
+};
+
+// The stages whose reads are observed, each a pager and cache client of its own.
+enum class ObservedStage : std::size_t { trace = 0, approx_hit = 1 };
+inline constexpr std::size_t kObservedStageCount = 2;
+std::string to_string(ObservedStage stage);
+
+class MemoryObservation {
+ public:
+  // `file_pager`: the real pager of a paged world file, emptied here so each render starts
+  // cold, or null.
+  MemoryObservation(const MemoryPlan& plan, std::vector<std::span<const std::byte>> world, int threads,
+                    FilePager* file_pager = nullptr);
+  const MemoryObservers& observers() const { return observers_; }
+  // Fills the pager and cache objects of the observed stages in `stages`.
+  void report(std::vector<StageStats>& stages) const;
+
+ private:
+  std::unique_ptr<Pager> pager_;
+  std::unique_ptr<CacheBank> caches_;
+  FilePager* file_pager_ = nullptr;
+  MemoryObservers observers_;
+};
+
+}  // namespace wavetrace

@@ -1,0 +1,27 @@
+// spawn: from each surviving hit, a shadow ray toward a light sample (carrying the light
+// it would deliver) and, if the path continues, a cosine-weighted bounce ray; each kind
+// goes out in its own batch.
+#pragma once
+
+#include "wavetrace/stages/path_rules.hpp"
+#include "wavetrace/stages/stage.hpp"
+#include "wavetrace/stages/world.hpp"
+
+namespace wavetrace {
+
+class SpawnStage final : public Stage {
+ public:
+  SpawnStage(const World& world, const PathRules& rules) : world_(world), rules_(rules) {}
+  std::string name() const override { return "spawn"; }
+  void process(Batch* batch, StageOutput& out) const override;
+
+  // Appends the rays spawned from the live rays of `range` of `batch` to `bounces` and
+  // (when the scene has lights) `shadows`; the megakernel calls it for one ray.
+  void spawn(const Batch& batch, RayRange range, RayBatch& bounces, RayBatch* shadows) const;
+
+ private:
+  const World& world_;
+  PathRules rules_;
+};
+
+}  // namespace wavetrace

@@ -1,0 +1,68 @@
+// Splits a batch into runs of one ray kind and hands each run to the accelerator: shadow
+// rays to any hit, camera rays to the coherent (packet) query, bounce rays to closest hit.
+#include "wavetrace/stages/trace.hpp"
+
+#include <chrono>
+#include <optional>
+
+#include <tbb/task_arena.h>
+
+#include "wavetrace/stages/memory_observation.hpp"
+
+namespace wavetrace {
+
+void TraceStage::process(Batch* batch, StageOutput& out) const {
+  const RayBatch& rays = batch->rays;
+  std::optional<RecordingProbe> probe;
+  if (instruments_.observers != nullptr) {
+    probe.emplace(*instruments_.observers, std::size_t(ObservedStage::trace),
+                  std::size_t(tbb::this_task_arena::current_thread_index()));
+  }
+  std::uint32_t begin = 0;
+  const auto count = static_cast<std::uint32_t>(rays.count);
+  while (begin < count) {
+    const RayKind kind = rays.kind[begin];
+    std::uint32_t end = begin + 1;
+    while (end < count && rays.kind[end] == kind) ++end;
+    if (instruments_.times == nullptr) {
+      trace_run(*batch, {begin, end}, probe ? &*probe : nullptr);
+    } else {
+      const auto start = std::chrono::steady_clock::now();
+      trace_run(*batch, {begin, end}, probe ? &*probe : nullptr);
+      const auto nanoseconds = static_cast<std::uint64_t>(
+          std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count());
+      const bool shadow = kind == RayKind::shadow;
+      (shadow ? instruments_.times->any_rays : instruments_.times->closest_rays).fetch_add(end - begin);
+      (shadow ? instruments_.times->any_nanoseconds : instruments_.times->closest_nanoseconds).fetch_add(nanoseconds);
+    }
+    begin = end;
+  }
+  out.emit(batch);
+}
+
+void TraceStage::trace_run(Batch& batch, RayRange range, RecordingProbe* probe) const {
+  const RayBatch& rays = batch.rays;
+  HitBatch& hits = batch.hits;
+  const RayKind kind = rays.kind[range.begin];
+  if (kind == RayKind::shadow) {
+    if (probe != nullptr) {
+      accelerator_.intersect_any_probed(rays, hits, range, *probe);
+    } else {
+      accelerator_.intersect_any(rays, hits, range);
+    }
+    return;
+  }
+  if (probe != nullptr) {
+    accelerator_.intersect_closest_probed(rays, hits, range, *probe);
+  } else if (kind == RayKind::camera) {
+    accelerator_.intersect_coherent(rays, hits, range);  // packets where the accelerator has them
+  } else {
+    accelerator_.intersect_closest(rays, hits, range);
+  }
+  for (std::uint32_t i = range.begin; i < range.end; ++i) {
+    if (hits.is_hit(i)) hits.material[i] = materials_.material(hits.primitive[i]);
+  }
+  if (instruments_.hit_rates != nullptr) instruments_.hit_rates->record(rays, hits, range);
+}
+
+}  // namespace wavetrace

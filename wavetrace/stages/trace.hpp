@@ -1,0 +1,58 @@
+// trace: closest hit for camera and bounce rays, any hit for shadow rays, on the main accelerator.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+
+#include "wavetrace/accel/accelerator.hpp"
+#include "wavetrace/scene/material_runs.hpp"
+#include "wavetrace/stages/hit_rates.hpp"
+#include "wavetrace/stages/stage.hpp"
+
+namespace wavetrace {
+
+// Rays and busy nanoseconds by query kind: closest hit (camera and bounce rays) apart from
+// any hit (shadow rays), so reordering's effect on each shows.
+struct TraceTimes {
+  std::atomic<std::uint64_t> closest_rays{0}, closest_nanoseconds{0};
+  std::atomic<std::uint64_t> any_rays{0}, any_nanoseconds{0};
+  double closest_mrays_per_s() const { return rate(closest_rays, closest_nanoseconds); }
+  double any_mrays_per_s() const { return rate(any_rays, any_nanoseconds); }
+
+ private:
+  static double rate(const std::atomic<std::uint64_t>& rays, const std::atomic<std::uint64_t>& nanoseconds) {
+    return nanoseconds.load() ? double(rays.load()) / double(nanoseconds.load()) * 1e3 : 0.0;
+  }
+};
+
+// What a trace stage may count besides its own rays and seconds; each optional.
+struct TraceInstruments {
+  HitRateCounters* hit_rates = nullptr;        // hits per depth of closest-hit rays
+  const MemoryObservers* observers = nullptr;  // see every traversal read, if the accelerator can be probed
+  TraceTimes* times = nullptr;                 // seconds by query kind
+};
+
+// Besides the accelerator's hits (point and normal included), writes each closest hit's
+// material from `materials`, so that shade and spawn never read the mesh.
+class TraceStage final : public Stage {
+ public:
+  TraceStage(const Accelerator& accelerator, const MaterialRuns& materials, const TraceInstruments& instruments = {})
+      : accelerator_(accelerator), materials_(materials), instruments_(instruments) {
+    if (instruments_.observers != nullptr && !(instruments_.observers->any() && accelerator.probed())) {
+      instruments_.observers = nullptr;
+    }
+  }
+  std::string name() const override { return "trace"; }
+  void process(Batch* batch, StageOutput& out) const override;
+
+  // Traces `range` of `batch`, whose rays are all of one kind; the megakernel calls it
+  // for one ray at a time. `probe` sees every read (null: unobserved).
+  void trace_run(Batch& batch, RayRange range, RecordingProbe* probe = nullptr) const;
+
+ private:
+  const Accelerator& accelerator_;
+  const MaterialRuns& materials_;
+  TraceInstruments instruments_;
+};
+
+}  // namespace wavetrace
