@@ -26,7 +26,7 @@ struct ReportArguments {
   std::vector<std::string> from;
   bool quick = false;
   std::string python = "/usr/bin/python3";  // Debian's, which has matplotlib
-  std::string script = std::string(WAVETRACE_SOURCE_DIR) + "/wavetrace/bench/report.py";
+  std::string script = std::string(WAVETRACE_SOURCE_DIR) + "/bench/report.py";
   std::string mesh = std::string(WAVETRACE_SOURCE_DIR) + "/data/bunny00.off";
 };
 
@@ -113,7 +113,7 @@ void add_bench_report_command(CLI::App& bench, int& exit_code) {
       ->expected(1, 1 << 20);
   report->add_flag("--quick", args->quick, "small scenes and counts: every chart and table, in a minute or two");
   report->add_option("--python", args->python, "the Python interpreter with matplotlib (default Debian's)");
-  report->add_option("--script", args->script, "the chart and report writer (wavetrace/bench/report.py)");
+  report->add_option("--script", args->script, "the chart and report writer (bench/report.py)");
   report->add_option("--mesh", args->mesh, "the real mesh of the matrix (subdivided twice unless --quick)");
   report->callback([args, &exit_code] { exit_code = run_report(*args); });
 }

@@ -20,7 +20,7 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/wavetrace/ DESTINATION ${CMAKE_INSTALL_I
         FILES_MATCHING PATTERN "*.hpp")
 install(FILES ${PROJECT_BINARY_DIR}/include/wavetrace/build_config.hpp DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/wavetrace)
 # The report's chart writer, which `bench report` runs with Debian's python.
-install(FILES ${PROJECT_SOURCE_DIR}/wavetrace/bench/report.py ${PROJECT_SOURCE_DIR}/wavetrace/bench/plot_accel.py
+install(FILES ${PROJECT_SOURCE_DIR}/bench/report.py ${PROJECT_SOURCE_DIR}/bench/plot_accel.py
         DESTINATION ${CMAKE_INSTALL_DATADIR}/wavetrace)
 if(WAVETRACE_BUILD_APP)
   install(TARGETS wavetrace RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})

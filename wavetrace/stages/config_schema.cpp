@@ -1,5 +1,6 @@
 // The schema: every configuration key, its type, default and valid range. Adding a
-// feature's option means adding one line here.
+// feature's option means adding one line here and one row in plan_keys.cpp's table, which
+// says where the value goes (PlanKeys.EverySchemaKeyHasOneRowAndEveryRowAKey checks both).
 #include "wavetrace/stages/config.hpp"
 #include "wavetrace/stages/pipeline.hpp"
 
