@@ -74,15 +74,16 @@ TEST(AccelChoice, ASoupNeverGetsRayStrips) {
   const SceneTraits sphere = traits_of("builtin:sphere:100k");
   EXPECT_LT(soup.triangles_per_vertex, kSoupTrianglesPerVertex);
   EXPECT_GT(sphere.triangles_per_vertex, 5.0);
-  for (const std::size_t budget : {world_budget(6), world_budget(8), world_budget(10), world_budget(12), world_budget(100)}) {
+  for (const std::size_t budget : {world_budget(6), world_budget(8), world_budget(10), world_budget(14), world_budget(100)}) {
     const AccelChoice on_sphere = choose(sphere, budget, 0.0);
     EXPECT_FALSE(candidate(on_sphere, "raystrips").failure_case);
     try {
       const AccelChoice on_soup = choose(soup, budget, 0.0);
       EXPECT_NE(on_soup.options.type, "raystrips") << budget;
       EXPECT_TRUE(candidate(on_soup, "raystrips").failure_case) << budget;
-      // Where it fits (9.4 MB estimated), the grid is the exact method left.
-      if (budget == world_budget(10)) {
+      // Where it fits (about 12 MB estimated with the soup's own vertices), the grid is the
+      // exact method left.
+      if (budget == world_budget(14)) {
         EXPECT_EQ(on_soup.options.type, "mlgrid") << budget;
       }
     } catch (const ConfigError& error) {
@@ -99,8 +100,8 @@ TEST(AccelChoice, AStadiumNeverGetsAHashedGrid) {
   // Even where the grid is the only exact method left (strips ruled out as on a soup).
   SceneTraits crowded_soup = stadium;
   crowded_soup.triangles_per_vertex = soup.triangles_per_vertex;
-  EXPECT_EQ(choose(soup, world_budget(10), 0.0).options.type, "mlgrid");
-  EXPECT_THROW(choose(crowded_soup, world_budget(10), 0.0), ConfigError);
+  EXPECT_EQ(choose(soup, world_budget(14), 0.0).options.type, "mlgrid");
+  EXPECT_THROW(choose(crowded_soup, world_budget(10), 0.0), ConfigError);  // where only the grid fits
   for (const std::size_t budget : {world_budget(6), world_budget(10), world_budget(100)}) {
     const AccelChoice choice = choose(stadium, budget, 0.0);
     EXPECT_NE(choice.options.type, "mlgrid");

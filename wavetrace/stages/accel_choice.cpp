@@ -4,6 +4,8 @@
 #include "wavetrace/stages/accel_choice.hpp"
 
 #include <algorithm>
+#include <atomic>
+#include <functional>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -84,6 +86,13 @@ constexpr CandidateType kCandidates[] = {
     {"mlgrid", 0.24},     // 0.15 - 0.28 (room's empty space is its slowest)
 };
 
+// The hashed grid's cells and lists, its mesh apart: a triangle index per cell its box
+// overlaps and the hash's slots. Measured (mlgrid, bytes a triangle against entries a
+// triangle): sphere:1M 25.7 at 4.5, bunny00 subdivided twice 22.6 at 3.8, room:1M 47.6 at
+// 9.4, room:8M 117.6 at 27.4 (its walls span many cells); about 8 + 4 x entries, with a margin.
+constexpr double kGridBytesPerTriangle = 10.0;
+constexpr double kGridBytesPerEntry = 4.4;
+
 // How much slower a structure traces built in chunks whose boxes overlap so (SceneTraits::
 // chunk_overlap), fitted to `bench report`'s chunked 8-wide hmq, raystrips and bvh against
 // whole ones (chunks of an eighth): room 1.22x at overlap 2.96, sphere 1.5x at 3.44, the
@@ -155,6 +164,7 @@ SceneTraits measure_scene_traits(const TriangleSource& source, std::size_t chunk
 
   std::vector<std::uint64_t> cells;
   cells.reserve(traits.triangles / stride + 1);
+  std::atomic<std::uint64_t> cells_spanned{0};  // by the sampled triangles' boxes
   const std::vector<ChunkRange> chunks =
       chunk_triangles > 0 && traits.triangles > chunk_triangles
           ? plan_chunks(source.object_starts(), traits.triangles, chunk_triangles)
@@ -173,18 +183,27 @@ SceneTraits measure_scene_traits(const TriangleSource& source, std::size_t chunk
     const std::size_t samples = first_sample < count ? (count - first_sample + stride - 1) / stride : 0;
     const std::size_t filled = cells.size();
     cells.resize(filled + samples);
+    const auto cell_index = [&](double coordinate, int axis) {
+      const double index = std::floor((coordinate - double(traits.bounds.lower[axis])) / cell_size[axis]);
+      return static_cast<std::uint64_t>(std::clamp(index, 0.0, double(grid.cells[axis] - 1)));
+    };
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, samples), [&](const tbb::blocked_range<std::size_t>& range) {
+      std::uint64_t overlapped = 0;
       for (std::size_t s = range.begin(); s != range.end(); ++s) {
         const glm::uvec3 t = chunk.triangles[first_sample + s * stride];
-        const glm::dvec3 centroid =
-            (glm::dvec3(chunk.positions[t.x]) + glm::dvec3(chunk.positions[t.y]) + glm::dvec3(chunk.positions[t.z])) / 3.0;
+        const glm::dvec3 a(chunk.positions[t.x]), b(chunk.positions[t.y]), c(chunk.positions[t.z]);
+        const glm::dvec3 centroid = (a + b + c) / 3.0;
+        const glm::dvec3 lower = glm::min(a, glm::min(b, c)), upper = glm::max(a, glm::max(b, c));
         glm::u64vec3 cell;
+        std::uint64_t spanned = 1;
         for (int axis = 0; axis < 3; ++axis) {
-          const double index = std::floor((centroid[axis] - double(traits.bounds.lower[axis])) / cell_size[axis]);
-          cell[axis] = static_cast<std::uint64_t>(std::clamp(index, 0.0, double(grid.cells[axis] - 1)));
+          cell[axis] = cell_index(centroid[axis], axis);
+          spanned *= cell_index(upper[axis], axis) - cell_index(lower[axis], axis) + 1;
         }
         cells[filled + s] = (cell.z * grid.cells.y + cell.y) * grid.cells.x + cell.x;
+        overlapped += spanned;
       }
+      cells_spanned.fetch_add(overlapped, std::memory_order_relaxed);
     });
     if (!chunks.empty()) {
       for (std::size_t i = (centroid_stride - first % centroid_stride) % centroid_stride; i < count; i += centroid_stride) {
@@ -225,6 +244,8 @@ SceneTraits measure_scene_traits(const TriangleSource& source, std::size_t chunk
         [](double x, double y) { return std::min(x, y); });
   }
   traits.triangles_per_vertex = traits.vertices ? 3.0 * double(traits.triangles) / double(traits.vertices) : 0.0;
+  traits.mesh_bytes_per_triangle = (12.0 * double(traits.vertices) + 16.0 * double(traits.triangles)) / double(traits.triangles);
+  traits.grid_entries_per_triangle = cells.empty() ? 0.0 : double(cells_spanned.load()) / double(cells.size());
 
   // Sum of n^2 over sum of n per occupied cell; with a sample of share f, n^2 - (1 - f) n
   // is f^2 times an unbiased estimate of the full cell's N^2, and n is f times N.
@@ -242,6 +263,8 @@ SceneTraits measure_scene_traits(const TriangleSource& source, std::size_t chunk
   traits.triangles_per_grid_cell = total > 0.0 ? std::max(1.0, squares / (share * total)) : 0.0;
   if (!chunks.empty()) {
     traits.chunks = chunks.size();
+    for (const ChunkRange& chunk : chunks) traits.chunk_sizes.push_back(chunk.count);
+    std::sort(traits.chunk_sizes.begin(), traits.chunk_sizes.end(), std::greater<>());
     std::size_t containing = 0;
     for (const glm::vec3& point : centroids) {
       for (const Bounds3& box : chunk_boxes) {
@@ -277,15 +300,23 @@ AccelChoice choose_accelerator(const SceneTraits& traits, std::size_t budget_byt
     // Peak while building: the structure, the whole mesh unless the type keeps its own
     // geometry and is built from a streamed source (counted apart even where the structure's
     // bytes include the mesh it reads in place: measured peaks need it), the temporaries of
-    // the builds at once (a chunk per worker) and the process. On builtin:room:8M (render,
-    // VmHWM), estimate against peak: robust Embree 1.19 / 1.02 GB, bvh:width=8 1.57 / 1.54,
-    // hmq:width=8 0.90 / 0.64, raystrips:width=8 0.98 / 0.67; `bench report` measures them
-    // on its scenes.
-    const double mesh = holds_own_geometry(type) && streamed_source ? 0.0 : kWholeMeshBytesPerTriangle;
-    const double built_at_once =
-        candidate.chunked ? std::min(triangles, double(options.chunk_triangles) * double(allowance.builds_at_once))
-                          : triangles;
-    candidate.estimated_bytes = triangles * (estimated_bytes_per_triangle(options) + mesh) +
+    // the builds at once (the largest chunks, one per worker) and the process. On
+    // builtin:room:8M (render, VmHWM), estimate against peak: robust Embree 1.19 / 1.02 GB,
+    // bvh:width=8 1.57 / 1.54, hmq:width=8 0.90 / 0.64, raystrips:width=8 0.98 / 0.67;
+    // `bench report` measures them on its scenes.
+    const double mesh = holds_own_geometry(type) && streamed_source ? 0.0 : traits.mesh_bytes_per_triangle;
+    double built_at_once = triangles;
+    if (candidate.chunked) {
+      built_at_once = 0.0;
+      for (std::size_t c = 0; c < std::min(traits.chunk_sizes.size(), allowance.builds_at_once); ++c) {
+        built_at_once += double(traits.chunk_sizes[c]);
+      }
+      if (traits.chunk_sizes.empty()) built_at_once = std::min(triangles, double(options.chunk_triangles));
+    }
+    const double structure =
+        type == "mlgrid" ? kGridBytesPerTriangle + kGridBytesPerEntry * traits.grid_entries_per_triangle
+                         : estimated_bytes_per_triangle(options);
+    candidate.estimated_bytes = triangles * (structure + mesh) +
                                 built_at_once * estimated_build_bytes_per_triangle(type) +
                                 double(allowance.process_bytes);
     candidate.fits = candidate.estimated_bytes <= double(budget_bytes);
@@ -375,7 +406,7 @@ nlohmann::json to_json(const AccelChoice& choice) {
           {"budget_bytes", choice.budget_bytes},
           {"process_bytes", choice.allowance.process_bytes},
           {"builds_at_once", choice.allowance.builds_at_once},
-          {"mesh_bytes_per_triangle", kWholeMeshBytesPerTriangle},
+          {"mesh_bytes_per_triangle", choice.traits.mesh_bytes_per_triangle},
           {"max_error", choice.max_error},
           {"pixel_distance", choice.pixel_distance ? nlohmann::json(*choice.pixel_distance) : nlohmann::json(nullptr)},
           {"traits",
@@ -383,6 +414,8 @@ nlohmann::json to_json(const AccelChoice& choice) {
             {"vertices", t.vertices},
             {"triangles_per_vertex", t.triangles_per_vertex},
             {"triangles_per_grid_cell", t.triangles_per_grid_cell},
+            {"grid_entries_per_triangle", t.grid_entries_per_triangle},
+            {"mesh_bytes_per_triangle", t.mesh_bytes_per_triangle},
             {"chunks", t.chunks},
             {"chunk_overlap", t.chunk_overlap},
             {"nearest_in_view", t.nearest_in_view ? nlohmann::json(*t.nearest_in_view) : nlohmann::json(nullptr)}}},

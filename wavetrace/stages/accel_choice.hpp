@@ -44,6 +44,11 @@ struct SceneTraits {
   // kTraitSampleLimit). A few on an even surface; the whole small object on a stadium,
   // where a ray entering that cell tests all of them (the grids' failure case).
   double triangles_per_grid_cell = 0.0;
+  // On the same cells: how many an average triangle's box overlaps (the hashed grid's list
+  // entries a triangle, which its bytes follow).
+  double grid_entries_per_triangle = 0.0;
+  // The mesh read whole: 12 bytes a vertex, 12 of indices and 4 of material a triangle.
+  double mesh_bytes_per_triangle = 0.0;
   // The nearest distance from the camera to a triangle that may lie in view (not culled by
   // the view frustum; occlusion ignored, so never farther than the nearest surface seen).
   std::optional<double> nearest_in_view;
@@ -54,6 +59,7 @@ struct SceneTraits {
   // a chunked structure's speed is divided by chunk_slowdown(overlap) (accel_choice.cpp).
   double chunk_overlap = 1.0;
   std::size_t chunks = 1;
+  std::vector<std::size_t> chunk_sizes;  // triangles, largest first (the chunked builds at once)
 };
 inline constexpr std::size_t kTraitSampleLimit = std::size_t{1} << 20;
 // A mean over a grid cell past this is crowded; triangles per vertex under this, a soup.
@@ -70,8 +76,9 @@ struct AutoAllowance {
 inline constexpr std::size_t kAutoProcessBaseBytes = 32000000;
 inline constexpr std::size_t kAutoProcessBytesPerPixel = 48;
 AutoAllowance auto_allowance(const ImageSpec& image);
-// A mesh read whole: positions, 32-bit indices and a material per triangle (README, "Memory
-// at scale"); check_scene_fits counts it too.
+// A mesh read whole, on a closed mesh (2 triangles a vertex): positions, 32-bit indices and a
+// material per triangle (README, "Memory at scale"); check_scene_fits counts it before any
+// pass (auto measures it: SceneTraits::mesh_bytes_per_triangle).
 inline constexpr double kWholeMeshBytesPerTriangle = 22.0;
 
 // The pass; `chunk_triangles` as the chunked builder would cut the scene (0: never chunked);
