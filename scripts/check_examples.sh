@@ -9,8 +9,11 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
 cmake --install "$build" --prefix "$work/prefix" >/dev/null
-echo "installed: $(find "$work/prefix/include/wavetrace" -name '*.hpp' | wc -l) headers, $(ls "$work/prefix/lib"/*.a | wc -l) libraries, $(ls "$work/prefix/lib/cmake/wavetrace")"
-cmake -S "$root/examples" -B "$work/build" -DCMAKE_PREFIX_PATH="$work/prefix" -DCMAKE_BUILD_TYPE=Release >/dev/null
+echo "installed: $(find "$work/prefix/include/wavetrace" -name '*.hpp' | wc -l) headers, $(ls "$work/prefix/lib"/*.a | wc -l) libraries, $(ls "$work/prefix/lib/cmake/wavetrace" | tr "\n" " ")"
+# The compiler the library was built with (a package's C++ ABI is its compiler's).
+compiler=$(sed -n 's/^CMAKE_CXX_COMPILER:[A-Z]*=//p' "$build/CMakeCache.txt")
+cmake -S "$root/examples" -B "$work/build" -DCMAKE_PREFIX_PATH="$work/prefix" -DCMAKE_BUILD_TYPE=Release \
+  ${compiler:+-DCMAKE_CXX_COMPILER="$compiler"} >/dev/null
 cmake --build "$work/build" -j"$(nproc)" >/dev/null
 cd "$work"
 "$work/build/ambient_occlusion/ambient_occlusion" builtin:room:20k --set render.threads=2
