@@ -3,20 +3,12 @@
 #include <exception>
 #include <new>
 
-#include <malloc.h>
-
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
 #include "app/commands.hpp"
 
 int main(int argc, char** argv) {
-  // Blocks over 128 KiB are mapped and unmapped by themselves, always. glibc otherwise raises
-  // this threshold to the size of each mapped block freed, after which builds' temporaries of
-  // megabytes come from the heap and stay resident once freed: a pass over the scene before
-  // a chunked build (accel.type = auto's) made builtin:sphere:1M's render peak at 0.12 GB,
-  // not 0.06 (build and render times unchanged on builtin:room:1M).
-  mallopt(M_MMAP_THRESHOLD, 128 * 1024);
   CLI::App app("wavetrace: a CPU wavefront ray tracer for very large triangle meshes");
   app.require_subcommand(1);
   int exit_code = 0;
