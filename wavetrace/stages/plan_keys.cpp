@@ -197,7 +197,9 @@ const PlanKey kPlanKeys[] = {
     {"pipeline.tile", integer<&P::pipeline, &PipelineOptions::tile_side>},
 };
 
-void check_accelerator(const Config& config, const AcceleratorOptions& options) {
+}  // namespace
+
+void check_accelerator_options(const Config& config, const AcceleratorOptions& options) {
   // epsilon chooses the bits: both given (even bits = 16, the default) is a conflict.
   if ((config.given("accel.hmq.bits") && config.given("accel.hmq.epsilon")) ||
       (options.hmq.epsilon > 0.0 && options.hmq.bits != HmqOptions{}.bits)) {
@@ -219,7 +221,7 @@ void check_accelerator(const Config& config, const AcceleratorOptions& options) 
   }
 }
 
-void check_memory(const Config& config, const MemoryPlan& plan) {
+void check_memory_plan(const Config& config, const MemoryPlan& plan) {
   if (!std::has_single_bit(plan.page_bytes)) {
     throw ConfigError(fmt::format("memory.page_bytes = {} is not a power of two", plan.page_bytes));
   }
@@ -237,8 +239,6 @@ void check_memory(const Config& config, const MemoryPlan& plan) {
   }
 }
 
-}  // namespace
-
 std::span<const PlanKey> plan_keys() { return kPlanKeys; }
 
 void read_plan_keys(const Config& config, RenderPlan& plan, std::string_view prefix) {
@@ -252,7 +252,7 @@ AcceleratorOptions accelerator_options(const Config& config) {
   read_plan_keys(config, plan, "accel.");
   read_plan_keys(config, plan, "build.");
   read_plan_keys(config, plan, "render.threads");
-  check_accelerator(config, plan.accelerator);
+  check_accelerator_options(config, plan.accelerator);
   return plan.accelerator;
 }
 
@@ -265,7 +265,7 @@ AccelGoal accel_goal(const Config& config) {
 MemoryPlan plan_memory(const Config& config) {
   RenderPlan plan;
   read_plan_keys(config, plan, "memory.");
-  check_memory(config, plan.memory);
+  check_memory_plan(config, plan.memory);
   return plan.memory;
 }
 

@@ -21,6 +21,11 @@ std::span<const PlanKey> plan_keys();
 // Applies the rows whose key starts with `prefix` ("" for every row).
 void read_plan_keys(const Config& config, RenderPlan& plan, std::string_view prefix = "");
 
+// The checks across an accelerator's keys (widths, conflicting keys) and memory's (page size,
+// file backing, cache geometry); throw ConfigError naming the keys.
+void check_accelerator_options(const Config& config, const AcceleratorOptions& options);
+void check_memory_plan(const Config& config, const MemoryPlan& plan);
+
 // The accel.* and build.* keys as options for make_accelerator, checked (widths, conflicts).
 AcceleratorOptions accelerator_options(const Config& config);
 // What the config asks of accel.type = auto and of pixel error bounds.

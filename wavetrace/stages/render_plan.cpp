@@ -93,8 +93,8 @@ RenderPlan plan_render(const Config& config) {
                                   "must stay under 2^32",
                                   config.integer("render.seed"), plan.image.samples_per_pixel));
   }
-  plan.accelerator = accelerator_options(config);
-  plan.memory = plan_memory(config);
+  check_accelerator_options(config, plan.accelerator);
+  check_memory_plan(config, plan.memory);
   // The proxy's accelerator takes the main one's options, of its own type (proxy.accel).
   const std::string proxy_type = plan.proxy.accelerator.type;
   plan.proxy.accelerator = plan.accelerator;
