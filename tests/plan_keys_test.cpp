@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "wavetrace/stages/accelerator_spec.hpp"
 #include "wavetrace/stages/render_setup.hpp"
 
 namespace wavetrace {
@@ -52,6 +53,34 @@ TEST(PlanKeys, RowsSetTheFieldsTheyName) {
   EXPECT_EQ(plan.proxy.accelerator.type, "bvh");
   EXPECT_EQ(plan.proxy.accelerator.hmq.leaf_size, 7u);
   EXPECT_EQ(accelerator_options(config).hmq.width, 2u);
+}
+
+// --accel's specs, as render, build and bench take them: keys into their sections, and a
+// malformed option or an unknown key named.
+TEST(PlanKeys, AcceleratorSpecsSetTheirKeysAndNameWhatIsWrong) {
+  Config config;
+  apply_accelerator_spec(config, "hmq:width=8:chunk_triangles=125000:epsilon=pixel");
+  const RenderPlan plan = plan_render(config);
+  EXPECT_EQ(plan.accelerator.type, "hmq");
+  EXPECT_EQ(plan.accelerator.hmq.width, 8u);
+  EXPECT_EQ(plan.accelerator.chunk_triangles, 125000u);
+  EXPECT_TRUE(plan.accel_goal.hmq_epsilon_pixel);
+  Config automatic;
+  apply_accelerator_spec(automatic, "auto:memory_budget=1GB:max_error=0");
+  EXPECT_TRUE(accel_goal(automatic).automatic);
+  EXPECT_EQ(accel_goal(automatic).max_error, 0.0);
+  const auto message = [](const std::string& spec) {
+    Config fresh;
+    try {
+      apply_accelerator_spec(fresh, spec);
+    } catch (const ConfigError& error) {
+      return std::string(error.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message("hmq:width").find("'width' is not key=value"), std::string::npos) << message("hmq:width");
+  EXPECT_NE(message("hmq:depth=3").find("accel.hmq.depth"), std::string::npos) << message("hmq:depth=3");
+  EXPECT_NE(message("octree").find("accel.type"), std::string::npos) << message("octree");
 }
 
 }  // namespace

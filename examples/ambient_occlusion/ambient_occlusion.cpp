@@ -14,21 +14,14 @@
 
 #include <glm/geometric.hpp>
 
+#include <wavetrace/kernels/random.hpp>
+#include <wavetrace/kernels/sampling.hpp>
 #include <wavetrace/stages/render_setup.hpp>
 #include <wavetrace/stages/stage.hpp>
 
 namespace {
 
 using namespace wavetrace;
-
-// A deterministic number in [0, 1) for (pixel, sample, draw): images repeat run to run.
-float uniform(std::uint32_t pixel, std::uint32_t sample, std::uint32_t draw) {
-  std::uint64_t x = (std::uint64_t(pixel) << 32 | sample) * 0x9E3779B97F4A7C15ull + draw * 0xBF58476D1CE4E5B9ull;
-  x ^= x >> 31;
-  x *= 0x94D049BB133111EBull;
-  x ^= x >> 29;
-  return float(x >> 40) * (1.0f / 16777216.0f);
-}
 
 // For each camera ray that hit: `rays_per_hit` cosine-distributed rays over the hit's
 // hemisphere, `radius` long, and the share that escapes added to the pixel. Rays that
@@ -53,16 +46,12 @@ class AmbientOcclusionStage final : public Stage {
         const glm::vec3 direction(batch->rays.direction_x[i], batch->rays.direction_y[i], batch->rays.direction_z[i]);
         glm::vec3 normal = glm::normalize(batch->hits.normal(i));
         if (glm::dot(normal, direction) > 0.0f) normal = -normal;  // the side the camera sees
-        const glm::vec3 tangent = glm::normalize(std::fabs(normal.x) > 0.5f ? glm::cross(normal, {0.0f, 1.0f, 0.0f})
-                                                                          : glm::cross(normal, {1.0f, 0.0f, 0.0f}));
-        const glm::vec3 bitangent = glm::cross(normal, tangent);
         const glm::vec3 origin = batch->hits.point(i) + normal * (1e-4f * radius_);
         for (std::uint32_t k = 0; k < rays_per_hit_; ++k) {
-          const float u1 = uniform(batch->rays.pixel[i], batch->rays.sample[i], 2 * k);
-          const float u2 = uniform(batch->rays.pixel[i], batch->rays.sample[i], 2 * k + 1);
-          const float r = std::sqrt(u1), phi = 6.2831853f * u2;
-          const glm::vec3 probe = tangent * (r * std::cos(phi)) + bitangent * (r * std::sin(phi)) +
-                                  normal * std::sqrt(std::max(0.0f, 1.0f - u1));
+          // The library's counter-based draws: the image repeats for any thread count.
+          const UnitPair u = unit_pair(random_bits(batch->rays.pixel[i], batch->rays.sample[i], 1,
+                                                   RandomPurpose::bounce_direction, k));
+          const glm::vec3 probe = cosine_hemisphere(normal, u.first, u.second);
           const std::size_t slot = rays.count++;
           rays.set_geometry(slot, origin, probe, 0.0f, radius_);
           rays.pixel[slot] = batch->rays.pixel[i];
