@@ -50,6 +50,9 @@ TEST(BenchReport, TheQuickMatrixProducesEveryChartAndTableRow) {
   EXPECT_EQ(count_lines_starting(report, "wavetrace bench accel"), 10u);
   // auto: three settings on each of six accel runs, each against the fastest that fits.
   EXPECT_EQ(count_lines_starting(report, "| room:20k ") + count_lines_starting(report, "| sphere:20k "), 12u);
+  // The goal's tally: every auto run judged, and every one's render peak against its budget.
+  EXPECT_NE(report.find(" of 18 runs; its render's measured peak fits its budget on "), std::string::npos);
+  EXPECT_NE(report.find(" of 18."), std::string::npos);
   for (const std::string row :
        {"| Ray-Strips on a soup", "| Hashed grid on a stadium", "| HMQ, huge extents", "| HMQ, thin features",
         "| The proxy on fur", "| Rays through shared edges"}) {

@@ -16,15 +16,17 @@ std::vector<std::string> join(std::vector<std::string> first, const std::vector<
 }
 
 // auto under budgets that leave out the uncompressed structures: besides the process, 85
-// bytes a triangle (HMQ fits, at the pixel bound) and `exact_bytes` with max_error = 0 (100:
+// bytes a triangle (HMQ fits, at the pixel bound) and `exact_bytes` with max_error = 0 (90:
 // Ray-Strips and mlgrid fit), with chunks of an eighth of the scene, so that the build's
-// temporaries are what they are at scale.
+// temporaries are what they are at scale. Robust Embree's renders need 97 (sphere) to 130 (the
+// bunny) bytes a triangle above that process allowance: at 100, the sphere's fitted by 3 MB,
+// inside any estimate's margin, and the budget left out nothing it was meant to.
 std::size_t tight_chunk(std::size_t triangles) { return std::max<std::size_t>(2048, triangles / 8); }
 
 // The report's accel runs render at 320x240 (for pixel bounds): auto counts the process so.
 std::size_t report_process_bytes() { return auto_allowance(ImageSpec{320, 240}).process_bytes; }
 
-std::string tight_auto_specs(std::size_t triangles, std::size_t lossy_bytes = 85, std::size_t exact_bytes = 100) {
+std::string tight_auto_specs(std::size_t triangles, std::size_t lossy_bytes = 85, std::size_t exact_bytes = 90) {
   const std::size_t chunk = tight_chunk(triangles);
   const std::size_t process = report_process_bytes();
   return fmt::format("auto:memory_budget={}:chunk_triangles={},auto:memory_budget={}:max_error=0:chunk_triangles={}",

@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include <fmt/format.h>
+#include <malloc.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -156,6 +157,13 @@ class ChunkedAccelerator final : public Accelerator {
           finished_bytes += chunks_[c].mesh->bytes();
         }
       }
+      // The wave's meshes and temporaries go back to the OS before the next wave: glibc keeps
+      // freed blocks under its mmap threshold, which rises to the largest block a process has
+      // freed, so after a pass that freed large buffers (auto's, over the scene) each wave's
+      // temporaries stayed resident, on top of the next's: builtin:sphere:1M under auto at
+      // 121 MB peaked at 121 MB, 82 MB with this; 7% more build time (pages faulted again).
+      meshes.clear();
+      malloc_trim(0);
       wave_begin = wave_end;
     }
     build_top();
