@@ -250,6 +250,31 @@ def render_peaks(docs, commands):
     return peaks
 
 
+def estimate_rows(docs, commands, peaks):
+    """Auto's estimate of every candidate's render peak against that setting's measured peak:
+    the candidates of the footprint runs of auto (each render's own estimates, streamed as it
+    streams), as a whole build under the machine's budget and in the tight autos' chunks."""
+    rows = {}
+    for stem, run in commands.items():
+        if run.get("section") != "footprint" or stem not in docs:
+            continue
+        words = run["command"].split()
+        spec = words[words.index("--accel") + 1].strip("'")
+        choice = docs[stem].get("accel", {}).get("auto")
+        if not spec.startswith("auto") or not choice:
+            continue
+        label = stem.split("_")[1]
+        chunk = re.search(r":chunk_triangles=\d+", spec)
+        for candidate in choice["candidates"]:
+            setting = re.sub(r":epsilon=[^:]*", "", candidate["spec"])
+            if candidate["chunked"] and chunk:
+                setting += chunk.group(0)
+            peak = peaks.get((label, setting))
+            if peak is not None:
+                rows[(label, setting)] = (candidate["estimated_bytes"], peak)
+    return rows
+
+
 def auto_rows(name, doc, peaks):
     """Each auto setting of an accel run against the fastest setting that fits its budget and
     meets its error bound (measured footprint, measured hit-point error) and is not leaky.
@@ -443,6 +468,18 @@ def main():
                 f"{by_setting[(label, setting)] / 1e6:.0f}" if (label, setting) in by_setting else "-"
                 for label in labels) + " |")
         md += ["", made_by(*footprint_stems)]
+        estimates = estimate_rows(docs, commands, peaks)
+        if estimates:
+            under = [key for key, (estimate, peak) in estimates.items() if estimate < peak]
+            md += ["Auto's estimate of each candidate's render peak (from its pass, before building; HMQ's at "
+                   "the run's bound) against the peak measured for that setting above: "
+                   f"{len(estimates) - len(under)} of {len(estimates)} estimates lie at or above the measured peak"
+                   + (f"; under it: {', '.join(f'{setting} on {label}' for label, setting in under)}." if under else "."),
+                   "", "| scene | setting | estimate | measured peak | estimate / peak |", "|---|---|---|---|---|"]
+            for (label, setting), (estimate, peak) in estimates.items():
+                md.append(f"| {label} | {short(setting)} | {megabytes(estimate)} | {megabytes(peak)} | "
+                          f"{estimate / peak:.2f} |")
+            md.append("")
 
     error_stems = [s for s in docs if kinds[s] == "accel" and s.startswith("hmq_error")]
     image_stems = [s for s in docs if kinds[s] == "image"]

@@ -53,6 +53,9 @@ TEST(BenchReport, TheQuickMatrixProducesEveryChartAndTableRow) {
   // The goal's tally: every auto run judged, and every one's render peak against its budget.
   EXPECT_NE(report.find(" of 18 runs; its render's measured peak fits its budget on "), std::string::npos);
   EXPECT_NE(report.find(" of 18."), std::string::npos);
+  // And auto's estimate of every candidate against that setting's measured render peak.
+  EXPECT_NE(report.find(" estimates lie at or above the measured peak"), std::string::npos);
+  EXPECT_NE(report.find("| room | raystrips:width=8:chunked | "), std::string::npos);
   for (const std::string row :
        {"| Ray-Strips on a soup", "| Hashed grid on a stadium", "| HMQ, huge extents", "| HMQ, thin features",
         "| The proxy on fur", "| Rays through shared edges"}) {

@@ -93,6 +93,14 @@ constexpr CandidateType kCandidates[] = {
 constexpr double kGridBytesPerTriangle = 10.0;
 constexpr double kGridBytesPerEntry = 4.4;
 
+// Ray-Strips' bytes and its stripifier's temporaries grow as its pieces share fewer edges:
+// both are scaled by this over the triangles a vertex the pass saw (its chunks of 256k, as
+// a chunked build's), 1 on the closed builtins (room 5.5, sphere 5.9). Measured on bunny00
+// subdivided twice in chunks of an eighth, whose faces come in no spatial order (2.2): 54
+// bytes a triangle against 14 on room and sphere, and 650 of temporaries a chunk triangle
+// against 180; the scale gives 2.5x of each, short of the 3.7x measured (README).
+constexpr double kConnectedTrianglesPerVertex = 5.5;
+
 // How much slower a structure traces built in chunks whose boxes overlap so (SceneTraits::
 // chunk_overlap), fitted to `bench report`'s chunked 8-wide hmq, raystrips and bvh against
 // whole ones (chunks of an eighth): room 1.22x at overlap 2.96, sphere 1.5x at 3.44, the
@@ -304,7 +312,9 @@ AccelChoice choose_accelerator(const SceneTraits& traits, std::size_t budget_byt
     // builtin:room:8M (render, VmHWM), estimate against peak: robust Embree 1.19 / 1.02 GB,
     // bvh:width=8 1.57 / 1.54, hmq:width=8 0.90 / 0.64, raystrips:width=8 0.98 / 0.67;
     // `bench report` measures them on its scenes.
-    const double mesh = holds_own_geometry(type) && streamed_source ? 0.0 : traits.mesh_bytes_per_triangle;
+    double mesh = holds_own_geometry(type) && streamed_source ? 0.0 : traits.mesh_bytes_per_triangle;
+    // bvh's chunks keep copies of their meshes, beside a whole mesh that was not streamed.
+    if (candidate.chunked && !holds_own_geometry(type) && !streamed_source) mesh *= 2.0;
     double built_at_once = triangles;
     if (candidate.chunked) {
       built_at_once = 0.0;
@@ -313,12 +323,16 @@ AccelChoice choose_accelerator(const SceneTraits& traits, std::size_t budget_byt
       }
       if (traits.chunk_sizes.empty()) built_at_once = std::min(triangles, double(options.chunk_triangles));
     }
-    const double structure =
-        type == "mlgrid" ? kGridBytesPerTriangle + kGridBytesPerEntry * traits.grid_entries_per_triangle
-                         : estimated_bytes_per_triangle(options);
-    candidate.estimated_bytes = triangles * (structure + mesh) +
-                                built_at_once * estimated_build_bytes_per_triangle(type) +
-                                double(allowance.process_bytes);
+    double structure = type == "mlgrid" ? kGridBytesPerTriangle + kGridBytesPerEntry * traits.grid_entries_per_triangle
+                                        : estimated_bytes_per_triangle(options);
+    double build_temporaries = estimated_build_bytes_per_triangle(type);
+    if (type == "raystrips") {
+      const double sparse = std::max(1.0, kConnectedTrianglesPerVertex / std::max(traits.triangles_per_vertex, 1.0));
+      structure *= sparse;
+      build_temporaries *= sparse;
+    }
+    candidate.estimated_bytes =
+        triangles * (structure + mesh) + built_at_once * build_temporaries + double(allowance.process_bytes);
     candidate.fits = candidate.estimated_bytes <= double(budget_bytes);
 
     std::string error_reason;
