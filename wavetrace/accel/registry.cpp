@@ -27,10 +27,13 @@ double estimated_bytes_per_triangle(const AcceleratorOptions& options) {
 double estimated_build_bytes_per_triangle(const std::string& type) {
   // Embree's builder: VmHWM 0.26 GB above the finished render's resident memory on room:8M
   // (its allocation monitor said ~15 B/tri on room:64M); ours, the binned SAH build's arrays
-  // and the chunk's mesh, the largest measured: 165 B/tri on a monolithic room:64M; per chunk
-  // triangle, render VmHWM less the process and the finished structure on room:1M in chunks
-  // of 125k (two built at once), 141 for hmq:width=8, 140 for raystrips:width=8 and 188 for
-  // bvh:width=8 (its chunks keep their meshes), 180 for bvh:width=8 on room:8M.
+  // and the chunk's mesh: 165 B/tri on a monolithic room:64M, 180 per chunk triangle for
+  // bvh:width=8 on room:8M. In chunks of 125k on room:1M and sphere:1M (render VmHWM less an
+  // empty render's 18 MB and the finished structure, over the two chunks built at once):
+  // hmq:width=8 147 and 196, raystrips:width=8 174 and 182, bvh:width=8 266 and 221. These
+  // are not each an upper bound: auto's estimate adds them to a structure and a process
+  // allowance that are (12.5 and 22 B/tri against 9-15 measured, 32 MB against 18), and
+  // `bench report` sets every candidate's sum against its measured render peak.
   // The grids' counting build holds a count per cell and the lists' positions (bench accel
   // saw no VmHWM rise above its start on builtin:sphere:1M): bounded here by a cell count.
   if (type == "grid" || type == "mlgrid") return 24.0;

@@ -93,9 +93,10 @@ constexpr CandidateType kCandidates[] = {
 constexpr double kGridBytesPerTriangle = 10.0;
 constexpr double kGridBytesPerEntry = 4.4;
 
-// Ray-Strips' bytes and its stripifier's temporaries grow as its pieces share fewer edges:
-// both are scaled by this over the triangles a vertex the pass saw (its chunks of 256k, as
-// a chunked build's), 1 on the closed builtins (room 5.5, sphere 5.9). Measured on bunny00
+// Ray-Strips' bytes and its stripifier's temporaries grow as its chunks share fewer edges:
+// in chunks, both are scaled by this over the triangles a vertex the pass saw (in its runs of
+// 256k, as a chunked build's), 1 on the closed builtins (room 5.5, sphere 5.9); a whole
+// build's connectivity is the whole mesh's, which those runs understate. Measured on bunny00
 // subdivided twice in chunks of an eighth, whose faces come in no spatial order (2.2): 54
 // bytes a triangle against 14 on room and sphere, and 650 of temporaries a chunk triangle
 // against 180; the scale gives 2.5x of each, short of the 3.7x measured (README).
@@ -326,7 +327,7 @@ AccelChoice choose_accelerator(const SceneTraits& traits, std::size_t budget_byt
     double structure = type == "mlgrid" ? kGridBytesPerTriangle + kGridBytesPerEntry * traits.grid_entries_per_triangle
                                         : estimated_bytes_per_triangle(options);
     double build_temporaries = estimated_build_bytes_per_triangle(type);
-    if (type == "raystrips") {
+    if (type == "raystrips" && candidate.chunked) {
       const double sparse = std::max(1.0, kConnectedTrianglesPerVertex / std::max(traits.triangles_per_vertex, 1.0));
       structure *= sparse;
       build_temporaries *= sparse;
