@@ -238,16 +238,18 @@ def footprint(r):
     return max(r["bytes"], (r.get("build_peak_rss_above_start_bytes") or 0) + in_place)
 
 
-def render_peaks(docs, commands):
-    """(scene label, --accel spec) -> the render's peak resident bytes, from the footprint runs."""
-    peaks = {}
+def footprint_runs(docs, commands):
+    """(stem, scene label, --accel spec) of each footprint run whose stats are present."""
     for stem, run in commands.items():
         if run.get("section") != "footprint" or stem not in docs:
             continue
         words = run["command"].split()
-        spec = words[words.index("--accel") + 1].strip("'")
-        peaks[(stem.split("_")[1], spec)] = docs[stem]["memory"]["peak_rss_bytes"]
-    return peaks
+        yield stem, stem.split("_")[1], words[words.index("--accel") + 1].strip("'")
+
+
+def render_peaks(docs, commands):
+    """(scene label, --accel spec) -> the render's peak resident bytes, from the footprint runs."""
+    return {(label, spec): docs[stem]["memory"]["peak_rss_bytes"] for stem, label, spec in footprint_runs(docs, commands)}
 
 
 def estimate_rows(docs, commands, peaks):
@@ -255,15 +257,10 @@ def estimate_rows(docs, commands, peaks):
     the candidates of the footprint runs of auto (each render's own estimates, streamed as it
     streams), as a whole build under the machine's budget and in the tight autos' chunks."""
     rows = {}
-    for stem, run in commands.items():
-        if run.get("section") != "footprint" or stem not in docs:
-            continue
-        words = run["command"].split()
-        spec = words[words.index("--accel") + 1].strip("'")
+    for stem, label, spec in footprint_runs(docs, commands):
         choice = docs[stem].get("accel", {}).get("auto")
         if not spec.startswith("auto") or not choice:
             continue
-        label = stem.split("_")[1]
         chunk = re.search(r":chunk_triangles=\d+", spec)
         for candidate in choice["candidates"]:
             setting = re.sub(r":epsilon=[^:]*", "", candidate["spec"])
