@@ -252,6 +252,13 @@ def render_peaks(docs, commands):
     return {(label, spec): docs[stem]["memory"]["peak_rss_bytes"] for stem, label, spec in footprint_runs(docs, commands)}
 
 
+def candidate_setting(spec, candidate, auto_spec):
+    """The --accel setting a candidate of `auto_spec` stands for: built in that auto's chunks
+    when the choice would chunk it ('raystrips:width=8' -> 'raystrips:width=8:chunk_triangles=N')."""
+    chunk = re.search(r":chunk_triangles=\d+", auto_spec)
+    return spec + (chunk.group(0) if chunk and candidate.get("chunked") else "")
+
+
 def estimate_rows(docs, commands, peaks):
     """Auto's estimate of every candidate's render peak against that setting's measured peak:
     the candidates of the footprint runs of auto (each render's own estimates, streamed as it
@@ -261,11 +268,9 @@ def estimate_rows(docs, commands, peaks):
         choice = docs[stem].get("accel", {}).get("auto")
         if not spec.startswith("auto") or not choice:
             continue
-        chunk = re.search(r":chunk_triangles=\d+", spec)
         for candidate in choice["candidates"]:
-            setting = re.sub(r":epsilon=[^:]*", "", candidate["spec"])
-            if candidate["chunked"] and chunk:
-                setting += chunk.group(0)
+            # HMQ's footprint is measured at its default grid; the bound changes bytes little.
+            setting = candidate_setting(re.sub(r":epsilon=[^:]*", "", candidate["spec"]), candidate, spec)
             peak = peaks.get((label, setting))
             if peak is not None:
                 rows[(label, setting)] = (candidate["estimated_bytes"], peak)
@@ -305,8 +310,7 @@ def auto_rows(name, doc, peaks):
             fitting.append(other)
         best = max(fitting, key=lambda o: o["mrays_per_s"], default=None)
         chosen = next((c for c in choice["candidates"] if c["chosen"]), {})
-        chunk = re.search(r":chunk_triangles=\d+", base_spec(r["accel"]))
-        chosen_setting = choice["chosen"] + (chunk.group(0) if chunk and chosen.get("chunked") else "")
+        chosen_setting = candidate_setting(choice["chosen"], chosen, base_spec(r["accel"]))
         peak = peaks.get((label, base_spec(r["accel"])), float("nan"))
         rows.append({
             "run": name, "scene": scene_name(doc), "rays": doc["rays"]["kind"], "auto": short(base_spec(r["accel"])),
