@@ -5,14 +5,16 @@
 
 #include <fmt/format.h>
 
+#include "app/command_options.hpp"
 #include "app/commands.hpp"
+#include "wavetrace/scene/load_scene.hpp"
 #include "wavetrace/bench/accel_bench.hpp"
 #include "wavetrace/bench/image_bench.hpp"
 #include "wavetrace/bench/leak_bench.hpp"
 #include "wavetrace/bench/pipeline_bench.hpp"
 #include "wavetrace/bench/reorder_bench.hpp"
-#include "wavetrace/stages/render_setup.hpp"
-#include "wavetrace/stages/world_file.hpp"
+#include "wavetrace/setup/render_setup.hpp"
+#include "wavetrace/setup/world_file.hpp"
 
 namespace wavetrace {
 namespace {
@@ -142,17 +144,14 @@ Config render_bench_config(const std::vector<std::string>& defaults, const std::
   config.set_value("scene.source", scene);
   config.set("render.spp=" + std::to_string(spp));
   config.set("render.threads=" + std::to_string(threads));
-  const std::size_t by = size.find('x');
-  if (by == std::string::npos) throw ConfigError(fmt::format("--size '{}': expected WIDTHxHEIGHT", size));
-  config.set("render.width=" + size.substr(0, by));
-  config.set("render.height=" + size.substr(by + 1));
+  set_image_size(config, size);
   return config;
 }
 
 int run_reorder(const ReorderArguments& args) {
   Config config =
       render_bench_config({"render.max_depth=5"}, args.assignments, args.scene, args.spp, args.threads, args.size);
-  config.set("accel.type=" + args.accel);
+  apply_accelerator_spec(config, args.accel);
   config.set("reorder.curve=" + args.curve);
   std::vector<ReorderHeuristic> heuristics;
   for (const std::string& name : split_commas(args.heuristics)) {
@@ -228,21 +227,13 @@ int run_image(const ImageArguments& args) {
   return 0;
 }
 
-// --set KEY=VALUE, repeatable: config overrides applied over each benchmark's defaults.
-void add_set_option(CLI::App* command, std::vector<std::string>& assignments, const std::string& example) {
-  command->add_option("--set", assignments, "config override section.key=value (e.g. " + example + ")")
-      ->expected(1)
-      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
-}
-
 void add_common_options(CLI::App* command, BenchArguments& args) {
-  command->add_option("--scene", args.scene, "mesh file, scene file (.toml) or builtin:NAME[:TRIANGLES]");
-  command->add_option("--accel", args.accel,
-                      "comma-separated accelerators, each TYPE[:key=value]..., e.g. bvh:layout=veb,embree:mode=robust");
+  add_scene_option(*command, args.scene, SceneKinds::with_worlds, false);
+  add_accel_option(*command, args.accel, true);
   command->add_option("--count", args.count, "number of rays");
-  command->add_option("--threads", args.threads, "worker threads (0: all cores)");
+  add_threads_option(*command, args.threads);
   command->add_option("--json", args.json, "write results as JSON (and CSV beside it for bench accel)");
-  add_set_option(command, args.assignments, "scene.subdivide=2");
+  add_set_option(*command, args.assignments, "scene.subdivide=2");
 }
 
 }  // namespace
@@ -273,45 +264,44 @@ void add_bench_command(CLI::App& app, int& exit_code) {
 
   auto reorder_args = std::make_shared<ReorderArguments>();
   CLI::App* reorder = bench->add_subcommand("reorder", "render the same image once per ray reordering heuristic");
-  reorder->add_option("--scene", reorder_args->scene, "mesh file, scene file (.toml) or builtin:NAME[:TRIANGLES]");
-  reorder->add_option("--accel", reorder_args->accel, "main accelerator (accel.type)");
+  add_scene_option(*reorder, reorder_args->scene, SceneKinds::with_worlds, false);
+  add_accel_option(*reorder, reorder_args->accel);
   reorder->add_option("--heuristics", reorder_args->heuristics,
                       "comma-separated: none, origin, origin_dir, hph, hph_origin, hph_dir (the first is the baseline)");
   reorder->add_option("--curve", reorder_args->curve, "morton or hilbert");
-  reorder->add_option("--spp", reorder_args->spp, "samples per pixel");
-  reorder->add_option("--size", reorder_args->size, "image size as WIDTHxHEIGHT");
-  reorder->add_option("--threads", reorder_args->threads, "worker threads (0: all cores)");
+  add_spp_option(*reorder, reorder_args->spp);
+  add_size_option(*reorder, reorder_args->size);
+  add_threads_option(*reorder, reorder_args->threads);
   reorder->add_option("--json", reorder_args->json, "write results as JSON");
-  add_set_option(reorder, reorder_args->assignments, "memory.budget=20%");
+  add_set_option(*reorder, reorder_args->assignments, "memory.budget=20%");
   reorder->callback([reorder_args, &exit_code] { exit_code = run_reorder(*reorder_args); });
 
   auto pipeline_args = std::make_shared<PipelineArguments>();
   CLI::App* pipeline = bench->add_subcommand(
       "pipeline", "the megakernel against the wavefront with each reorder heuristic: speed, stage costs, images");
-  pipeline->add_option("--scene", pipeline_args->scene, "mesh file, scene file (.toml), builtin:NAME[:TRIANGLES] or world file");
-  pipeline->add_option("--accel", pipeline_args->accel, "main accelerator, TYPE[:key=value]..., e.g. hmq:width=8");
+  add_scene_option(*pipeline, pipeline_args->scene, SceneKinds::with_worlds, false);
+  add_accel_option(*pipeline, pipeline_args->accel);
   pipeline->add_option("--heuristics", pipeline_args->heuristics,
                        "comma-separated wavefront heuristics: none, origin, origin_dir, hph, hph_origin, hph_dir");
   pipeline->add_option("--threads", pipeline_args->threads, "comma-separated thread counts, each a full set of rows");
-  pipeline->add_option("--spp", pipeline_args->spp, "samples per pixel");
-  pipeline->add_option("--size", pipeline_args->size, "image size as WIDTHxHEIGHT");
+  add_spp_option(*pipeline, pipeline_args->spp);
+  add_size_option(*pipeline, pipeline_args->size);
   pipeline->add_option("--repeat", pipeline_args->repeat, "renders per row, interleaved (the median is reported)");
   pipeline->add_option("--json", pipeline_args->json, "write results as JSON");
-  add_set_option(pipeline, pipeline_args->assignments, "render.max_depth=8");
+  add_set_option(*pipeline, pipeline_args->assignments, "render.max_depth=8");
   pipeline->callback([pipeline_args, &exit_code] { exit_code = run_pipeline(*pipeline_args); });
 
   auto image_args = std::make_shared<ImageArguments>();
   CLI::App* image = bench->add_subcommand("image", "render the same image with each accelerator, RMSE against the first");
-  image->add_option("--scene", image_args->scene, "mesh file, scene file (.toml) or builtin:NAME[:TRIANGLES]");
-  image->add_option("--accel", image_args->accel,
-                    "comma-separated accelerators, TYPE[:key=value]...; the first renders the reference image");
-  image->add_option("--spp", image_args->spp, "samples per pixel");
-  image->add_option("--size", image_args->size, "image size as WIDTHxHEIGHT");
-  image->add_option("--threads", image_args->threads, "worker threads (0: all cores)");
+  add_scene_option(*image, image_args->scene, SceneKinds::without_worlds, false);
+  add_accel_option(*image, image_args->accel, true, "the first renders the reference image");
+  add_spp_option(*image, image_args->spp);
+  add_size_option(*image, image_args->size);
+  add_threads_option(*image, image_args->threads);
   image->add_flag("--noise", image_args->noise,
                   "also render the first accelerator with render.seed + 1: its RMSE is the Monte Carlo noise");
   image->add_option("--json", image_args->json, "write results as JSON");
-  add_set_option(image, image_args->assignments, "render.max_depth=2");
+  add_set_option(*image, image_args->assignments, "render.max_depth=2");
   image->callback([image_args, &exit_code] { exit_code = run_image(*image_args); });
 
   add_bench_report_command(*bench, exit_code);

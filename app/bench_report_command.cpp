@@ -6,15 +6,17 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <memory>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "app/commands.hpp"
+#include "wavetrace/scene/load_scene.hpp"
 #include "wavetrace/bench/report_matrix.hpp"
 #include "wavetrace/scene/builtin_scenes.hpp"
-#include "wavetrace/stages/config.hpp"
+#include "wavetrace/setup/config.hpp"
 
 namespace wavetrace {
 namespace {
@@ -92,10 +94,14 @@ int run_report(const ReportArguments& args) {
   }
   const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   write_json(data / "runs.json", {{"quick", args.quick}, {"total_seconds", total}, {"runs", runs}});
+  // The script's own error is the message: its stderr goes to a file shown when it fails.
+  const fs::path errors = data / "report_py.stderr";
   const std::string plot = fmt::format("'{}' '{}' '{}'", args.python, args.script, out.string());
-  if (const int status = std::system(plot.c_str()); status != 0) {
-    throw std::runtime_error(fmt::format("{} failed (status {}): the charts need Debian's python3-matplotlib", plot,
-                                         WIFEXITED(status) ? WEXITSTATUS(status) : -1));
+  if (const int status = std::system((plot + " 2> '" + errors.string() + "'").c_str()); status != 0) {
+    std::ifstream error_file(errors);
+    const std::string error_text((std::istreambuf_iterator<char>(error_file)), std::istreambuf_iterator<char>());
+    throw std::runtime_error(fmt::format("{} failed (status {}):\n{}", plot, WIFEXITED(status) ? WEXITSTATUS(status) : -1,
+                                         error_text.empty() ? "(it printed nothing on stderr)" : error_text));
   }
   fmt::print("wrote {} ({} runs in {:.0f} s{})\n", (out / "report.md").string(), runs.size(), total,
              failed ? fmt::format(", {} FAILED", failed) : std::string());

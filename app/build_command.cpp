@@ -4,17 +4,19 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "wavetrace/accel/registry.hpp"
+#include "app/command_options.hpp"
 #include "app/commands.hpp"
 #include "wavetrace/memory/process_memory.hpp"
 #include "wavetrace/scene/lights.hpp"
-#include "wavetrace/stages/accelerator_spec.hpp"
-#include "wavetrace/stages/render_setup.hpp"
-#include "wavetrace/stages/world_file.hpp"
+#include "wavetrace/setup/accelerator_spec.hpp"
+#include "wavetrace/setup/render_setup.hpp"
+#include "wavetrace/setup/world_file.hpp"
 
 namespace wavetrace {
 namespace {
@@ -22,7 +24,7 @@ namespace {
 struct BuildArguments {
   std::string scene;
   std::string accel;
-  int threads = -1;
+  std::optional<int> threads;  // unset: render.threads from the config
   std::string config_file;
   std::vector<std::string> assignments;
   bool proxy = false;
@@ -39,7 +41,7 @@ int run_build(const BuildArguments& args) {
   if (!args.config_file.empty()) config.load_file(args.config_file);
   if (!args.scene.empty()) config.set_value("scene.source", args.scene);
   if (!args.accel.empty()) apply_accelerator_spec(config, args.accel);
-  if (args.threads >= 0) config.set_value("render.threads", std::int64_t{args.threads});
+  if (args.threads) config.set_value("render.threads", std::int64_t{*args.threads});
   for (const std::string& assignment : args.assignments) config.set(assignment);
   if (!is_world_file(args.out)) throw ConfigError(fmt::format("--out {}: a world file is named *.wtw", args.out));
   RenderPlan plan = plan_render(config);
@@ -55,13 +57,7 @@ int run_build(const BuildArguments& args) {
   const std::string& type = plan.accelerator.type;
   if (const std::string line = resolution_summary(loaded.accelerator); !line.empty()) fmt::print("{}\n", line);
   // The world records what was built, not what chose it.
-  const AcceleratorOptions& built = plan.accelerator;
-  config.set_value("accel.type", type);
-  if (type == "hmq" && built.hmq.epsilon > 0.0) config.set_value("accel.hmq.epsilon", built.hmq.epsilon);
-  if (type == "hmq") config.set_value("accel.hmq.width", std::int64_t{built.hmq.width});
-  if (type == "bvh") config.set_value("accel.bvh.width", std::int64_t{built.bvh.width});
-  if (type == "raystrips") config.set_value("accel.raystrips.width", std::int64_t{built.raystrips.width});
-  if (type == "embree") config.set_value("accel.embree.mode", to_string(built.embree.mode));
+  record_built_accelerator(config, plan);
   WorldBuildInfo info;
   info.scene_seconds = seconds_since(load_start);
   const auto build_start = std::chrono::steady_clock::now();
@@ -113,13 +109,11 @@ int run_build(const BuildArguments& args) {
 void add_build_command(CLI::App& app, int& exit_code) {
   auto args = std::make_shared<BuildArguments>();
   CLI::App* command = app.add_subcommand("build", "build a scene's world once and save it to a world file (.wtw)");
-  command->add_option("scene,--scene", args->scene, "mesh file, scene file (.toml) or builtin:NAME[:TRIANGLES]");
-  command->add_option("--accel", args->accel, "accelerator: TYPE[:key=value]..., as bench takes it (accel.type, accel.TYPE.key, build.chunk_triangles)");
-  command->add_option("--threads", args->threads, "worker threads, 0 = all cores (render.threads)");
-  command->add_option("--config", args->config_file, "TOML config file");
-  command->add_option("--set", args->assignments, "override a config key: section.key=value")
-      ->expected(1)
-      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  add_scene_option(*command, args->scene, SceneKinds::without_worlds);
+  add_accel_option(*command, args->accel);
+  add_threads_option(*command, args->threads);
+  add_config_option(*command, args->config_file);
+  add_set_option(*command, args->assignments);
   command->add_flag("--proxy", args->proxy,
                     "also simplify and save the proxy that hit-point reordering needs (always when reorder.heuristic needs it)");
   command->add_option("--out", args->out, "the world file to write (*.wtw)")->required();

@@ -11,6 +11,7 @@ void add_info_command(CLI::App& app, int& exit_code);
 void add_bench_command(CLI::App& app, int& exit_code);
 void add_export_command(CLI::App& app, int& exit_code);
 void add_build_command(CLI::App& app, int& exit_code);
+void add_keys_command(CLI::App& app, int& exit_code);
 // `bench report`, added under the bench command.
 void add_bench_report_command(CLI::App& bench, int& exit_code);
 

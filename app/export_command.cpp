@@ -5,11 +5,12 @@
 
 #include <fmt/format.h>
 
+#include "app/command_options.hpp"
 #include "app/commands.hpp"
 #include "wavetrace/scene/ply_file.hpp"
-#include "wavetrace/scene/scene.hpp"
+#include "wavetrace/scene/load_scene.hpp"
 #include "wavetrace/scene/triangle_source.hpp"
-#include "wavetrace/stages/config.hpp"
+#include "wavetrace/setup/config.hpp"
 
 namespace wavetrace {
 namespace {
@@ -44,12 +45,10 @@ int run_export(const ExportArguments& args) {
 void add_export_command(CLI::App& app, int& exit_code) {
   auto args = std::make_shared<ExportArguments>();
   CLI::App* command = app.add_subcommand("export", "write a scene's triangles as binary PLY");
-  command->add_option("scene,--scene", args->scene, "mesh file, scene file (.toml) or builtin:NAME[:TRIANGLES]");
+  add_scene_option(*command, args->scene, SceneKinds::without_worlds);
   command->add_option("--out", args->out, "the .ply file to write")->required();
-  command->add_option("--subdivide", args->subdivide, "levels of Loop subdivision first");
-  command->add_option("--set", args->assignments, "a config key: build.chunk_triangles sets the piece size")
-      ->expected(1)
-      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  add_subdivide_option(*command, args->subdivide);
+  add_set_option(*command, args->assignments, "build.chunk_triangles=1000000, the piece size");
   command->callback([args, &exit_code] { exit_code = run_export(*args); });
 }
 

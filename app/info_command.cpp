@@ -5,11 +5,12 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "app/command_options.hpp"
 #include "app/commands.hpp"
 #include "app/render_report.hpp"
 #include "wavetrace/scene/mesh_report.hpp"
-#include "wavetrace/scene/scene.hpp"
-#include "wavetrace/stages/world_file.hpp"
+#include "wavetrace/scene/load_scene.hpp"
+#include "wavetrace/setup/world_file.hpp"
 
 namespace wavetrace {
 namespace {
@@ -116,8 +117,8 @@ int run_info(const InfoArguments& args) {
 void add_info_command(CLI::App& app, int& exit_code) {
   auto args = std::make_shared<InfoArguments>();
   CLI::App* command = app.add_subcommand("info", "report a scene's size, bounds and topology, or what a saved world holds");
-  command->add_option("scene,--scene", args->scene, "mesh file, scene file (.toml), builtin:NAME[:TRIANGLES] or a saved world (.wtw)");
-  command->add_option("--subdivide", args->subdivide, "levels of Loop subdivision first");
+  add_scene_option(*command, args->scene, SceneKinds::with_worlds);
+  add_subdivide_option(*command, args->subdivide);
   command->add_flag("--json", args->json, "print JSON");
   command->callback([args, &exit_code] { exit_code = run_info(*args); });
 }

@@ -1,4 +1,4 @@
-// The `wavetrace` command line: render, build, info, bench, export.
+// The `wavetrace` command line: render, build, info, bench, export, keys.
 #include <cstdio>
 #include <exception>
 #include <new>
@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   wavetrace::add_bench_command(app, exit_code);
   wavetrace::add_export_command(app, exit_code);
   wavetrace::add_build_command(app, exit_code);
+  wavetrace::add_keys_command(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {

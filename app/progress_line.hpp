@@ -3,7 +3,7 @@
 
 #include <cstdio>
 
-#include "wavetrace/stages/pipeline.hpp"
+#include "wavetrace/pipeline/pipeline.hpp"
 
 namespace wavetrace {
 

@@ -4,19 +4,21 @@
 #include <fstream>
 #include <memory>
 #include <new>
+#include <optional>
 
 #include <fmt/format.h>
 
 #include "wavetrace/accel/registry.hpp"
+#include "app/command_options.hpp"
 #include "app/commands.hpp"
 #include "app/image_output.hpp"
 #include "app/progress_line.hpp"
 #include "app/render_report.hpp"
 #include "wavetrace/memory/process_memory.hpp"
 #include "wavetrace/scene/lights.hpp"
-#include "wavetrace/stages/accelerator_spec.hpp"
-#include "wavetrace/stages/render_setup.hpp"
-#include "wavetrace/stages/world_file.hpp"
+#include "wavetrace/setup/accelerator_spec.hpp"
+#include "wavetrace/setup/render_setup.hpp"
+#include "wavetrace/setup/world_file.hpp"
 
 namespace wavetrace {
 namespace {
@@ -24,9 +26,9 @@ namespace {
 struct RenderArguments {
   std::string scene;
   std::string accel;
-  int spp = 0;
+  std::optional<int> spp;  // unset: render.spp from the config
   std::string size;
-  int threads = -1;
+  std::optional<int> threads;  // unset: render.threads from the config
   std::string config_file;
   std::vector<std::string> assignments;
   std::string out = "out/render.exr";
@@ -38,14 +40,9 @@ Config build_config(const RenderArguments& args) {
   if (!args.config_file.empty()) config.load_file(args.config_file);
   if (!args.scene.empty()) config.set_value("scene.source", args.scene);
   if (!args.accel.empty()) apply_accelerator_spec(config, args.accel);
-  if (args.spp != 0) config.set_value("render.spp", std::int64_t{args.spp});
-  if (args.threads >= 0) config.set_value("render.threads", std::int64_t{args.threads});
-  if (!args.size.empty()) {
-    const std::size_t x = args.size.find('x');
-    if (x == std::string::npos) throw ConfigError(fmt::format("--size '{}': expected WIDTHxHEIGHT", args.size));
-    config.set("render.width=" + args.size.substr(0, x));
-    config.set("render.height=" + args.size.substr(x + 1));
-  }
+  if (args.spp) config.set_value("render.spp", std::int64_t{*args.spp});
+  if (args.threads) config.set_value("render.threads", std::int64_t{*args.threads});
+  if (!args.size.empty()) set_image_size(config, args.size);
   for (const std::string& assignment : args.assignments) config.set(assignment);
   return config;
 }
@@ -110,14 +107,13 @@ int run_render(const RenderArguments& args) {
 void add_render_command(CLI::App& app, int& exit_code) {
   auto args = std::make_shared<RenderArguments>();
   CLI::App* command = app.add_subcommand("render", "path-trace an image through the stage pipeline");
-  command->add_option("scene,--scene", args->scene,
-                      "mesh file, scene file (.toml), builtin:NAME[:TRIANGLES] or a saved world (.wtw) (default builtin:default)");
-  command->add_option("--accel", args->accel, "accelerator: TYPE[:key=value]..., as bench takes it (accel.type, accel.TYPE.key, build.chunk_triangles)");
-  command->add_option("--spp", args->spp, "samples per pixel (render.spp)");
-  command->add_option("--size", args->size, "image size as WIDTHxHEIGHT");
-  command->add_option("--threads", args->threads, "worker threads, 0 = all cores (render.threads)");
-  command->add_option("--config", args->config_file, "TOML config file");
-  command->add_option("--set", args->assignments, "override a config key: section.key=value")->expected(1)->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  add_scene_option(*command, args->scene, SceneKinds::with_worlds);
+  add_accel_option(*command, args->accel);
+  add_spp_option(*command, args->spp);
+  add_size_option(*command, args->size);
+  add_threads_option(*command, args->threads);
+  add_config_option(*command, args->config_file);
+  add_set_option(*command, args->assignments);
   command->add_option("--out", args->out, "OpenEXR output; a PNG preview is written beside it");
   command->add_option("--stats", args->stats, "write run statistics as JSON");
   command->callback([args, &exit_code] { exit_code = run_render(*args); });

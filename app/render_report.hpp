@@ -7,7 +7,7 @@
 
 #include "wavetrace/accel/accelerator.hpp"
 #include "wavetrace/scene/scene.hpp"
-#include "wavetrace/stages/render_setup.hpp"
+#include "wavetrace/setup/render_setup.hpp"
 
 namespace wavetrace {
 

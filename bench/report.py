@@ -14,6 +14,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.ticker  # noqa: E402
 
 # Settings that let rays through shared edges (bench leak): left out of "watertight".
 LEAKY = ("embree", "embree:mode=compact")
@@ -54,6 +55,13 @@ def scene_name(doc):
     return doc["scene"]["source"].replace("builtin:", "")
 
 
+def scene_label(stem):
+    """The scene part of a matrix run's name (accel_room_primary -> room); a file named any
+    other way (bench accel --json a.json, given with --from) is its own label."""
+    parts = stem.split("_")
+    return parts[1] if len(parts) > 1 else stem
+
+
 def base_spec(label):
     """'auto:memory_budget=... (hmq:width=8:epsilon=0.01)' -> 'auto:memory_budget=...'."""
     return label.split(" (")[0]
@@ -92,12 +100,19 @@ def chart_pareto(name, doc, out):
                           textcoords="offset points")
     axes.scatter([], [], marker="*", s=100, color="tab:red", label="accel.type = auto (its choice)")
     axes.set_xscale("log")
+    # The values a reader looks for, not only the decades: 2, 5, 10, 20, 50, 100 ...
+    low, high = axes.get_xlim()
+    ticks = [t for t in (1, 2, 5, 10, 20, 50, 100, 200, 500, 1000) if low <= t <= high]
+    axes.xaxis.set_major_locator(matplotlib.ticker.FixedLocator(ticks))
+    axes.xaxis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
+    axes.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     axes.set_xlabel("bytes per triangle (structure, and the mesh it reads in place)")
     axes.set_ylabel("Mrays/s (median)")
     axes.set_title(f"{scene_name(doc)}: {doc['rays']['kind']} rays, {doc['threads']} threads")
-    axes.legend(fontsize=7, loc="lower right")
+    # Below the axes, where it can hide no point.
+    axes.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2, frameon=False)
     figure.tight_layout()
-    figure.savefig(out / f"{name}.png", dpi=110)
+    figure.savefig(out / f"{name}.png", dpi=110, bbox_inches="tight")
     plt.close(figure)
     return front
 
@@ -244,7 +259,7 @@ def footprint_runs(docs, commands):
         if run.get("section") != "footprint" or stem not in docs:
             continue
         words = run["command"].split()
-        yield stem, stem.split("_")[1], words[words.index("--accel") + 1].strip("'")
+        yield stem, scene_label(stem), words[words.index("--accel") + 1].strip("'")
 
 
 def render_peaks(docs, commands):
@@ -284,7 +299,7 @@ def auto_rows(name, doc, peaks):
     else (earlier JSON) the bench's bytes or build peak, with the whole mesh for compact types."""
     rows = []
     triangles = doc["scene"]["triangles"]
-    label = name.split("_")[1]
+    label = scene_label(name)
     for r in doc["results"]:
         choice = r.get("auto")
         if not choice:
@@ -436,7 +451,7 @@ def main():
            "and the peak measured (VmHWM of a render of its own at the same image size: the footprint runs), against "
            "the fastest setting of the same run whose measured render peak fits the same budget and whose measured "
            f"hit-point error meets the same bound, leaving out leaky ones ({WATERTIGHT_NOTE}). Auto's estimates are "
-           "conservative (the largest bytes per triangle measured on the README's scenes), so it may take a smaller, "
+           "conservative (the largest bytes per triangle measured on docs/memory.md's scenes), so it may take a smaller, "
            "slower setting than the fastest that fits; it ranks the ones that fit by their median speed on these "
            "scenes, divided for chunked ones by a slowdown that grows with the chunk boxes around a triangle.", "",
            "| run | auto | budget | bound | chose | estimate | peak | Mrays/s | fastest that fits | its peak | its Mrays/s "

@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <string_view>
 
-#include "wavetrace/stages/config.hpp"
-#include "wavetrace/stages/render_setup.hpp"
+#include "wavetrace/setup/config.hpp"
+#include "wavetrace/setup/render_setup.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view input(reinterpret_cast<const char*>(data), size);

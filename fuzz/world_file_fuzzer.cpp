@@ -15,7 +15,7 @@
 
 #include "fuzz/fuzz_input_file.hpp"
 #include "wavetrace/memory/section_file_format.hpp"
-#include "wavetrace/stages/world_file.hpp"
+#include "wavetrace/setup/world_file.hpp"
 
 namespace {
 

@@ -9,8 +9,8 @@
 #include <nlohmann/json.hpp>
 
 #include "wavetrace/scene/builtin_scenes.hpp"
-#include "wavetrace/stages/accel_choice.hpp"
-#include "wavetrace/stages/render_setup.hpp"
+#include "wavetrace/setup/accel_choice.hpp"
+#include "wavetrace/setup/render_setup.hpp"
 #include "test_support.hpp"
 
 namespace wavetrace {

@@ -81,5 +81,27 @@ TEST(BenchReport, TheQuickMatrixProducesEveryChartAndTableRow) {
   EXPECT_TRUE(fs::exists(again / "hmq_image.png"));
 }
 
+// A new user's path: any bench JSON, whatever its file is called, charts with --from; and when
+// the chart writer fails, the command shows the writer's own error, not a guess at its cause.
+TEST(BenchReport, FromTakesAnyBenchJsonAndAFailingScriptShowsItsOwnError) {
+  const fs::path dir = fresh_dir("report_any_name");
+  fs::create_directories(dir);
+  const fs::path json = dir / "a.json";
+  const auto bench = testing::run_wavetrace("bench accel --scene builtin:sphere:2000 --accel bvh,hmq --count 2000 "
+                                            "--repeat 1 --json " + json.string());
+  ASSERT_EQ(bench.exit_code, 0) << bench.output;
+  const auto from = testing::run_wavetrace("bench report " + (dir / "out").string() + " --from " + json.string());
+  ASSERT_EQ(from.exit_code, 0) << from.output;
+  EXPECT_NE(read_text(dir / "out" / "report.md").find("](a.png)"), std::string::npos);
+
+  const fs::path broken = dir / "broken_report.py";
+  std::ofstream(broken) << "import sys\nsys.exit('the chart writer broke on purpose')\n";
+  const auto failed = testing::run_wavetrace("bench report " + (dir / "again").string() + " --from " + json.string() +
+                                             " --script " + broken.string());
+  EXPECT_NE(failed.exit_code, 0);
+  EXPECT_NE(failed.output.find("the chart writer broke on purpose"), std::string::npos) << failed.output;
+  EXPECT_EQ(failed.output.find("python3-matplotlib"), std::string::npos) << failed.output;
+}
+
 }  // namespace
 }  // namespace wavetrace

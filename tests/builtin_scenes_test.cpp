@@ -3,6 +3,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "wavetrace/scene/load_scene.hpp"
 #include "wavetrace/scene/builtin_scenes.hpp"
 #include "wavetrace/scene/mesh_report.hpp"
 #include "wavetrace/scene/subdivide.hpp"

@@ -13,7 +13,7 @@
 #include "wavetrace/bench/leak_bench.hpp"
 #include "wavetrace/bench/ray_sets.hpp"
 #include "wavetrace/scene/builtin_scenes.hpp"
-#include "wavetrace/scene/scene.hpp"
+#include "wavetrace/scene/load_scene.hpp"
 #include "test_support.hpp"
 
 namespace wavetrace {

@@ -10,11 +10,11 @@
 #include "wavetrace/accel/chunked/chunked_accelerator.hpp"
 #include "wavetrace/accel/registry.hpp"
 #include "wavetrace/bench/ray_sets.hpp"
-#include "wavetrace/memory/pager.hpp"
+#include "wavetrace/memory/simulated_pager.hpp"
 #include "wavetrace/scene/builtin_scenes.hpp"
-#include "wavetrace/stages/config.hpp"
-#include "wavetrace/stages/render_setup.hpp"
-#include "wavetrace/stages/tracing_arena.hpp"
+#include "wavetrace/setup/config.hpp"
+#include "wavetrace/setup/render_setup.hpp"
+#include "wavetrace/pipeline/tracing_arena.hpp"
 #include "accel_agreement.hpp"
 
 namespace wavetrace {
@@ -112,7 +112,7 @@ TEST(ChunkedWorld, ProbedAnswersAsUnprobedAndReadsOnlyItsWorld) {
   ASSERT_TRUE(chunked->probed());
   const RaySet rays = make_ray_set(RaySetKind::diffuse, scene, *chunked, 4000);
   const auto plain = trace_ray_set(*chunked, rays);
-  Pager pager(chunked->memory_spans(), 16384, MemoryBudget{}, io_preset("nvme"));
+  SimulatedPager pager(chunked->memory_spans(), 16384, MemoryBudget{}, io_preset("nvme"));
   TracingArena arena(1);
   std::vector<std::unique_ptr<HitBatch>> probed;
   arena.execute([&] { probed = trace_ray_set_probed(*chunked, rays, MemoryObservers{&pager, nullptr}); });

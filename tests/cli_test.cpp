@@ -124,6 +124,8 @@ INSTANTIATE_TEST_SUITE_P(
                       BadInput{"render --accel octree", "accel.type = 'octree' is not one of"},
                       BadInput{"render --set render.nope=1", "unknown config key 'render.nope'"},
                       BadInput{"render --set render.spp=-1", "render.spp = -1 is out of range"},
+                      // 0 is no sample at all, not "the default".
+                      BadInput{"render --spp 0", "render.spp = 0 is out of range [1, 65536]"},
                       BadInput{"render --size 10by10", "--size '10by10'"},
                       BadInput{"render --set pipeline.stages=generate,shade", "'shade' needs 'trace'"},
                       BadInput{"render --set camera.look_at=0,2.4,5.8", "look_at equals position"},

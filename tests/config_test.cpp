@@ -1,8 +1,8 @@
 // Config: defaults, TOML files, --set overrides, and every kind of bad input naming its key.
 #include <gtest/gtest.h>
 
-#include "wavetrace/stages/config.hpp"
-#include "wavetrace/stages/render_setup.hpp"
+#include "wavetrace/setup/config.hpp"
+#include "wavetrace/setup/render_setup.hpp"
 #include "test_support.hpp"
 
 namespace wavetrace {

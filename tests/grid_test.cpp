@@ -3,6 +3,7 @@
 // resolution guard, and its memory report.
 #include <gtest/gtest.h>
 
+#include "wavetrace/scene/load_scene.hpp"
 #include "wavetrace/accel/grid/array_grid.hpp"
 #include "wavetrace/accel/grid/hashed_grid.hpp"
 #include "wavetrace/accel/registry.hpp"

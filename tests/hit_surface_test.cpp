@@ -7,8 +7,8 @@
 #include "wavetrace/bench/accel_bench.hpp"
 #include "wavetrace/bench/ray_sets.hpp"
 #include "wavetrace/scene/builtin_scenes.hpp"
-#include "wavetrace/stages/config.hpp"
-#include "wavetrace/stages/render_setup.hpp"
+#include "wavetrace/setup/config.hpp"
+#include "wavetrace/setup/render_setup.hpp"
 #include "wavetrace/stages/trace.hpp"
 
 namespace wavetrace {

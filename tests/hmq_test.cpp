@@ -23,10 +23,10 @@
 #include "wavetrace/bench/ray_sets.hpp"
 #include "wavetrace/scene/builtin_scenes.hpp"
 #include "wavetrace/scene/lights.hpp"
-#include "wavetrace/scene/scene.hpp"
-#include "wavetrace/stages/config.hpp"
+#include "wavetrace/scene/load_scene.hpp"
+#include "wavetrace/setup/config.hpp"
 #include "accel_agreement.hpp"
-#include "wavetrace/stages/render_setup.hpp"
+#include "wavetrace/setup/render_setup.hpp"
 #include "wavetrace/stages/world.hpp"
 
 namespace wavetrace {

@@ -4,7 +4,7 @@
 
 #include "render_support.hpp"
 #include "wavetrace/scene/builtin_scenes.hpp"
-#include "wavetrace/stages/render_setup.hpp"
+#include "wavetrace/setup/render_setup.hpp"
 
 namespace wavetrace {
 namespace {

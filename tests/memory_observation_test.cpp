@@ -9,9 +9,9 @@
 #include "wavetrace/accel/registry.hpp"
 #include "wavetrace/bench/ray_sets.hpp"
 #include "wavetrace/scene/builtin_scenes.hpp"
-#include "wavetrace/stages/memory_observation.hpp"
-#include "wavetrace/stages/render_setup.hpp"
-#include "wavetrace/stages/tracing_arena.hpp"
+#include "wavetrace/pipeline/memory_observation.hpp"
+#include "wavetrace/setup/render_setup.hpp"
+#include "wavetrace/pipeline/tracing_arena.hpp"
 #include "test_support.hpp"
 
 namespace wavetrace {
@@ -37,7 +37,7 @@ struct ProbedPass {
 
 ProbedPass probed_pass(const Accelerator& accelerator, const RaySet& rays, const std::string& budget) {
   const MemoryPlan plan = plan_with({"memory.budget=" + budget, "memory.page_bytes=16384", "memory.cache=l2"});
-  Pager pager(accelerator.memory_spans(), plan.page_bytes, *plan.budget, plan.io);
+  SimulatedPager pager(accelerator.memory_spans(), plan.page_bytes, *plan.budget, plan.io);
   CacheBank caches(*plan.cache, 1);
   ProbedPass pass;
   TracingArena arena(1);

@@ -6,19 +6,23 @@
 
 #include <gtest/gtest.h>
 
-#include "wavetrace/stages/accelerator_spec.hpp"
-#include "wavetrace/stages/render_setup.hpp"
+#include <fstream>
+#include <sstream>
+
+#include "wavetrace/setup/accelerator_spec.hpp"
+#include "wavetrace/setup/config_reference.hpp"
+#include "wavetrace/setup/render_setup.hpp"
 
 namespace wavetrace {
 namespace {
 
-TEST(PlanKeys, EverySchemaKeyHasOneRowAndEveryRowAKey) {
-  std::set<std::string> schema;
-  for (const ConfigKey& key : config_schema()) schema.insert(key.name);
-  std::multiset<std::string> rows;
-  for (const PlanKey& row : plan_keys()) rows.insert(std::string(row.key));
-  for (const std::string& key : schema) EXPECT_EQ(rows.count(key), 1u) << key << " is read by no row, or by two";
-  for (const std::string& row : rows) EXPECT_TRUE(schema.contains(row)) << row << " is not a config key";
+TEST(PlanKeys, EveryKeyIsOneRowWithAReader) {
+  std::multiset<std::string> names;
+  for (const ConfigKey& key : config_schema()) {
+    names.insert(key.name);
+    EXPECT_NE(key.read, nullptr) << key.name << " sets no plan field";
+  }
+  for (const std::string& name : names) EXPECT_EQ(names.count(name), 1u) << name << " has two rows";
 }
 
 TEST(PlanKeys, RowsSetTheFieldsTheyName) {
@@ -53,6 +57,31 @@ TEST(PlanKeys, RowsSetTheFieldsTheyName) {
   EXPECT_EQ(plan.proxy.accelerator.type, "bvh");
   EXPECT_EQ(plan.proxy.accelerator.hmq.leaf_size, 7u);
   EXPECT_EQ(accelerator_options(config).hmq.width, 2u);
+}
+
+// The option structs' own defaults (what a C++ user gets from RenderPlan{}) are the table's:
+// reading any key at its default changes nothing in a default plan.
+TEST(PlanKeys, OptionStructDefaultsEqualTheTable) {
+  const Config defaults;
+  const RenderPlan untouched;
+  for (const ConfigKey& key : config_schema()) {
+    RenderPlan plan;
+    key.read(defaults, key.name, plan);
+    EXPECT_TRUE(plan == untouched) << key.name << "'s default in the table differs from its option struct's";
+  }
+}
+
+// docs/configuration.md is the table printed; regenerate it with `build/wavetrace keys`.
+TEST(PlanKeys, DocsConfigurationIsGeneratedFromTheTable) {
+  std::ifstream file(std::string(WAVETRACE_SOURCE_DIR) + "/docs/configuration.md");
+  ASSERT_TRUE(file) << "docs/configuration.md is missing";
+  std::stringstream text;
+  text << file.rdbuf();
+  EXPECT_TRUE(text.str() == configuration_markdown())
+      << "docs/configuration.md is stale: run build/wavetrace keys > docs/configuration.md";
+  for (const ConfigKey& key : config_schema()) {
+    EXPECT_NE(text.str().find("| `" + key.name + "` |"), std::string::npos) << key.name;
+  }
 }
 
 // --accel's specs, as render, build and bench take them: keys into their sections, and a

@@ -9,7 +9,7 @@
 
 #include "wavetrace/scene/builtin_scenes.hpp"
 #include "wavetrace/scene/ply_file.hpp"
-#include "wavetrace/scene/scene.hpp"
+#include "wavetrace/scene/load_scene.hpp"
 #include "test_support.hpp"
 
 namespace wavetrace {
@@ -58,7 +58,7 @@ TEST(PlyFile, ExportReadsBackToTheBitInAnyOrderOfRanges) {
   const Scene stream = load_scene(stream_request);
   ASSERT_TRUE(stream.streamed());
   EXPECT_EQ(stream.triangle_count, scene.triangle_count);
-  EXPECT_FALSE(is_binary_ply(testing::data_path("sphere.ply"))) << "ASCII PLY stays with OpenMesh";
+  EXPECT_FALSE(is_binary_ply(testing::data_path("sphere.ply"))) << "ASCII PLY goes to the text reader (ply_text_reader.cpp)";
 }
 
 // A little builder of binary PLY bytes.

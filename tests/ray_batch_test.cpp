@@ -1,5 +1,7 @@
 // Ray and hit batch layout: alignment, capacity, optional columns, pooling.
 #include <cstdint>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -60,6 +62,34 @@ TEST(RayBatch, OptionalColumnsAppearOnRequestAndCopy) {
   EXPECT_EQ(target.approx_hit_z[0], 4.5f);
   EXPECT_EQ(target.sort_key[0], 0x123456789ull);
   EXPECT_EQ(target.pixel[0], 77u);
+}
+
+// The column lists are the one declaration: the visitor sees every present column once, in
+// layout order, and the bytes a ray costs are the sum of its columns' element sizes.
+TEST(RayBatch, ColumnVisitorAndBytesFollowTheOneList) {
+  RayBatch rays(8);
+  std::size_t columns = 0, bytes = 0;
+  const auto count = [&](const char*, void* column, std::size_t element_bytes) {
+    EXPECT_TRUE(aligned(column));
+    ++columns;
+    bytes += element_bytes;
+  };
+  rays.for_each_column(count);
+  EXPECT_EQ(columns, 16u);
+  EXPECT_EQ(bytes, RayBatch::kBytesPerRay);
+  EXPECT_EQ(RayBatch::kBytesPerRay, 13 * 4 + 2 + 1 + 1u);
+  rays.enable_approx_hit();
+  rays.enable_sort_key();
+  columns = bytes = 0;
+  rays.for_each_column(count);
+  EXPECT_EQ(columns, 20u);
+  EXPECT_EQ(bytes, RayBatch::kBytesPerRay + RayBatch::kApproxHitBytesPerRay + RayBatch::kSortKeyBytesPerRay);
+  EXPECT_EQ(HitBatch::kBytesPerHit, 11 * 4u);
+  // The visitor names the columns as the class does, first to last.
+  std::vector<std::string> names;
+  rays.for_each_column([&](const char* name, void*, std::size_t) { names.emplace_back(name); });
+  EXPECT_EQ(names.front(), "origin_x");
+  EXPECT_EQ(names.back(), "sort_key");
 }
 
 TEST(BatchPool, ReusesReleasedBatches) {

@@ -18,8 +18,8 @@
 #include "wavetrace/bench/leak_bench.hpp"
 #include "wavetrace/bench/ray_sets.hpp"
 #include "wavetrace/scene/builtin_scenes.hpp"
-#include "wavetrace/scene/scene.hpp"
-#include "wavetrace/stages/config.hpp"
+#include "wavetrace/scene/load_scene.hpp"
+#include "wavetrace/setup/config.hpp"
 #include "accel_agreement.hpp"
 
 namespace wavetrace {

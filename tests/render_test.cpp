@@ -10,7 +10,7 @@
 #include "wavetrace/accel/registry.hpp"
 #include "wavetrace/scene/builtin_scenes.hpp"
 #include "wavetrace/scene/lights.hpp"
-#include "wavetrace/stages/render_setup.hpp"
+#include "wavetrace/setup/render_setup.hpp"
 
 namespace wavetrace {
 namespace {

@@ -18,7 +18,7 @@
 #include "wavetrace/kernels/space_filling_curve.hpp"
 #include "wavetrace/scene/builtin_scenes.hpp"
 #include "wavetrace/scene/lights.hpp"
-#include "wavetrace/stages/render_setup.hpp"
+#include "wavetrace/setup/render_setup.hpp"
 #include "wavetrace/stages/zsort.hpp"
 #include "collecting_output.hpp"
 

@@ -13,7 +13,7 @@
 #include "wavetrace/scene/lights.hpp"
 #include "wavetrace/scene/mesh_report.hpp"
 #include "wavetrace/scene/shapes.hpp"
-#include "wavetrace/stages/render_setup.hpp"
+#include "wavetrace/setup/render_setup.hpp"
 #include "render_support.hpp"
 #include "test_support.hpp"
 

@@ -6,13 +6,14 @@
 
 #include <glm/geometric.hpp>
 
+#include "wavetrace/scene/load_scene.hpp"
 #include "wavetrace/accel/registry.hpp"
 #include "wavetrace/scene/builtin_scenes.hpp"
 #include "wavetrace/scene/lights.hpp"
 #include "wavetrace/scene/object_transform.hpp"
 #include "wavetrace/scene/scene_file.hpp"
 #include "wavetrace/scene/subdivide.hpp"
-#include "wavetrace/stages/render_setup.hpp"
+#include "wavetrace/setup/render_setup.hpp"
 #include "test_support.hpp"
 
 namespace wavetrace {
@@ -184,7 +185,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadScene{"[[light]]\ncorner = [0, 0, 0]\nedge_u = [1, 0, 0]\n", "light #1: 'edge_v' is required"},
         BadScene{"lights = 3\n", "unknown key 'lights'"}, BadScene{"background = 1\n", "the scene has no [[object]]"},
         BadScene{"[camera]\nposition = [0, 0, 0]\nlook_at = [0, 0, 0]\n[[object]]\nmesh = \"tetrahedron.off\"\n",
-                 "camera: "},
+                 ".toml: camera: look_at equals position"},
         BadScene{"[[object]\nmesh = 1\n", ".toml:1:"}),
     [](const ::testing::TestParamInfo<BadScene>& info) { return "case" + std::to_string(info.index); });
 

@@ -14,8 +14,8 @@
 #include "wavetrace/bench/leak_bench.hpp"
 #include "wavetrace/bench/ray_sets.hpp"
 #include "wavetrace/scene/builtin_scenes.hpp"
-#include "wavetrace/scene/scene.hpp"
-#include "wavetrace/stages/render_setup.hpp"
+#include "wavetrace/scene/load_scene.hpp"
+#include "wavetrace/setup/render_setup.hpp"
 #include "test_support.hpp"
 
 namespace wavetrace {

@@ -19,8 +19,8 @@
 #include "wavetrace/memory/section_writer.hpp"
 #include "wavetrace/scene/builtin_scenes.hpp"
 #include "wavetrace/scene/lights.hpp"
-#include "wavetrace/stages/render_setup.hpp"
-#include "wavetrace/stages/world_file.hpp"
+#include "wavetrace/setup/render_setup.hpp"
+#include "wavetrace/setup/world_file.hpp"
 #include "test_support.hpp"
 
 namespace wavetrace {

@@ -16,7 +16,7 @@
 
 #include <wavetrace/kernels/random.hpp>
 #include <wavetrace/kernels/sampling.hpp>
-#include <wavetrace/stages/render_setup.hpp>
+#include <wavetrace/setup/render_setup.hpp>
 #include <wavetrace/stages/stage.hpp>
 
 namespace {

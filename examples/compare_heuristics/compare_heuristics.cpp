@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include <wavetrace/stages/render_setup.hpp>
+#include <wavetrace/setup/render_setup.hpp>
 
 int main(int argc, char** argv) {
   using namespace wavetrace;

@@ -9,11 +9,11 @@
 
 #include <wavetrace/accel/registry.hpp>
 #include <wavetrace/scene/lights.hpp>
-#include <wavetrace/scene/scene.hpp>
+#include <wavetrace/scene/load_scene.hpp>
 #include <wavetrace/stages/approx_hit.hpp>
 #include <wavetrace/stages/generate.hpp>
-#include <wavetrace/stages/pipeline.hpp>
-#include <wavetrace/stages/render_setup.hpp>
+#include <wavetrace/pipeline/pipeline.hpp>
+#include <wavetrace/setup/render_setup.hpp>
 #include <wavetrace/stages/trace.hpp>
 
 using namespace wavetrace;

@@ -1,8 +1,11 @@
 // Accelerators by name, as config files, --accel and the bench harness name them.
 #pragma once
 
+#include <array>
 #include <memory>
+#include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "wavetrace/accel/accelerator.hpp"
@@ -17,6 +20,8 @@
 
 namespace wavetrace {
 
+class SectionLoader;
+
 struct AcceleratorOptions {
   std::string type = "embree";
   EmbreeOptions embree;
@@ -28,8 +33,57 @@ struct AcceleratorOptions {
   HmqOptions hmq;
   // Scenes of more triangles are built in chunks of at most this many (hmq, raystrips, bvh).
   std::size_t chunk_triangles = std::size_t{1} << 22;
+  bool operator==(const AcceleratorOptions&) const = default;
 };
 
+// Why accel.type = auto passes a type over on a scene, however fast: the cases where the
+// method is known to fail (bench report's stability table measures each).
+enum class KnownFailure {
+  none,
+  triangle_soup,  // strips of one triangle each: no vertex shared
+  crowded_cells,  // a grid whose every cell holds many triangles (a dense object in a huge box)
+};
+
+// How accel.type = auto (setup/accel_choice.hpp) sees a type.
+struct AutoCandidate {
+  // Its setting's median speed against robust Embree's on bench report's scenes; 0: never a
+  // candidate (the binary layouts, slower at no fewer bytes; grid, slower than mlgrid at the
+  // same bytes; arraygrid, larger).
+  double relative_speed = 0.0;
+  // The setting auto builds (widths, modes; max_error for a lossy type) and its --accel spec.
+  void (*set_up)(AcceleratorOptions& options, double max_error) = nullptr;
+  std::string (*spec)(double max_error) = nullptr;
+  bool lossy = false;                        // hit points within max_error of the mesh, not exact
+  bool structure_from_grid_entries = false;  // its bytes follow the grid entries a triangle makes
+  bool grows_in_sparse_chunks = false;       // in chunks that share few edges its bytes grow
+  KnownFailure failure = KnownFailure::none;
+};
+
+// One row of facts per accelerator type: the only place a type's name is compared.
+struct AcceleratorType {
+  std::string_view name;
+  std::unique_ptr<Accelerator> (*make)(const TriangleMesh& mesh, const AcceleratorOptions& options);
+  // A structure saved under the loader's prefix with one of `saved_kinds` (SavedKind::type),
+  // traced in place; null: the type saves no structure, and a world file rebuilds it from the
+  // saved geometry when loaded.
+  std::unique_ptr<Accelerator> (*load)(SectionLoader& in, std::string_view kind);
+  std::array<std::string_view, 2> saved_kinds;
+  bool builds_in_chunks;    // chunk by chunk under a top-level BVH (make_world_accelerator)
+  bool holds_own_geometry;  // traces no reference to the input mesh, which can then be released
+  // What its finished structure costs per triangle (the most measured on the scenes of
+  // docs/memory.md), and what its build holds beyond it per triangle built at once (a chunk,
+  // where it builds in chunks): for refusing a scene that will not fit, and for auto.
+  double (*bytes_per_triangle)(const AcceleratorOptions& options);
+  double build_bytes_per_triangle;
+  AutoCandidate automatic;
+};
+
+// Every type, in the order config files and error messages list them.
+std::span<const AcceleratorType> accelerator_types();
+// The row of `name`, or null (accel.type = auto names no type of its own).
+const AcceleratorType* find_accelerator_type(std::string_view name);
+// The row of `name`; throws std::invalid_argument naming the known types.
+const AcceleratorType& accelerator_type(std::string_view name);
 std::vector<std::string> accelerator_names();
 
 // Throws std::invalid_argument naming an unknown type.
@@ -37,24 +91,14 @@ std::unique_ptr<Accelerator> make_accelerator(const TriangleMesh& mesh, const Ac
 
 // The accelerator saved under the loader's prefix (its "kind" names the type), traced in
 // place; throws SectionFileError for a type that cannot be loaded or a damaged structure.
-class SectionLoader;
 std::unique_ptr<Accelerator> load_accelerator(SectionLoader& in);
-// Types whose built structure can be saved and traced in place from a world file; the
-// others (embree, the grids) are rebuilt from the world's saved geometry when it is loaded.
-bool saves_structure(const std::string& type);
 
-// What an accelerator's finished structure costs per triangle (the most measured on the
-// README's scenes), and what its build holds beyond it per triangle built at once (a chunk,
-// where the type builds in chunks; README, "Memory at scale"): for refusing a scene that will
-// not fit, and for accel.type = auto, before building it.
+// The row's facts by name; false for a name that is no type (auto).
+bool saves_structure(std::string_view type);
+bool builds_in_chunks(std::string_view type);
+bool holds_own_geometry(std::string_view type);
 double estimated_bytes_per_triangle(const AcceleratorOptions& options);
-double estimated_build_bytes_per_triangle(const std::string& type);
-
-// Types that can be built chunk by chunk under a top-level BVH.
-bool builds_in_chunks(const std::string& type);
-// Types whose structure holds the geometry it traces (no reference to the input mesh), so
-// the mesh can be released once they are built and need never exist whole.
-bool holds_own_geometry(const std::string& type);
+double estimated_build_bytes_per_triangle(std::string_view type);
 
 // The world's accelerator over a scene's triangles: chunked (make_chunked_accelerator) when
 // the type builds in chunks and the source has more than options.chunk_triangles, else one

@@ -1,4 +1,5 @@
 // Builds, times and checks each accelerator against the Embree reference.
+#include "wavetrace/bench/json_fields.hpp"
 #include "wavetrace/bench/accel_bench.hpp"
 
 #include <algorithm>
@@ -9,8 +10,8 @@
 #include <glm/geometric.hpp>
 
 #include "wavetrace/memory/process_memory.hpp"
-#include "wavetrace/stages/render_setup.hpp"
-#include "wavetrace/stages/tracing_arena.hpp"
+#include "wavetrace/setup/render_setup.hpp"
+#include "wavetrace/pipeline/tracing_arena.hpp"
 
 namespace wavetrace {
 namespace {
@@ -55,7 +56,7 @@ AcceleratorSpec parse_accelerator_spec(const std::string& text, const Config& ba
 }
 
 void resolve_accelerator_spec(AcceleratorSpec& spec, const Scene& scene, const Config& base) {
-  if (!spec.goal.automatic && !(spec.goal.hmq_epsilon_pixel && spec.options.type == "hmq")) return;
+  if (!spec.goal.automatic && !pixel_epsilon_applies(spec.options, spec.goal)) return;
   if (scene.streamed()) throw ConfigError(fmt::format("--accel {}: needs the scene's mesh", spec.label));
   const RenderPlan plan = plan_render(base);
   const MeshTriangleSource source(scene.mesh);
@@ -226,9 +227,6 @@ nlohmann::json memory_runs_json(const AccelBenchReport& report, const AccelBench
 nlohmann::json to_json(const AccelBenchReport& report) {
   nlohmann::json results = nlohmann::json::array();
   for (const AccelBenchResult& r : report.results) {
-    const auto optional = [](const std::optional<double>& value) {
-      return value ? nlohmann::json(*value) : nlohmann::json(nullptr);
-    };
     results.push_back({{"accel", r.label},
                        {"bytes", r.memory.total()},
                        {"bytes_per_triangle", r.bytes_per_triangle},
@@ -240,11 +238,11 @@ nlohmann::json to_json(const AccelBenchReport& report) {
                        {"mrays_per_s", r.mrays_per_s},
                        {"mrays_per_s_runs", r.mrays_per_s_runs},
                        {"hit_agreement", r.hit_agreement},
-                       {"prim_agreement", optional(r.prim_agreement)},
-                       {"surface_error_max", optional(r.surface_error_max)},
-                       {"vertex_error_max", optional(r.vertex_error_max)},
-                       {"t_error_max", optional(r.t_error_max)},
-                       {"t_error_mean", optional(r.t_error_mean)},
+                       {"prim_agreement", json_or_null(r.prim_agreement)},
+                       {"surface_error_max", json_or_null(r.surface_error_max)},
+                       {"vertex_error_max", json_or_null(r.vertex_error_max)},
+                       {"t_error_max", json_or_null(r.t_error_max)},
+                       {"t_error_mean", json_or_null(r.t_error_mean)},
                        {"memory_runs", memory_runs_json(report, r)},
                        {"auto", r.auto_choice ? to_json(*r.auto_choice) : nlohmann::json(nullptr)}});
   }

@@ -11,10 +11,10 @@
 #include "wavetrace/accel/registry.hpp"
 #include "wavetrace/bench/ray_sets.hpp"
 #include "wavetrace/scene/scene.hpp"
-#include "wavetrace/stages/accel_choice.hpp"
-#include "wavetrace/stages/accelerator_spec.hpp"
-#include "wavetrace/stages/config.hpp"
-#include "wavetrace/stages/memory_observation.hpp"
+#include "wavetrace/setup/accel_choice.hpp"
+#include "wavetrace/setup/accelerator_spec.hpp"
+#include "wavetrace/setup/config.hpp"
+#include "wavetrace/pipeline/memory_observation.hpp"
 
 namespace wavetrace {
 
@@ -90,7 +90,7 @@ struct AccelBenchRequest {
   int threads = 0;
   int repeats = 3;
   bool packets = false;  // primary rays through intersect_coherent (packets where an accelerator has them)
-  // Pager settings and cache; `budgets` (e.g. "100%", "20%") replace memory.budget when given.
+  // The simulated pager's settings and cache; `budgets` (e.g. "100%", "20%") replace memory.budget when given.
   MemoryPlan memory;
   std::vector<std::string> budgets;
   // A saved world (bench accel --scene FILE.wtw): measured instead of `accelerators`, with

@@ -1,5 +1,6 @@
 // Renders one image per accelerator with identical settings (renders are deterministic, so
 // any difference is the accelerator's) and measures each against the first.
+#include "wavetrace/scene/load_scene.hpp"
 #include "wavetrace/bench/image_bench.hpp"
 
 #include <algorithm>
@@ -8,7 +9,7 @@
 #include <fmt/format.h>
 
 #include "wavetrace/scene/lights.hpp"
-#include "wavetrace/stages/render_setup.hpp"
+#include "wavetrace/setup/render_setup.hpp"
 
 namespace wavetrace {
 

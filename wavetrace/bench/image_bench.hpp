@@ -9,7 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "wavetrace/bench/accel_bench.hpp"
-#include "wavetrace/stages/config.hpp"
+#include "wavetrace/setup/config.hpp"
 
 namespace wavetrace {
 

@@ -12,8 +12,8 @@
 #include "wavetrace/kernels/random.hpp"
 #include "wavetrace/kernels/sampling.hpp"
 #include "wavetrace/scene/mesh_report.hpp"
-#include "wavetrace/stages/render_setup.hpp"
-#include "wavetrace/stages/tracing_arena.hpp"
+#include "wavetrace/setup/render_setup.hpp"
+#include "wavetrace/pipeline/tracing_arena.hpp"
 
 namespace wavetrace {
 namespace {

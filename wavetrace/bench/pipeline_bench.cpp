@@ -1,5 +1,6 @@
 // One world, every mode and heuristic rendered `repeats` times at each thread count,
 // interleaved so that the machine's drift falls on all rows alike.
+#include "wavetrace/bench/json_fields.hpp"
 #include "wavetrace/bench/pipeline_bench.hpp"
 
 #include <algorithm>
@@ -9,7 +10,7 @@
 #include <fmt/format.h>
 
 #include "wavetrace/bench/render_world.hpp"
-#include "wavetrace/stages/render_setup.hpp"
+#include "wavetrace/setup/render_setup.hpp"
 
 namespace wavetrace {
 namespace {
@@ -127,7 +128,6 @@ PipelineBenchReport run_pipeline_bench(const Config& config, const PipelineBench
 }
 
 nlohmann::json to_json(const PipelineBenchReport& report) {
-  const auto optional = [](const auto& value) { return value ? nlohmann::json(*value) : nlohmann::json(nullptr); };
   nlohmann::json results = nlohmann::json::array();
   for (const PipelineBenchResult& r : report.results) {
     nlohmann::json stages = nlohmann::json::array();
@@ -147,9 +147,9 @@ nlohmann::json to_json(const PipelineBenchReport& report) {
                        {"rays_traced", r.rays_traced},
                        {"mrays_per_s", r.mrays_per_s},
                        {"stages", stages},
-                       {"outside_trace_share", optional(r.outside_trace_share)},
+                       {"outside_trace_share", json_or_null(r.outside_trace_share)},
                        {"speed_vs_megakernel", r.speed_vs_megakernel},
-                       {"thread_scaling", optional(r.thread_scaling)},
+                       {"thread_scaling", json_or_null(r.thread_scaling)},
                        {"image_identical", r.image_identical},
                        {"pixels_differing", r.pixels_differing},
                        {"image_difference", r.image_difference}});
@@ -157,7 +157,7 @@ nlohmann::json to_json(const PipelineBenchReport& report) {
   return {{"scene", {{"source", report.scene}, {"triangles", report.triangles}}},
           {"accel", report.accel},
           {"image", report.image},
-          {"proxy", optional(report.proxy)},
+          {"proxy", json_or_null(report.proxy)},
           {"results", results}};
 }
 

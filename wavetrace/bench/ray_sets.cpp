@@ -15,7 +15,7 @@
 #include "wavetrace/kernels/ray_offset.hpp"
 #include "wavetrace/kernels/sampling.hpp"
 #include "wavetrace/scene/lights.hpp"
-#include "wavetrace/stages/render_setup.hpp"
+#include "wavetrace/setup/render_setup.hpp"
 
 namespace wavetrace {
 namespace {

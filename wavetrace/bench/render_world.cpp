@@ -1,4 +1,5 @@
 // Opening or building a benchmark's world once.
+#include "wavetrace/scene/load_scene.hpp"
 #include "wavetrace/bench/render_world.hpp"
 
 #include <fmt/format.h>

@@ -9,9 +9,9 @@
 #include "wavetrace/accel/proxy/proxy.hpp"
 #include "wavetrace/scene/lights.hpp"
 #include "wavetrace/scene/scene.hpp"
-#include "wavetrace/stages/render_setup.hpp"
+#include "wavetrace/setup/render_setup.hpp"
 #include "wavetrace/stages/world.hpp"
-#include "wavetrace/stages/world_file.hpp"
+#include "wavetrace/setup/world_file.hpp"
 
 namespace wavetrace {
 

@@ -1,10 +1,11 @@
 // One scene, accelerator and proxy shared by every heuristic's render.
+#include "wavetrace/bench/json_fields.hpp"
 #include "wavetrace/bench/reorder_bench.hpp"
 
 #include <fmt/format.h>
 
 #include "wavetrace/bench/render_world.hpp"
-#include "wavetrace/stages/render_setup.hpp"
+#include "wavetrace/setup/render_setup.hpp"
 
 namespace wavetrace {
 namespace {
@@ -113,7 +114,6 @@ ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<Reo
 }
 
 nlohmann::json to_json(const ReorderBenchReport& report) {
-  const auto optional = [](const auto& value) { return value ? nlohmann::json(*value) : nlohmann::json(nullptr); };
   nlohmann::json results = nlohmann::json::array();
   for (const ReorderBenchResult& r : report.results) {
     results.push_back({{"heuristic", r.heuristic},
@@ -127,13 +127,13 @@ nlohmann::json to_json(const ReorderBenchReport& report) {
                        {"overhead_share", r.overhead_share},
                        {"rays_traced", r.rays_traced},
                        {"rays_retired_by_approx_hit", r.rays_retired_by_approx_hit},
-                       {"page_faults", optional(r.page_faults)},
-                       {"bytes_loaded", optional(r.bytes_loaded)},
-                       {"simulated_io_seconds", optional(r.simulated_io_seconds)},
-                       {"cache_misses", optional(r.cache_misses)},
-                       {"disk_faults", optional(r.disk_faults)},
-                       {"disk_bytes_read", optional(r.disk_bytes_read)},
-                       {"disk_read_seconds", optional(r.disk_read_seconds)},
+                       {"page_faults", json_or_null(r.page_faults)},
+                       {"bytes_loaded", json_or_null(r.bytes_loaded)},
+                       {"simulated_io_seconds", json_or_null(r.simulated_io_seconds)},
+                       {"cache_misses", json_or_null(r.cache_misses)},
+                       {"disk_faults", json_or_null(r.disk_faults)},
+                       {"disk_bytes_read", json_or_null(r.disk_bytes_read)},
+                       {"disk_read_seconds", json_or_null(r.disk_read_seconds)},
                        {"image_identical", r.image_identical}});
   }
   return {{"scene", {{"source", report.scene}, {"triangles", report.triangles}}},
@@ -141,7 +141,7 @@ nlohmann::json to_json(const ReorderBenchReport& report) {
           {"curve", report.curve},
           {"image", report.image},
           {"threads", report.threads},
-          {"proxy", optional(report.proxy)},
+          {"proxy", json_or_null(report.proxy)},
           {"memory", report.memory},
           {"world_bytes", report.world_bytes},
           {"page_count", report.page_count},

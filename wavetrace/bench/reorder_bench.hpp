@@ -10,7 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "wavetrace/stages/config.hpp"
+#include "wavetrace/setup/config.hpp"
 #include "wavetrace/stages/reorder_keys.hpp"
 
 namespace wavetrace {

@@ -18,6 +18,7 @@ struct CacheGeometry {
   std::size_t capacity_bytes = 0;
   std::size_t ways = 1;
   std::size_t sets() const { return capacity_bytes / (line_bytes * ways); }
+  bool operator==(const CacheGeometry&) const = default;
 };
 // "paper_l2" (6 MiB, 24-way), "l1d" (32 KiB, 8-way), "l2" (512 KiB, 8-way); 64-byte lines.
 // Throws std::invalid_argument naming the known presets.

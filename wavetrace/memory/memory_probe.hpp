@@ -11,7 +11,7 @@
 
 #include "wavetrace/memory/cache_simulator.hpp"
 #include "wavetrace/memory/file_pager.hpp"
-#include "wavetrace/memory/pager.hpp"
+#include "wavetrace/memory/simulated_pager.hpp"
 
 namespace wavetrace {
 
@@ -23,7 +23,7 @@ struct NullProbe {
 // What a run observes: the shared page pool and one simulated cache per thread, each
 // optional. `client` numbers the stage whose reads are counted apart.
 struct MemoryObservers {
-  Pager* pager = nullptr;
+  SimulatedPager* pager = nullptr;
   CacheBank* caches = nullptr;
   FilePager* file_pager = nullptr;  // real paging: reads keep its LRU order and load its pages
   bool any() const { return pager != nullptr || caches != nullptr || file_pager != nullptr; }
@@ -71,7 +71,7 @@ class RecordingProbe {
   // A read of the page this thread read last needs no LRU update: it is still the most
   // recent page (exactly so with one thread; with more, another thread may have moved it).
   void read_page(std::uint32_t page) {
-    if (page == last_page_ && page != Pager::kNoPage) {
+    if (page == last_page_ && page != SimulatedPager::kNoPage) {
       ++repeated_page_reads_;
       return;
     }
@@ -79,14 +79,14 @@ class RecordingProbe {
     last_page_ = page;
   }
 
-  Pager* pager_;
+  SimulatedPager* pager_;
   CacheSimulator* cache_;
   FilePager* file_pager_;
   std::size_t client_;
   unsigned file_page_shift_ = 0;
   std::uintptr_t last_file_page_ = ~std::uintptr_t{0};
   std::optional<FilePager::ClientScope> client_scope_;
-  std::uint32_t last_page_ = Pager::kNoPage;
+  std::uint32_t last_page_ = SimulatedPager::kNoPage;
   std::uint64_t repeated_page_reads_ = 0;
 };
 

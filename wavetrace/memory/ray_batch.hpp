@@ -25,6 +25,26 @@ inline constexpr std::uint8_t missed_scene_box = 1u << 1;
 inline constexpr std::uint8_t continues = 1u << 2;  // shade kept the path going: spawn bounces it
 }  // namespace ray_flags
 
+// The columns, declared once (pbrt-v4's workitems.soa habit): each X(type, name) is a column
+// of `capacity` elements. Layout (one 64-byte-aligned slice per column, in this order),
+// copying a ray, the bytes a ray costs and the column visitors (for_each_column) all follow
+// from these lists; adding a column is one line here.
+#define WAVETRACE_RAY_COLUMNS(X)                                                                     \
+  X(float, origin_x) X(float, origin_y) X(float, origin_z)                                             \
+  X(float, direction_x) X(float, direction_y) X(float, direction_z)                                    \
+  X(float, tmin) X(float, tmax) X(std::uint32_t, pixel) X(std::uint32_t, sample) X(std::uint16_t, depth) \
+  X(RayKind, kind) X(float, throughput_r) X(float, throughput_g) X(float, throughput_b) X(std::uint8_t, flags)
+// Optional ray columns, allocated on first request (approx_hit's points, zsort's keys).
+#define WAVETRACE_APPROX_HIT_COLUMNS(X) X(float, approx_hit_x) X(float, approx_hit_y) X(float, approx_hit_z)
+#define WAVETRACE_SORT_KEY_COLUMNS(X) X(std::uint64_t, sort_key)
+#define WAVETRACE_HIT_COLUMNS(X)                                                                     \
+  X(float, t) X(std::uint32_t, primitive) X(float, u) X(float, v)                                      \
+  X(float, point_x) X(float, point_y) X(float, point_z) X(float, normal_x) X(float, normal_y)           \
+  X(float, normal_z) X(std::uint32_t, material)
+
+#define WAVETRACE_COLUMN_POINTER(type, name) type* name = nullptr;
+#define WAVETRACE_COLUMN_BYTES(type, name) +sizeof(type)
+
 // A half-open range of ray indices inside one batch: the unit accelerators answer.
 struct RayRange {
   std::uint32_t begin = 0;
@@ -39,33 +59,33 @@ class RayBatch {
   std::size_t capacity() const { return capacity_; }
   std::size_t count = 0;
 
-  // Always present.
-  float* origin_x;
-  float* origin_y;
-  float* origin_z;
-  float* direction_x;
-  float* direction_y;
-  float* direction_z;
-  float* tmin;
-  float* tmax;
-  std::uint32_t* pixel;
-  std::uint32_t* sample;
-  std::uint16_t* depth;
-  RayKind* kind;
-  float* throughput_r;
-  float* throughput_g;
-  float* throughput_b;
-  std::uint8_t* flags;
+  // Always present (WAVETRACE_RAY_COLUMNS): origin, direction, [tmin, tmax], pixel, sample,
+  // depth, kind, throughput, flags.
+  WAVETRACE_RAY_COLUMNS(WAVETRACE_COLUMN_POINTER)
 
   // Optional columns, allocated on first request and kept when a pooled batch is reused.
   bool has_approx_hit() const { return approx_hit_x != nullptr; }
   void enable_approx_hit();
   bool has_sort_key() const { return sort_key != nullptr; }
   void enable_sort_key();
-  float* approx_hit_x = nullptr;
-  float* approx_hit_y = nullptr;
-  float* approx_hit_z = nullptr;
-  std::uint64_t* sort_key = nullptr;
+  WAVETRACE_APPROX_HIT_COLUMNS(WAVETRACE_COLUMN_POINTER)
+  WAVETRACE_SORT_KEY_COLUMNS(WAVETRACE_COLUMN_POINTER)
+
+  // Bytes one ray holds in the always-present columns, and in each optional set.
+  static constexpr std::size_t kBytesPerRay = 0 WAVETRACE_RAY_COLUMNS(WAVETRACE_COLUMN_BYTES);
+  static constexpr std::size_t kApproxHitBytesPerRay = 0 WAVETRACE_APPROX_HIT_COLUMNS(WAVETRACE_COLUMN_BYTES);
+  static constexpr std::size_t kSortKeyBytesPerRay = 0 WAVETRACE_SORT_KEY_COLUMNS(WAVETRACE_COLUMN_BYTES);
+
+  // Calls visit(name, column, element_bytes) for every present column, in layout order: what
+  // copies, writes or reads whole columns needs, without a list of its own.
+  template <typename Visit>
+  void for_each_column(Visit&& visit) {
+#define WAVETRACE_VISIT(type, name) visit(#name, static_cast<void*>(name), sizeof(type));
+    WAVETRACE_RAY_COLUMNS(WAVETRACE_VISIT)
+    if (has_approx_hit()) { WAVETRACE_APPROX_HIT_COLUMNS(WAVETRACE_VISIT) }
+    if (has_sort_key()) { WAVETRACE_SORT_KEY_COLUMNS(WAVETRACE_VISIT) }
+#undef WAVETRACE_VISIT
+  }
 
   // Writes a ray's origin, direction and [tmin, tmax]; other columns are untouched.
   void set_geometry(std::size_t i, const glm::vec3& origin, const glm::vec3& direction, float ray_tmin, float ray_tmax) {
@@ -100,20 +120,12 @@ class HitBatch {
   explicit HitBatch(std::size_t capacity = kDefaultBatchCapacity);
   std::size_t capacity() const { return capacity_; }
 
-  float* t;
-  std::uint32_t* primitive;  // kInvalidPrimitive on a miss
-  float* u;
-  float* v;
-  // Closest hits only: a + (b - a) u + (c - a) v and cross(b - a, c - a) of the hit
-  // triangle's corners a, b, c in the mesh's winding (unnormalized: its direction gives the
-  // front face); the material index of the triangle.
-  float* point_x;
-  float* point_y;
-  float* point_z;
-  float* normal_x;
-  float* normal_y;
-  float* normal_z;
-  std::uint32_t* material;
+  // WAVETRACE_HIT_COLUMNS: t, primitive (kInvalidPrimitive on a miss), u, v; closest hits
+  // only: a + (b - a) u + (c - a) v and cross(b - a, c - a) of the hit triangle's corners a,
+  // b, c in the mesh's winding (unnormalized: its direction gives the front face), and the
+  // material index of the triangle.
+  WAVETRACE_HIT_COLUMNS(WAVETRACE_COLUMN_POINTER)
+  static constexpr std::size_t kBytesPerHit = 0 WAVETRACE_HIT_COLUMNS(WAVETRACE_COLUMN_BYTES);
 
   bool is_hit(std::size_t ray) const { return primitive[ray] != kInvalidPrimitive; }
   void set_hit(std::size_t ray, float hit_t, std::uint32_t hit_primitive, float hit_u, float hit_v) {

@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "wavetrace/memory/file_pager.hpp"
-#include "wavetrace/memory/pager.hpp"
+#include "wavetrace/memory/memory_budget.hpp"
 #include "wavetrace/memory/section_file_format.hpp"
 
 namespace wavetrace {
@@ -23,12 +23,6 @@ namespace wavetrace {
 class SectionFileError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
-};
-
-struct PagingRequest {
-  std::size_t page_bytes = std::size_t{128} << 10;
-  MemoryBudget budget;  // a share of the file's bytes, or bytes
-  std::size_t clients = 1;
 };
 
 struct SectionInfo {

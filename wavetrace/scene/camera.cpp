@@ -13,13 +13,13 @@ namespace wavetrace {
 
 void validate_camera(const Camera& camera) {
   const glm::vec3 forward = camera.look_at - camera.position;
-  if (glm::dot(forward, forward) == 0.0f) throw SceneError("camera: look_at equals position");
-  if (glm::dot(camera.up, camera.up) == 0.0f) throw SceneError("camera: up is a zero vector");
+  if (glm::dot(forward, forward) == 0.0f) throw SceneError("look_at equals position");
+  if (glm::dot(camera.up, camera.up) == 0.0f) throw SceneError("up is a zero vector");
   if (glm::length(glm::cross(glm::normalize(forward), glm::normalize(camera.up))) < 1e-6f) {
-    throw SceneError("camera: up is parallel to the viewing direction");
+    throw SceneError("up is parallel to the viewing direction");
   }
   if (!(camera.vertical_fov_degrees > 0.0f && camera.vertical_fov_degrees < 180.0f)) {
-    throw SceneError(fmt::format("camera: fov {} is outside (0, 180) degrees", camera.vertical_fov_degrees));
+    throw SceneError(fmt::format("fov {} is outside (0, 180) degrees", camera.vertical_fov_degrees));
   }
 }
 

@@ -8,23 +8,12 @@
 #include <new>
 
 #include <fmt/format.h>
-#include <OpenMesh/Core/System/omstream.hh>
 
 #include "wavetrace/scene/mesh_readers.hpp"
 #include "wavetrace/scene/ply_file.hpp"
 #include "wavetrace/scene/text_lines.hpp"
 
 namespace wavetrace {
-
-void silence_openmesh_logs() {
-  static const bool silenced = [] {
-    omlog().disable();
-    omout().disable();
-    omerr().disable();
-    return true;
-  }();
-  (void)silenced;
-}
 
 void add_polygon(LoadedMesh& out, std::span<const std::uint32_t> corners) {
   if (corners.size() > 3) ++out.polygons_triangulated;

@@ -4,24 +4,14 @@
 
 #include <string>
 
-#include "wavetrace/scene/triangle_mesh.hpp"
+#include "wavetrace/scene/loaded_mesh.hpp"
 
 namespace wavetrace {
-
-struct LoadedMesh {
-  TriangleMesh mesh;
-  std::size_t polygons_triangulated = 0;  // faces of more than 3 corners, fanned into triangles
-  MeshCleanup cleanup;
-};
 
 // Reads every face of the file as written (non-manifold faces included, which OpenMesh's
 // own mesh kernels would drop), fans polygons into triangles, then validates and cleans.
 // Throws SceneError naming the file (and the line, for text formats) on a missing,
 // unreadable or malformed file, and naming the file and its size when memory runs out.
 LoadedMesh load_mesh_file(const std::string& path);
-
-// OpenMesh reports problems on its own log streams (faces its kernel refuses, stripifier
-// notes); ours are exceptions or counts, so every OpenMesh user calls this first.
-void silence_openmesh_logs();
 
 }  // namespace wavetrace

@@ -13,7 +13,7 @@
 #include <string>
 #include <string_view>
 
-#include "wavetrace/scene/mesh_io.hpp"
+#include "wavetrace/scene/loaded_mesh.hpp"
 
 namespace wavetrace {
 

@@ -38,6 +38,7 @@ struct Bounds3 {
   glm::vec3 extent() const { return upper - lower; }
   glm::vec3 center() const { return (lower + upper) * 0.5f; }
   float diagonal() const;
+  bool operator==(const Bounds3&) const = default;
 };
 
 struct TriangleMesh {

@@ -8,7 +8,7 @@
 
 #include "wavetrace/kernels/ray_box.hpp"
 #include "wavetrace/stages/escaped_light.hpp"
-#include "wavetrace/stages/memory_observation.hpp"
+#include "wavetrace/stages/observed_stage.hpp"
 
 namespace wavetrace {
 

@@ -24,6 +24,7 @@ struct ImageSpec {
   // (pixel, sample), so another seed draws independent samples of the same image.
   std::uint32_t seed = 0;
   std::uint32_t pixel_count() const { return width * height; }
+  bool operator==(const ImageSpec&) const = default;
 };
 
 class GenerateStage {

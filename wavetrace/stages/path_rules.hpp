@@ -14,6 +14,7 @@ struct PathRules {
 
   bool may_bounce(std::uint32_t depth) const { return depth + 1 <= max_depth; }
   bool roulette_applies(std::uint32_t depth) const { return depth + 1 >= russian_roulette_depth; }
+  bool operator==(const PathRules&) const = default;
 };
 
 // Probability that a path continues past a surface of this albedo under Russian roulette.

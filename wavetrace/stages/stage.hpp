@@ -1,5 +1,7 @@
-// The stage contract: a stage is a function of a batch and the read-only world. It keeps
-// no state between batches beyond its configuration, so any batch can run on any thread.
+// The stage contract: a stage is a function of a batch and the read-only world, so any batch
+// can run on any thread. A plain stage keeps no state between batches beyond its
+// configuration and its lock-free counters; a buffering stage (buffering_stage.hpp) also holds
+// the batches it has taken until it flushes them, and its node runs one call at a time.
 #pragma once
 
 #include <string>

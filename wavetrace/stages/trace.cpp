@@ -7,7 +7,7 @@
 
 #include <tbb/task_arena.h>
 
-#include "wavetrace/stages/memory_observation.hpp"
+#include "wavetrace/stages/observed_stage.hpp"
 
 namespace wavetrace {
 

@@ -14,14 +14,15 @@
 namespace wavetrace {
 
 // radix: the stable LSD radix sort (kernels/radix_sort.hpp), one thread; parallel:
-// tbb::parallel_sort. Radix measured faster here (see the README), so it is the default.
+// tbb::parallel_sort. Radix measured faster here (docs/reordering.md), so it is the default.
 enum class SortAlgorithm { radix, parallel };
 
 struct ZSortOptions {
-  ReorderHeuristic heuristic = ReorderHeuristic::hph;
+  ReorderHeuristic heuristic = ReorderHeuristic::none;
   CurveKind curve = CurveKind::morton;
   std::size_t buffer_rays = std::size_t{1} << 18;
   SortAlgorithm sort = SortAlgorithm::radix;
+  bool operator==(const ZSortOptions&) const = default;
 };
 
 // A buffered ray's place and key; arrival order is (batch, ray).
@@ -38,10 +39,12 @@ struct SortEntry {
 
 class ZSortStage final : public BufferingStage {
  public:
-  // What one buffered ray holds: its RayBatch columns (origin, direction, tmin, tmax,
-  // pixel, sample, throughput: 4 bytes each; depth 2, kind 1, flags 1), the approximate hit
-  // (12) and key (8) columns, its HitBatch slot (16) and its sort entry (16).
-  static constexpr std::size_t kBytesPerBufferedRay = 13 * 4 + 2 + 1 + 1 + 12 + 8 + 16 + sizeof(SortEntry);
+  // What one buffered ray holds, from the batch's column lists: its ray columns with the
+  // approximate hit and key, its hit columns (the buffer holds whole batches) and its sort
+  // entry: 56 + 12 + 8 + 44 + 16 = 136 bytes.
+  static constexpr std::size_t kBytesPerBufferedRay = RayBatch::kBytesPerRay + RayBatch::kApproxHitBytesPerRay +
+                                                      RayBatch::kSortKeyBytesPerRay + HitBatch::kBytesPerHit +
+                                                      sizeof(SortEntry);
 
   ZSortStage(const ZSortOptions& options, const Bounds3& scene_bounds) : options_(options), bounds_(scene_bounds) {}
   std::string name() const override { return "zsort"; }

@@ -7,7 +7,9 @@
 #include <span>
 #include <type_traits>
 
-#include "wavetrace/accel/bvh/bvh_accelerator.hpp"
+#include "wavetrace/accel/accelerator.hpp"
+#include "wavetrace/accel/bvh/bvh_options.hpp"
+#include "wavetrace/scene/triangle_mesh.hpp"
 #include "wavetrace/accel/bvh/indexed_face_set.hpp"
 #include "wavetrace/accel/bvh/sah_builder.hpp"
 #include "wavetrace/accel/bvh/tree_check.hpp"

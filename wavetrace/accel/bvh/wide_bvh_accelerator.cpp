@@ -14,6 +14,7 @@
 #endif
 
 #include "wavetrace/accel/bvh/bvh_build.hpp"
+#include "wavetrace/accel/probed_accelerator.hpp"
 #include "wavetrace/accel/ray_loop.hpp"
 #include "wavetrace/accel/section_archive.hpp"
 #include "wavetrace/accel/bvh/indexed_face_set.hpp"
@@ -87,7 +88,9 @@ struct WideRay {
 #endif
 }
 
-class WideBvhAccelerator final : public Accelerator {
+class WideBvhAccelerator final : public ProbedAccelerator<WideBvhAccelerator> {
+  friend class ProbedAccelerator<WideBvhAccelerator>;
+
  public:
   explicit WideBvhAccelerator(SectionLoader& in) : geometry_(in) {
     load_bvh(in, geometry_, "bvh8.nodes", nodes_, leaf_triangles_, build_);
@@ -112,23 +115,6 @@ class WideBvhAccelerator final : public Accelerator {
 
   std::string name() const override { return "bvh8"; }
 
-  void intersect_closest(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
-    NullProbe probe;
-    traverse<false>(rays, hits, range, probe);
-  }
-  void intersect_any(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
-    NullProbe probe;
-    traverse<true>(rays, hits, range, probe);
-  }
-  bool probed() const override { return true; }
-  void intersect_closest_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
-                                RecordingProbe& probe) const override {
-    traverse<false>(rays, hits, range, probe);
-  }
-  void intersect_any_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
-                            RecordingProbe& probe) const override {
-    traverse<true>(rays, hits, range, probe);
-  }
 
   MemoryReport memory() const override {
     return {nodes_.size() * sizeof(WideBvhNode) + leaf_triangles_.size() * sizeof(std::uint32_t),

@@ -3,7 +3,9 @@
 
 #include <memory>
 
-#include "wavetrace/accel/bvh/bvh_accelerator.hpp"
+#include "wavetrace/accel/accelerator.hpp"
+#include "wavetrace/accel/bvh/bvh_options.hpp"
+#include "wavetrace/scene/triangle_mesh.hpp"
 
 namespace wavetrace {
 

@@ -88,7 +88,7 @@ constexpr std::uint32_t kChunkedSavedVersion = 1;
 class ChunkedAccelerator final : public Accelerator {
  public:
   ChunkedAccelerator(SectionLoader& in, const ChunkLoader& load_chunk) {
-    in.expect_kind("chunked", kChunkedSavedVersion);
+    in.expect_kind(kChunkedKind, kChunkedSavedVersion);
     StoredArray<SavedChunk> saved;
     in.array("chunked.chunks", saved);
     in.array("chunked.top", top_);
@@ -106,7 +106,7 @@ class ChunkedAccelerator final : public Accelerator {
   }
 
   void save(SectionWriter& out, const std::string& prefix) const override {
-    out.add_value(prefix + "kind", saved_kind("chunked", kChunkedSavedVersion));
+    out.add_value(prefix + "kind", saved_kind(kChunkedKind, kChunkedSavedVersion));
     LargeArray<SavedChunk> saved;
     for (const Chunk& chunk : chunks_) saved.push_back({chunk.first, chunk.count, chunk.bounds});
     SectionSaver saver(out, prefix);

@@ -1,8 +1,8 @@
 // A world of chunks: the scene's triangles cut into runs of at most `chunk_triangles`, each
 // built into a sub-accelerator of its own (its build temporaries freed once it is built;
 // as many chunks built at once as there are worker threads and memory for them), joined by
-// a top-level BVH over the chunks' boxes. The chunk is the unit of building
-// and, later, of saving and paging. See ../shared/DESIGN.md, "The world at scale".
+// a top-level BVH over the chunks' boxes. The chunk is the unit of building, of saving
+// (each chunk's sections in a world file) and of paging (docs/memory.md).
 #pragma once
 
 #include <cstddef>
@@ -10,6 +10,7 @@
 #include <functional>
 #include <memory>
 #include <span>
+#include <string_view>
 #include <vector>
 
 #include "wavetrace/accel/accelerator.hpp"
@@ -47,6 +48,8 @@ std::unique_ptr<Accelerator> make_chunked_accelerator(const TriangleSource& sour
 // chunk's accelerator loaded by `load_chunk` from its own prefix.
 class SectionLoader;
 using ChunkLoader = std::function<std::unique_ptr<Accelerator>(SectionLoader&)>;
+// The saved kind (SavedKind::type) of a chunked world.
+inline constexpr std::string_view kChunkedKind = "chunked";
 std::unique_ptr<Accelerator> load_chunked_accelerator(SectionLoader& in, const ChunkLoader& load_chunk);
 
 }  // namespace wavetrace

@@ -20,6 +20,7 @@ struct EmbreeOptions {
   EmbreeMode mode = EmbreeMode::standard;
   EmbreeQueries queries = EmbreeQueries::stream;
   int threads = 0;  // build threads; 0 = the TBB arena's
+  bool operator==(const EmbreeOptions&) const = default;
 };
 
 EmbreeMode parse_embree_mode(const std::string& text);  // "default" | "compact" | "robust"

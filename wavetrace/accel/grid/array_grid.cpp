@@ -13,6 +13,7 @@
 
 #include "wavetrace/accel/grid/grid_walk.hpp"
 #include "wavetrace/accel/hit_surface.hpp"
+#include "wavetrace/accel/probed_accelerator.hpp"
 #include "wavetrace/accel/ray_loop.hpp"
 #include "wavetrace/kernels/checked_narrowing.hpp"
 #include "wavetrace/kernels/ray_box.hpp"
@@ -37,7 +38,9 @@ struct ArrayGridCell {
 };
 static_assert(sizeof(ArrayGridCell) == 8);
 
-class ArrayGridAccelerator final : public Accelerator {
+class ArrayGridAccelerator final : public ProbedAccelerator<ArrayGridAccelerator> {
+  friend class ProbedAccelerator<ArrayGridAccelerator>;
+
  public:
   ArrayGridAccelerator(const TriangleMesh& mesh, const ArrayGridOptions& options) : mesh_(mesh), options_(options) {
     const auto start = std::chrono::steady_clock::now();
@@ -64,23 +67,6 @@ class ArrayGridAccelerator final : public Accelerator {
   }
 
   std::string name() const override { return "arraygrid"; }
-  void intersect_closest(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
-    NullProbe probe;
-    traverse_batch<false>(rays, hits, range, probe);
-  }
-  void intersect_any(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
-    NullProbe probe;
-    traverse_batch<true>(rays, hits, range, probe);
-  }
-  bool probed() const override { return true; }
-  void intersect_closest_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
-                                RecordingProbe& probe) const override {
-    traverse_batch<false>(rays, hits, range, probe);
-  }
-  void intersect_any_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
-                            RecordingProbe& probe) const override {
-    traverse_batch<true>(rays, hits, range, probe);
-  }
   MemoryReport memory() const override {
     MemoryReport report;
     report.hierarchy = nodes_.size() * sizeof(ArrayGridNode) + cells_.size() * sizeof(ArrayGridCell) +
@@ -239,7 +225,7 @@ class ArrayGridAccelerator final : public Accelerator {
   }
 
   template <bool kAnyHit, typename Probe>
-  void traverse_batch(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
+  void traverse(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
     for_each_ray(rays, hits, range, [&](const SingleRay& ray, std::uint32_t i) {
       RayState state;
       state.origin = ray.origin;

@@ -30,6 +30,7 @@ struct ArrayGridOptions {
   // cells, as in builtin:fur, otherwise multiply the lists at every level).
   std::size_t max_cells = std::size_t{1} << 28;
   std::size_t max_entries = std::size_t{1} << 28;
+  bool operator==(const ArrayGridOptions&) const = default;
 };
 
 std::unique_ptr<Accelerator> make_array_grid_accelerator(const TriangleMesh& mesh, const ArrayGridOptions& options);

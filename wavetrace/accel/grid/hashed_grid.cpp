@@ -15,6 +15,7 @@
 
 #include "wavetrace/accel/grid/grid_walk.hpp"
 #include "wavetrace/accel/hit_surface.hpp"
+#include "wavetrace/accel/probed_accelerator.hpp"
 #include "wavetrace/accel/ray_loop.hpp"
 #include "wavetrace/kernels/checked_narrowing.hpp"
 #include "wavetrace/kernels/ray_box.hpp"
@@ -30,7 +31,9 @@ struct CellRange {
   glm::uvec3 lower, upper;  // inclusive
 };
 
-class HashedGridAccelerator final : public Accelerator {
+class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerator> {
+  friend class ProbedAccelerator<HashedGridAccelerator>;
+
  public:
   HashedGridAccelerator(const TriangleMesh& mesh, const HashedGridOptions& options) : mesh_(mesh) {
     const auto start = std::chrono::steady_clock::now();
@@ -45,23 +48,6 @@ class HashedGridAccelerator final : public Accelerator {
 
   std::string name() const override { return macrocell_factor_ > 0 ? "mlgrid" : "grid"; }
 
-  void intersect_closest(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
-    NullProbe probe;
-    traverse<false>(rays, hits, range, probe);
-  }
-  void intersect_any(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
-    NullProbe probe;
-    traverse<true>(rays, hits, range, probe);
-  }
-  bool probed() const override { return true; }
-  void intersect_closest_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
-                                RecordingProbe& probe) const override {
-    traverse<false>(rays, hits, range, probe);
-  }
-  void intersect_any_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
-                            RecordingProbe& probe) const override {
-    traverse<true>(rays, hits, range, probe);
-  }
 
   MemoryReport memory() const override {
     MemoryReport report;

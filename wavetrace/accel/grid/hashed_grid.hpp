@@ -29,6 +29,7 @@ struct HashedGridOptions {
   // mlgrid (§3.3): levels of macrocells, each a bit per block of factor^k cells, so that
   // traversal jumps over empty space; 0 for the plain one-level grid. The paper: 6.
   std::uint32_t macrocell_factor = 0;
+  bool operator==(const HashedGridOptions&) const = default;
 };
 
 // The cells per axis the grid takes over `bounds` for `triangles` (the box's extent floored

@@ -11,27 +11,10 @@
 #include <optional>
 
 #include "wavetrace/accel/accelerator.hpp"
+#include "wavetrace/accel/hmq/hmq_options.hpp"
 #include "wavetrace/scene/triangle_mesh.hpp"
 
 namespace wavetrace {
-
-struct HmqOptions {
-  // Grid bits per axis (1 .. 24); the paper uses 16. Ignored when epsilon is set.
-  std::uint32_t bits = 16;
-  // Error bound in scene units (0: unset): the grid is the coarsest on which no vertex moves
-  // more than this. Setting it together with bits other than 16 is an error.
-  double epsilon = 0.0;
-  std::uint32_t leaf_size = 8;   // most triangles per leaf, 1 .. 14 (the paper's table: 4, 8, 12)
-  double top_fraction = 0.05;    // share of the BVH's nodes kept uncompressed at its top, 0 .. 1
-                                 // (binary layout only: the 8-wide one quantizes every node)
-  // 2: the paper's binary tree of 4-byte nodes in blocks; 8: 64-byte nodes of eight children
-  // quantized to 8 bits per plane, tested in AVX2 lanes (accel/bvh/quantized_wide_node.hpp). Same leaves.
-  std::uint32_t width = 2;
-  std::uint32_t bins = 16;       // SAH bins
-  // The box the global grid spans: the whole scene's when a chunk is built, so that every
-  // chunk snaps to the same grid and shared vertices decode alike; unset: the mesh's box.
-  std::optional<Bounds3> grid_bounds;
-};
 
 // Throws std::invalid_argument for options outside their ranges or set together.
 std::unique_ptr<Accelerator> make_hmq_accelerator(const TriangleMesh& mesh, const HmqOptions& options);

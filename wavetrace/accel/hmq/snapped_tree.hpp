@@ -6,7 +6,8 @@
 
 #include "wavetrace/accel/bvh/sah_builder.hpp"
 #include "wavetrace/accel/hmq/global_grid.hpp"
-#include "wavetrace/accel/hmq/hmq_accelerator.hpp"
+#include "wavetrace/accel/hmq/hmq_options.hpp"
+#include "wavetrace/scene/triangle_mesh.hpp"
 #include "wavetrace/accel/hmq/leaf_codec.hpp"
 
 namespace wavetrace::hmq {

@@ -24,6 +24,7 @@ struct ProxyOptions {
   double share = 0.02;  // of the scene's triangles; the paper: 2% (0.0125%-8% workable)
   ProxyMethod method = ProxyMethod::automatic;
   AcceleratorOptions accelerator;
+  bool operator==(const ProxyOptions&) const = default;
 };
 
 // How well a proxy stands in for the scene on rays from random points of the scene's box

@@ -6,15 +6,27 @@
 
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
+#include <OpenMesh/Core/System/omstream.hh>
 #include <OpenMesh/Tools/Utils/StripifierT.hh>
 
 #include "wavetrace/accel/raystrips/stripify.hpp"
-#include "wavetrace/scene/mesh_io.hpp"
 
 namespace wavetrace {
 namespace {
 
 using OpenMeshTriangles = OpenMesh::TriMesh_ArrayKernelT<>;
+
+// OpenMesh reports what its kernel refuses on its own log streams; ours are counts (the
+// notes), so its logs are off before the first sub-mesh.
+void silence_openmesh_logs() {
+  static const bool silenced = [] {
+    omlog().disable();
+    omout().disable();
+    omerr().disable();
+    return true;
+  }();
+  (void)silenced;
+}
 
 std::uint64_t sorted_triple_key(std::uint32_t a, std::uint32_t b, std::uint32_t c, std::uint32_t vertex_count) {
   if (a > b) std::swap(a, b);

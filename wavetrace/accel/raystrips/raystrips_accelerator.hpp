@@ -38,6 +38,7 @@ struct RayStripsOptions {
   // active rays in a strip, the packet falls back to single-ray strip traversal.
   bool packets = true;
   std::uint32_t packet_min_active = 2;  // 1 .. 4
+  bool operator==(const RayStripsOptions&) const = default;
 };
 
 // Throws std::invalid_argument for options outside their ranges. `mesh` must outlive

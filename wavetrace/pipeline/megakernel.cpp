@@ -1,0 +1,108 @@
+// One path at a time through trace, shade and spawn, each called on a one-ray batch.
+#include "wavetrace/pipeline/megakernel.hpp"
+
+#include <atomic>
+#include <utility>
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include "wavetrace/pipeline/tracing_arena.hpp"
+
+namespace wavetrace {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// A worker's rays: the path's current ray, the next bounce and a shadow ray, one slot each.
+struct PathScratch {
+  Batch current{1}, next{1}, shadow{1};
+  std::uint64_t rays_traced = 0;
+  std::uint64_t nanoseconds = 0;
+};
+
+}  // namespace
+
+PipelineRun run_megakernel(const GenerateStage& generate, const TraceStage& trace, const ShadeStage& shade,
+                           const SpawnStage* spawn, const MegakernelOptions& options,
+                           const std::function<void(const Progress&)>& on_progress,
+                           std::chrono::milliseconds interval) {
+  TracingArena arena(options.threads);
+  const ImageSpec& image = generate.image();
+  const std::uint32_t side = std::max<std::uint32_t>(options.tile_side, 1);
+  const std::uint32_t tiles_x = (image.width + side - 1) / side, tiles_y = (image.height + side - 1) / side;
+  const std::uint64_t total = std::uint64_t(image.pixel_count()) * image.samples_per_pixel;
+  const RayRange one{0, 1};
+
+  tbb::enumerable_thread_specific<PathScratch> scratch;
+  std::atomic<std::uint64_t> camera_rays_done{0}, rays_traced{0};  // for progress reports
+  const Clock::time_point start = Clock::now();
+  std::optional<ProgressReporter> reporter;
+  reporter.emplace(
+      on_progress,
+      [&] {
+        const std::uint64_t done = camera_rays_done.load(std::memory_order_relaxed);
+        return Progress{done, total, rays_traced.load(std::memory_order_relaxed),
+                        std::chrono::duration<double>(Clock::now() - start).count()};
+      },
+      interval);
+
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, tiles_x * tiles_y, 1), [&](const auto& tiles) {
+      const Clock::time_point busy_since = Clock::now();
+      PathScratch& s = scratch.local();
+      const std::uint64_t traced_before = s.rays_traced;
+      std::uint64_t paths = 0;
+      for (std::uint32_t tile = tiles.begin(); tile != tiles.end(); ++tile) {
+        const std::uint32_t x0 = tile % tiles_x * side, y0 = tile / tiles_x * side;
+        for (std::uint32_t y = y0; y < std::min(y0 + side, image.height); ++y) {
+          for (std::uint32_t x = x0; x < std::min(x0 + side, image.width); ++x) {
+            for (std::uint32_t sample = 0; sample < image.samples_per_pixel; ++sample) {
+              Batch* current = &s.current;
+              Batch* next = &s.next;
+              generate.write_camera_ray(current->rays, 0, y * image.width + x, sample);
+              current->rays.count = 1;
+              for (;;) {
+                trace.trace_run(*current, one);
+                ++s.rays_traced;
+                if (shade.shade(*current, one) == 0 || spawn == nullptr) break;
+                next->rays.count = 0;
+                s.shadow.rays.count = 0;
+                spawn->spawn(*current, one, next->rays, &s.shadow.rays);
+                if (s.shadow.rays.count > 0) {
+                  trace.trace_run(s.shadow, one);
+                  ++s.rays_traced;
+                  shade.shade(s.shadow, one);
+                }
+                if (next->rays.count == 0) break;
+                std::swap(current, next);
+              }
+              ++paths;
+            }
+          }
+        }
+      }
+      camera_rays_done.fetch_add(paths, std::memory_order_relaxed);
+      rays_traced.fetch_add(s.rays_traced - traced_before, std::memory_order_relaxed);
+      s.nanoseconds += static_cast<std::uint64_t>(
+          std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - busy_since).count());
+    });
+  });
+
+  PipelineRun run;
+  run.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  reporter.reset();
+  run.threads = arena.threads();
+  StageStats stats;
+  stats.name = "megakernel";
+  for (const PathScratch& s : scratch) {
+    stats.rays_in += s.rays_traced;
+    stats.seconds += double(s.nanoseconds) * 1e-9;
+  }
+  stats.rays_out = 0;
+  run.stages.push_back(stats);
+  return run;
+}
+
+}  // namespace wavetrace

@@ -1,0 +1,33 @@
+// memory.* keys to a pager and caches, and their counters into the stage statistics.
+#include "wavetrace/pipeline/memory_observation.hpp"
+
+#include <bit>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+namespace wavetrace {
+
+MemoryObservation::MemoryObservation(const MemoryPlan& plan, std::vector<std::span<const std::byte>> world,
+                                     int threads, FilePager* file_pager)
+    : file_pager_(file_pager) {
+  if (file_pager_ != nullptr) file_pager_->reset();
+  if (plan.budget) {
+    pager_ = std::make_unique<SimulatedPager>(std::move(world), plan.page_bytes, *plan.budget, plan.io, kObservedStageCount);
+  }
+  if (plan.cache) caches_ = std::make_unique<CacheBank>(*plan.cache, std::size_t(threads), kObservedStageCount);
+  observers_ = {pager_.get(), caches_.get(), file_pager_};
+}
+
+void MemoryObservation::report(std::vector<StageStats>& stages) const {
+  for (StageStats& stage : stages) {
+    for (std::size_t client = 0; client < kObservedStageCount; ++client) {
+      if (stage.name != to_string(ObservedStage(client))) continue;
+      if (pager_) stage.pager = PagerStats{pager_->page_bytes(), pager_->budget_bytes(), pager_->counters(client)};
+      if (caches_) stage.cache = CacheStats{caches_->geometry(), caches_->total(client)};
+      if (file_pager_) stage.disk = DiskStats{file_pager_->page_bytes(), file_pager_->budget_bytes(), file_pager_->counters(client)};
+    }
+  }
+}
+
+}  // namespace wavetrace

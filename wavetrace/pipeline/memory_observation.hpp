@@ -1,0 +1,47 @@
+// The [memory] section made real: a pager over the world's spans and a bank of simulated
+// caches, observing the stages that query accelerators (trace; approx_hit with the proxy),
+// each counted apart.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "wavetrace/memory/cache_simulator.hpp"
+#include "wavetrace/memory/memory_probe.hpp"
+#include "wavetrace/memory/simulated_pager.hpp"
+#include "wavetrace/pipeline/stage_counters.hpp"
+#include "wavetrace/stages/observed_stage.hpp"
+
+namespace wavetrace {
+
+struct MemoryPlan {
+  std::optional<MemoryBudget> budget;  // no pager without one
+  bool file_backing = false;           // memory.backing = file: a world file really paged under the budget
+  std::size_t page_bytes = std::size_t{4} << 20;
+  IoModel io = io_preset("disk");  // memory.io
+  std::optional<CacheGeometry> cache;  // no cache simulation without one
+  bool enabled() const { return budget.has_value() || cache.has_value(); }
+  bool operator==(const MemoryPlan&) const = default;
+};
+
+class MemoryObservation {
+ public:
+  // `file_pager`: the real pager of a paged world file, emptied here so each render starts
+  // cold, or null.
+  MemoryObservation(const MemoryPlan& plan, std::vector<std::span<const std::byte>> world, int threads,
+                    FilePager* file_pager = nullptr);
+  const MemoryObservers& observers() const { return observers_; }
+  // Fills the pager and cache objects of the observed stages in `stages`.
+  void report(std::vector<StageStats>& stages) const;
+
+ private:
+  std::unique_ptr<SimulatedPager> pager_;
+  std::unique_ptr<CacheBank> caches_;
+  FilePager* file_pager_ = nullptr;
+  MemoryObservers observers_;
+};
+
+}  // namespace wavetrace

@@ -1,0 +1,210 @@
+// Flow-graph nodes around stages, ray accounting, and the threaded run.
+#include "wavetrace/pipeline/pipeline.hpp"
+
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+#include "wavetrace/pipeline/tracing_arena.hpp"
+
+namespace wavetrace {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::uint64_t nanoseconds_since(Clock::time_point start) {
+  return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - start).count());
+}
+
+// Routes a stage's output into its node's port, counting rays as they enter the graph
+// before they can be seen (and retired) downstream.
+class PortOutput final : public StageOutput {
+ public:
+  PortOutput(PipelineContext& context, BatchNode::output_ports_type& ports) : context_(context), ports_(ports) {}
+  void emit(Batch* batch) override {
+    emitted_rays += batch->rays.count;
+    context_.add_rays(batch->rays.count);
+    std::get<0>(ports_).try_put(batch);
+  }
+  Batch* acquire() override { return context_.pool().acquire(); }
+  void release(Batch* batch) override { context_.pool().release(batch); }
+  std::size_t emitted_rays = 0;
+
+ private:
+  PipelineContext& context_;
+  BatchNode::output_ports_type& ports_;
+};
+
+}  // namespace
+
+PipelineMode parse_pipeline_mode(const std::string& text) {
+  if (text == "wavefront") return PipelineMode::wavefront;
+  if (text == "megakernel") return PipelineMode::megakernel;
+  throw std::invalid_argument("unknown pipeline mode '" + text + "' (wavefront, megakernel)");
+}
+
+std::string to_string(PipelineMode mode) { return mode == PipelineMode::megakernel ? "megakernel" : "wavefront"; }
+
+PipelineContext::PipelineContext(std::size_t batch_capacity, std::size_t rays_in_flight)
+    : pool_(batch_capacity), budget_(std::max(rays_in_flight, 2 * batch_capacity)) {}
+
+void PipelineContext::retire_rays(std::size_t count) {
+  const std::int64_t now = live_rays_.fetch_sub(std::int64_t(count), std::memory_order_seq_cst) - std::int64_t(count);
+  if (buffer_node_ != nullptr) {
+    const auto waiting = std::int64_t(buffer_stage_->buffered_rays());
+    if (waiting > 0 && now <= waiting) buffer_node_->try_put(nullptr);
+  }
+  if (generator_node_ != nullptr && !generator_stage_->exhausted() &&
+      now + std::int64_t(pool_.batch_capacity()) <= std::int64_t(budget_)) {
+    generator_node_->try_put(tbb::flow::continue_msg());
+  }
+}
+
+std::unique_ptr<GenerateNode> make_generate_node(tbb::flow::graph& graph, GenerateStage& stage,
+                                                 PipelineContext& context, StageCounters& counters) {
+  // Any number of bodies at once: each claims its rays (counting them alive first, so the
+  // budget sees them) and fills its batch in parallel with the others.
+  auto node = std::make_unique<GenerateNode>(
+      graph, tbb::flow::unlimited, [&stage, &context, &counters](tbb::flow::continue_msg, GenerateNode::output_ports_type& ports) {
+        const std::size_t capacity = context.pool().batch_capacity();
+        while (!stage.exhausted() && context.live_rays() + std::int64_t(capacity) <= std::int64_t(context.budget())) {
+          const Clock::time_point start = Clock::now();
+          const GenerateStage::Claim claimed = stage.claim(capacity);
+          if (claimed.count == 0) return;
+          context.add_rays(claimed.count);
+          Batch* batch = context.pool().acquire();
+          stage.fill_range(batch->rays, claimed);
+          counters.record(0, claimed.count, nanoseconds_since(start));
+          std::get<0>(ports).try_put(batch);
+        }
+      });
+  context.attach_generator(node.get(), &stage);
+  return node;
+}
+
+std::unique_ptr<BatchNode> make_stage_node(tbb::flow::graph& graph, const Stage& stage, PipelineContext& context,
+                                           StageCounters& counters) {
+  return std::make_unique<BatchNode>(
+      graph, tbb::flow::unlimited, [&stage, &context, &counters](Batch* batch, BatchNode::output_ports_type& ports) {
+        const Clock::time_point start = Clock::now();
+        const std::size_t rays_in = batch->rays.count;
+        PortOutput out(context, ports);
+        stage.process(batch, out);
+        counters.record(rays_in, out.emitted_rays, nanoseconds_since(start));
+        context.retire_rays(rays_in);
+      });
+}
+
+namespace {
+
+// A buffering stage's output: its rays are already counted alive, so emitting adds nothing.
+class BufferedOutput final : public StageOutput {
+ public:
+  BufferedOutput(PipelineContext& context, BatchNode::output_ports_type& ports) : context_(context), ports_(ports) {}
+  void emit(Batch* batch) override { std::get<0>(ports_).try_put(batch); }
+  Batch* acquire() override { return context_.pool().acquire(); }
+  void release(Batch* batch) override { context_.pool().release(batch); }
+
+ private:
+  PipelineContext& context_;
+  BatchNode::output_ports_type& ports_;
+};
+
+}  // namespace
+
+std::unique_ptr<BatchNode> make_buffering_node(tbb::flow::graph& graph, const BufferingStage& stage,
+                                               PipelineContext& context, StageCounters& counters) {
+  auto node = std::make_unique<BatchNode>(
+      graph, tbb::flow::serial, [&stage, &context, &counters](Batch* batch, BatchNode::output_ports_type& ports) {
+        const Clock::time_point start = Clock::now();
+        BufferedOutput out(context, ports);
+        const std::size_t rays_in = batch != nullptr ? batch->rays.count : 0;
+        std::size_t rays_out = batch != nullptr ? stage.take(batch, out) : 0;
+        const std::size_t waiting = stage.buffered_rays();
+        if (waiting > 0 && std::int64_t(waiting) >= context.live_rays()) rays_out += stage.flush(out);
+        if (rays_in > 0 || rays_out > 0) counters.record(rays_in, rays_out, nanoseconds_since(start));
+      });
+  context.attach_buffer(node.get(), &stage);
+  return node;
+}
+
+std::unique_ptr<tbb::flow::function_node<Batch*>> make_retire_node(tbb::flow::graph& graph, PipelineContext& context) {
+  return std::make_unique<tbb::flow::function_node<Batch*>>(graph, tbb::flow::unlimited, [&context](Batch* batch) {
+    const std::size_t count = batch->rays.count;
+    context.pool().release(batch);
+    context.retire_rays(count);
+    return tbb::flow::continue_msg();
+  });
+}
+
+Pipeline::Pipeline(GenerateStage& generate, std::vector<const Stage*> chain, bool loops, const PipelineOptions& options)
+    : generate_(generate), chain_(std::move(chain)), loops_(loops), options_(options) {}
+
+PipelineRun Pipeline::run(const std::function<void(const Progress&)>& on_progress, std::chrono::milliseconds interval) {
+  TracingArena arena(options_.threads);
+  const int threads = arena.threads();
+
+  StageCounters generate_counters(generate_.name());
+  std::vector<std::unique_ptr<StageCounters>> counters;
+  for (const Stage* stage : chain_) counters.push_back(std::make_unique<StageCounters>(stage->name()));
+  const StageCounters* trace_counters = nullptr;
+  for (const auto& c : counters) {
+    if (c->snapshot().name == "trace") trace_counters = c.get();
+  }
+
+  PipelineContext context(options_.batch_size, options_.rays_in_flight);
+  const Clock::time_point start = Clock::now();
+
+  std::optional<ProgressReporter> reporter;
+  reporter.emplace(
+      on_progress,
+      [&] {
+        return Progress{generate_.generated(), generate_.total_rays(), trace_counters ? trace_counters->rays_in() : 0,
+                        std::chrono::duration<double>(Clock::now() - start).count()};
+      },
+      interval);
+  arena.execute([&] {
+    tbb::flow::graph graph;
+    auto generate_node = make_generate_node(graph, generate_, context, generate_counters);
+    std::vector<std::unique_ptr<BatchNode>> nodes;
+    for (std::size_t i = 0; i < chain_.size(); ++i) {
+      if (const auto* buffering = dynamic_cast<const BufferingStage*>(chain_[i])) {
+        nodes.push_back(make_buffering_node(graph, *buffering, context, *counters[i]));
+      } else {
+        nodes.push_back(make_stage_node(graph, *chain_[i], context, *counters[i]));
+      }
+    }
+    std::unique_ptr<tbb::flow::function_node<Batch*>> retire;
+    if (nodes.empty()) {
+      retire = make_retire_node(graph, context);
+      tbb::flow::make_edge(tbb::flow::output_port<0>(*generate_node), *retire);
+    } else {
+      tbb::flow::make_edge(tbb::flow::output_port<0>(*generate_node), *nodes.front());
+      for (std::size_t i = 0; i + 1 < nodes.size(); ++i) {
+        tbb::flow::make_edge(tbb::flow::output_port<0>(*nodes[i]), *nodes[i + 1]);
+      }
+      if (loops_) {
+        tbb::flow::make_edge(tbb::flow::output_port<0>(*nodes.back()), *nodes.front());
+      } else {
+        retire = make_retire_node(graph, context);
+        tbb::flow::make_edge(tbb::flow::output_port<0>(*nodes.back()), *retire);
+      }
+    }
+    generate_node->try_put(tbb::flow::continue_msg());
+    graph.wait_for_all();
+  });
+  if (context.live_rays() != 0) {
+    throw std::logic_error("the pipeline drained with " + std::to_string(context.live_rays()) + " rays still alive");
+  }
+
+  PipelineRun result;
+  result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  reporter.reset();
+  result.threads = threads;
+  result.stages.push_back(generate_counters.snapshot());
+  for (const auto& c : counters) result.stages.push_back(c->snapshot());
+  result.batches_allocated = context.pool().allocated();
+  return result;
+}
+
+}  // namespace wavetrace

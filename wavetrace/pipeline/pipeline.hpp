@@ -1,0 +1,130 @@
+// The stage chain on a tbb::flow::graph. The building blocks (PipelineContext and the
+// node factories) are public so a C++ user can wire the same stage objects by hand;
+// Pipeline assembles the chain a config names.
+//
+// Flow control: the context counts the rays alive in the graph. The generate node emits
+// camera batches only while that count stays under the in-flight budget (give or take a
+// batch per thread generating at once), and every node that retires rays wakes it, so
+// memory stays bounded and the graph drains by itself. A buffering stage (zsort, repack)
+// holds rays until it is ready or holds every live ray; whoever sees the latter last (its
+// node after taking a batch, or a node after retiring) makes it flush.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <tbb/flow_graph.h>
+
+#include "wavetrace/memory/batch_pool.hpp"
+#include "wavetrace/stages/generate.hpp"
+#include "wavetrace/pipeline/progress_reporter.hpp"
+#include "wavetrace/stages/stage.hpp"
+#include "wavetrace/pipeline/stage_counters.hpp"
+#include "wavetrace/stages/buffering_stage.hpp"
+
+namespace wavetrace {
+
+using BatchNode = tbb::flow::multifunction_node<Batch*, std::tuple<Batch*>>;
+using GenerateNode = tbb::flow::multifunction_node<tbb::flow::continue_msg, std::tuple<Batch*>>;
+
+class PipelineContext {
+ public:
+  PipelineContext(std::size_t batch_capacity, std::size_t rays_in_flight);
+
+  BatchPool& pool() { return pool_; }
+  std::int64_t live_rays() const { return live_rays_.load(std::memory_order_acquire); }
+  std::size_t budget() const { return budget_; }
+
+  // Rays entering the graph (made by generate or spawn).
+  void add_rays(std::size_t count) { live_rays_.fetch_add(std::int64_t(count), std::memory_order_acq_rel); }
+  // Rays leaving it; wakes the generator when there is room for another batch.
+  void retire_rays(std::size_t count);
+
+  void attach_generator(GenerateNode* node, const GenerateStage* stage) {
+    generator_node_ = node;
+    generator_stage_ = stage;
+  }
+  // The buffering node is poked (sent a null batch) when every live ray is waiting in its
+  // stage, since then nothing else will arrive to make it flush.
+  void attach_buffer(BatchNode* node, const BufferingStage* stage) {
+    buffer_node_ = node;
+    buffer_stage_ = stage;
+  }
+
+ private:
+  BatchPool pool_;
+  std::size_t budget_;
+  std::atomic<std::int64_t> live_rays_{0};
+  GenerateNode* generator_node_ = nullptr;
+  const GenerateStage* generator_stage_ = nullptr;
+  BatchNode* buffer_node_ = nullptr;
+  const BufferingStage* buffer_stage_ = nullptr;
+};
+
+// The node that emits camera batches while the in-flight budget allows, any number of
+// them filled at once; start it with try_put(continue_msg()).
+std::unique_ptr<GenerateNode> make_generate_node(tbb::flow::graph& graph, GenerateStage& stage,
+                                                 PipelineContext& context, StageCounters& counters);
+
+// A node running `stage` on any number of batches at once.
+std::unique_ptr<BatchNode> make_stage_node(tbb::flow::graph& graph, const Stage& stage, PipelineContext& context,
+                                           StageCounters& counters);
+
+// The serial node of a buffering stage (zsort, repack): hands it each batch and flushes it
+// when it holds every live ray; a null batch is a poke to re-check. One per pipeline.
+std::unique_ptr<BatchNode> make_buffering_node(tbb::flow::graph& graph, const BufferingStage& stage,
+                                               PipelineContext& context, StageCounters& counters);
+
+// A node that ends every batch it receives (for chains without spawn).
+std::unique_ptr<tbb::flow::function_node<Batch*>> make_retire_node(tbb::flow::graph& graph,
+                                                                   PipelineContext& context);
+
+// How paths are run: batches through the stage graph, or one path at a time per worker.
+enum class PipelineMode { wavefront, megakernel };
+PipelineMode parse_pipeline_mode(const std::string& text);
+std::string to_string(PipelineMode mode);
+
+// Rays per batch of a render: a batch and its hits (~100 KB) stay in L2 between stages.
+// render.batch_size's default; the benches' ray sets use kDefaultBatchCapacity.
+inline constexpr std::size_t kPipelineBatchSize = 1024;
+
+struct PipelineOptions {
+  PipelineMode mode = PipelineMode::wavefront;
+  std::uint32_t tile_side = 16;  // megakernel tiles
+  std::size_t batch_size = kPipelineBatchSize;
+  std::size_t rays_in_flight = std::size_t{1} << 18;
+  int threads = 0;  // 0: all cores
+  bool operator==(const PipelineOptions&) const = default;
+};
+
+struct PipelineRun {
+  std::vector<StageStats> stages;  // generate first, then the chain in order
+  double seconds = 0.0;            // wall time of the whole run
+  int threads = 0;
+  std::size_t batches_allocated = 0;
+};
+
+class Pipeline {
+ public:
+  // `chain` is everything after generate, in order. If `loops` is set, the last stage's
+  // output goes back to the first (spawn feeding new rays into the chain).
+  Pipeline(GenerateStage& generate, std::vector<const Stage*> chain, bool loops, const PipelineOptions& options);
+
+  // Runs until every ray has finished. `on_progress`, if given, is called about every
+  // `interval` from a helper thread.
+  PipelineRun run(const std::function<void(const Progress&)>& on_progress = {},
+                  std::chrono::milliseconds interval = std::chrono::milliseconds(250));
+
+ private:
+  GenerateStage& generate_;
+  std::vector<const Stage*> chain_;
+  bool loops_;
+  PipelineOptions options_;
+};
+
+}  // namespace wavetrace

@@ -1,0 +1,64 @@
+// What each stage did: rays in, rays out, busy seconds; lock-free, updated once per batch.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "wavetrace/memory/cache_simulator.hpp"
+#include "wavetrace/memory/file_pager.hpp"
+#include "wavetrace/memory/simulated_pager.hpp"
+
+namespace wavetrace {
+
+struct PagerStats {
+  std::size_t page_bytes = 0;
+  std::size_t budget_bytes = 0;
+  PagerCounters counters;
+};
+
+struct DiskStats {
+  std::size_t page_bytes = 0;
+  std::size_t budget_bytes = 0;
+  DiskCounters counters;
+};
+
+struct CacheStats {
+  CacheGeometry geometry;
+  CacheCounters counters;
+};
+
+struct StageStats {
+  std::string name;
+  std::uint64_t rays_in = 0;
+  std::uint64_t rays_out = 0;
+  std::uint64_t batches = 0;
+  double seconds = 0.0;  // thread-seconds spent inside the stage, summed over threads
+  // Rays in per busy thread-second: the stage's throughput on one core.
+  double mrays_per_s() const { return seconds > 0.0 ? double(rays_in) / seconds * 1e-6 : 0.0; }
+  // Simulated memory traffic of the stage's accelerator reads, when observed.
+  std::optional<PagerStats> pager;
+  std::optional<CacheStats> cache;
+  // Real paging of a world file (memory.backing = file), measured.
+  std::optional<DiskStats> disk;
+};
+
+class StageCounters {
+ public:
+  explicit StageCounters(std::string name) : name_(std::move(name)) {}
+  void record(std::uint64_t rays_in, std::uint64_t rays_out, std::uint64_t nanoseconds) {
+    rays_in_.fetch_add(rays_in, std::memory_order_relaxed);
+    rays_out_.fetch_add(rays_out, std::memory_order_relaxed);
+    batches_.fetch_add(1, std::memory_order_relaxed);
+    nanoseconds_.fetch_add(nanoseconds, std::memory_order_relaxed);
+  }
+  std::uint64_t rays_in() const { return rays_in_.load(std::memory_order_relaxed); }
+  StageStats snapshot() const;
+
+ private:
+  std::string name_;
+  std::atomic<std::uint64_t> rays_in_{0}, rays_out_{0}, batches_{0}, nanoseconds_{0};
+};
+
+}  // namespace wavetrace

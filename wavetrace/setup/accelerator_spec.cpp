@@ -1,0 +1,26 @@
+// TYPE[:key=value]... to config keys.
+#include "wavetrace/setup/accelerator_spec.hpp"
+
+#include <fmt/format.h>
+
+namespace wavetrace {
+
+void apply_accelerator_spec(Config& config, const std::string& text) {
+  std::size_t colon = text.find(':');
+  const std::string type = text.substr(0, colon);
+  config.set("accel.type=" + type);
+  while (colon != std::string::npos) {
+    const std::size_t next = text.find(':', colon + 1);
+    const std::string option = text.substr(colon + 1, next == std::string::npos ? std::string::npos : next - colon - 1);
+    if (option.find('=') == std::string::npos) {
+      throw ConfigError(fmt::format("--accel '{}': '{}' is not key=value", text, option));
+    }
+    const std::string section = option.starts_with("chunk_triangles=") ? "build."
+                                : type == "auto"                        ? "accel."
+                                                                        : "accel." + type + ".";
+    config.set(section + option);
+    colon = next;
+  }
+}
+
+}  // namespace wavetrace

@@ -1,0 +1,372 @@
+// The one key table: every configuration key with its type, default, valid range, help text
+// and the plan field it sets. Adding an option means adding one row here; the option
+// structs' own defaults must equal the row's (ConfigKeys.OptionStructDefaultsEqualTheTable),
+// and docs/configuration.md is generated from it (`wavetrace keys --markdown`).
+#include <algorithm>
+#include <stdexcept>
+#include <type_traits>
+
+#include <fmt/format.h>
+
+#include "wavetrace/pipeline/pipeline.hpp"
+#include "wavetrace/setup/config.hpp"
+#include "wavetrace/setup/render_plan.hpp"
+
+namespace wavetrace {
+namespace {
+
+// The plan field a path of member pointers names: field<&RenderPlan::image, &ImageSpec::width>.
+template <auto... Path>
+auto& field(RenderPlan& plan) {
+  return (plan.*....*Path);
+}
+template <auto... Path>
+const auto& field(const RenderPlan& plan) {
+  return (plan.*....*Path);
+}
+
+template <auto... Path>
+void integer(const Config& config, std::string_view key, RenderPlan& plan) {
+  auto& target = field<Path...>(plan);
+  target = static_cast<std::remove_cvref_t<decltype(target)>>(config.integer(key));
+}
+
+template <auto... Path>
+void real(const Config& config, std::string_view key, RenderPlan& plan) {
+  auto& target = field<Path...>(plan);
+  target = static_cast<std::remove_cvref_t<decltype(target)>>(config.real(key));
+}
+
+template <auto... Path>
+void boolean(const Config& config, std::string_view key, RenderPlan& plan) {
+  field<Path...>(plan) = config.boolean(key);
+}
+
+template <auto... Path>
+void text(const Config& config, std::string_view key, RenderPlan& plan) {
+  field<Path...>(plan) = config.text(key);
+}
+
+// A text key with listed choices, to its enum.
+template <auto Parse, auto... Path>
+void choice(const Config& config, std::string_view key, RenderPlan& plan) {
+  field<Path...>(plan) = Parse(config.text(key));
+}
+
+// A built accelerator's setting as the world file records it (ConfigKey::record).
+using Recorded = std::optional<ConfigValue>;
+template <auto... Path>
+Recorded recorded_integer(const RenderPlan& plan) {
+  return std::int64_t(field<Path...>(plan));
+}
+
+// Keys without a default: the override is set only when the key is.
+template <auto... Path>
+void optional_vector3(const Config& config, std::string_view key, RenderPlan& plan) {
+  if (config.has(key)) field<Path...>(plan) = config.vector3(key);
+}
+
+template <auto... Path>
+void optional_float(const Config& config, std::string_view key, RenderPlan& plan) {
+  if (config.has(key)) field<Path...>(plan) = static_cast<float>(config.real(key));
+}
+
+template <auto... Path>
+void optional_size(const Config& config, std::string_view key, RenderPlan& plan) {
+  if (config.has(key)) field<Path...>(plan) = static_cast<std::size_t>(config.integer(key));
+}
+
+using P = RenderPlan;
+using A = AcceleratorOptions;
+
+// Keys that set more than one field, or read a word or a unit, spelled out.
+void read_threads(const Config& config, std::string_view key, RenderPlan& plan) {
+  plan.pipeline.threads = static_cast<int>(config.integer(key));
+  plan.accelerator.embree.threads = plan.pipeline.threads;  // Embree's builder runs on as many
+}
+void read_film(const Config& config, std::string_view key, RenderPlan& plan) {
+  plan.film_per_thread = config.text(key) == "per_thread";
+}
+void read_accel_type(const Config& config, std::string_view key, RenderPlan& plan) {
+  plan.accelerator.type = config.text(key);
+  plan.accel_goal.automatic = plan.accelerator.type == "auto";
+}
+void read_max_error(const Config& config, std::string_view key, RenderPlan& plan) {
+  // "pixel" (no number): half a pixel's footprint, resolved against the camera later.
+  plan.accel_goal.max_error = config.word(key) ? std::nullopt : std::optional<double>(config.real(key));
+}
+void read_bins(const Config& config, std::string_view key, RenderPlan& plan) {
+  const auto bins = static_cast<std::uint32_t>(config.integer(key));
+  plan.accelerator.bvh.bins = plan.accelerator.raystrips.bins = plan.accelerator.hmq.bins = bins;  // every SAH build's
+}
+void read_hmq_epsilon(const Config& config, std::string_view key, RenderPlan& plan) {
+  plan.accel_goal.hmq_epsilon_pixel = config.word(key).has_value();
+  // "pixel" is resolved against the camera once the scene is loaded (resolve_accelerator).
+  plan.accelerator.hmq.epsilon = plan.accel_goal.hmq_epsilon_pixel ? 0.0 : config.real(key);
+}
+void read_memory_budget(const Config& config, std::string_view key, RenderPlan& plan) {
+  const std::string& budget = config.text(key);
+  try {
+    plan.memory.budget = budget == "none" ? std::nullopt : std::optional<MemoryBudget>(parse_memory_budget(budget));
+  } catch (const std::invalid_argument& error) {
+    throw ConfigError(fmt::format("{}: {}", key, error.what()));
+  }
+}
+void read_backing(const Config& config, std::string_view key, RenderPlan& plan) {
+  plan.memory.file_backing = config.text(key) == "file";
+}
+void read_io(const Config& config, std::string_view key, RenderPlan& plan) { plan.memory.io = io_preset(config.text(key)); }
+void read_cache(const Config& config, std::string_view key, RenderPlan& plan) {
+  const std::string& cache = config.text(key);
+  plan.memory.cache = cache == "none"     ? std::nullopt
+                      : cache == "custom" ? std::optional<CacheGeometry>(CacheGeometry{"custom", 64, 0, 0})
+                                          : std::optional<CacheGeometry>(cache_preset(cache));
+}
+template <std::size_t CacheGeometry::*Member>
+void read_cache_size(const Config& config, std::string_view key, RenderPlan& plan) {
+  if (plan.memory.cache && config.has(key)) (*plan.memory.cache).*Member = static_cast<std::size_t>(config.integer(key));
+}
+void read_proxy_accel(const Config& config, std::string_view key, RenderPlan& plan) {
+  plan.proxy.accelerator.type = config.text(key);  // the main accelerator's options otherwise (copied in plan_render)
+}
+void read_buffer_bytes(const Config& config, std::string_view key, RenderPlan& plan) {
+  if (!config.has(key)) return;
+  plan.reorder.buffer_rays =
+      std::max<std::size_t>(1, static_cast<std::size_t>(config.integer(key)) / ZSortStage::kBytesPerBufferedRay);
+}
+void read_sort(const Config& config, std::string_view key, RenderPlan& plan) {
+  plan.reorder.sort = config.text(key) == "radix" ? SortAlgorithm::radix : SortAlgorithm::parallel;
+}
+void read_stages(const Config& config, std::string_view key, RenderPlan& plan) { plan.stages = config.text_list(key); }
+
+// The registry's types, then auto.
+std::vector<std::string> accel_type_choices() {
+  std::vector<std::string> choices = accelerator_names();
+  choices.push_back("auto");
+  return choices;
+}
+
+}  // namespace
+
+const std::vector<std::string>& config_sections() {
+  static const std::vector<std::string> sections = {"scene", "camera", "render", "accel", "build",
+                                                    "proxy", "reorder", "memory", "pipeline"};
+  return sections;
+}
+
+// Rows in an order where a row may read what earlier rows set (memory.cache before the
+// sizes that adjust its geometry; reorder.buffer_bytes after buffer_rays, which it overrides).
+const std::vector<ConfigKey>& config_schema() {
+  using T = ConfigType;
+  static const std::vector<ConfigKey> schema = {
+      {"scene.source", T::text, std::string("builtin:default"), 0, 0, {},
+       "mesh file (.off .ply .obj .stl), scene file (.toml) or builtin:NAME[:TRIANGLES]",
+       text<&P::scene, &SceneRequest::source>},
+      {"scene.subdivide", T::integer, std::int64_t{0}, 0, 6, {}, "levels of Loop subdivision after loading",
+       integer<&P::scene, &SceneRequest::subdivide>},
+
+      {"camera.position", T::vector3, std::nullopt, 0, 0, {}, "eye point (default: the scene's or framed)",
+       optional_vector3<&P::camera, &CameraOverride::position>},
+      {"camera.look_at", T::vector3, std::nullopt, 0, 0, {}, "point looked at",
+       optional_vector3<&P::camera, &CameraOverride::look_at>},
+      {"camera.up", T::vector3, std::nullopt, 0, 0, {}, "up direction (default: the scene's, or +y)",
+       optional_vector3<&P::camera, &CameraOverride::up>},
+      {"camera.fov", T::real, std::nullopt, 1, 179, {}, "vertical field of view in degrees",
+       optional_float<&P::camera, &CameraOverride::vertical_fov_degrees>},
+
+      {"render.width", T::integer, std::int64_t{640}, 1, 16384, {}, "image width in pixels",
+       integer<&P::image, &ImageSpec::width>},
+      {"render.height", T::integer, std::int64_t{480}, 1, 16384, {}, "image height in pixels",
+       integer<&P::image, &ImageSpec::height>},
+      {"render.spp", T::integer, std::int64_t{8}, 1, 65536, {}, "samples per pixel",
+       integer<&P::image, &ImageSpec::samples_per_pixel>},
+      {"render.seed", T::integer, std::int64_t{0}, 0, 1 << 20, {},
+       "which samples are drawn: seed k draws samples k*spp .. (k+1)*spp - 1 of each pixel (another seed, "
+       "independent noise)",
+       integer<&P::image, &ImageSpec::seed>},
+      {"render.max_depth", T::integer, std::int64_t{5}, 0, 64, {},
+       "most bounces of a path (0: direct light only)",
+       integer<&P::rules, &PathRules::max_depth>},
+      {"render.russian_roulette_depth", T::integer, std::int64_t{3}, 0, 64, {},
+       "bounce depth from which Russian roulette may end a path",
+       integer<&P::rules, &PathRules::russian_roulette_depth>},
+      {"render.threads", T::integer, std::int64_t{0}, 0, 1024, {}, "worker threads (0: all cores)",
+       read_threads},
+      {"render.batch_size", T::integer, std::int64_t{kPipelineBatchSize}, 16, 1 << 20, {},
+       "rays per batch (1024: a batch and its hits, ~100 KB, stay in L2 between stages)",
+       integer<&P::pipeline, &PipelineOptions::batch_size>},
+      {"render.rays_in_flight", T::integer, std::nullopt, 1024, std::int64_t{1} << 30, {},
+       "most rays alive at once (bounds memory); default: reorder.buffer_rays with zsort in the chain, else 4 "
+       "batches per worker",
+       optional_size<&P::pipeline, &PipelineOptions::rays_in_flight>},
+      {"render.film", T::text, std::string("shared"), 0, 0, {"shared", "per_thread"},
+       "shared: one film, atomic adds; per_thread: a film per worker, summed at the end (same image)",
+       read_film},
+      {"render.pixel_order", T::text, std::string("scanline"), 0, 0, {"scanline", "zcurve"},
+       "order in which camera rays are generated",
+       choice<parse_pixel_order, &P::pixel_order>},
+
+      {"accel.type", T::text, std::string("embree"), 0, 0,
+       accel_type_choices(),
+       "main accelerator (auto: the fastest that fits accel.memory_budget and meets accel.max_error)",
+       read_accel_type},
+      {"accel.memory_budget", T::text, std::string("available"), 0, 0, {},
+       "what accel.type = auto may spend on the whole process (structure, mesh, build): bytes ('8GB', '512MiB'), a "
+       "share of the memory available now ('50%'), or 'available' (what is available now, less 10%); not "
+       "memory.budget, the page pool",
+       text<&P::accel_goal, &AccelGoal::memory_budget>},
+      {"accel.max_error", T::real, std::string("pixel"), 0.0, 1e30, {"pixel"},
+       "largest hit-point error accel.type = auto may accept, in scene units (0: exact methods only), or pixel: half "
+       "a pixel's footprint at the nearest surface in view",
+       read_max_error},
+      {"accel.embree.mode", T::text, std::string("default"), 0, 0, {"default", "compact", "robust"},
+       "Embree scene flags",
+       choice<parse_embree_mode, &P::accelerator, &A::embree, &EmbreeOptions::mode>,
+       [](const RenderPlan& plan) -> Recorded { return to_string(plan.accelerator.embree.mode); }},
+      {"accel.embree.queries", T::text, std::string("stream"), 0, 0, {"single", "stream"},
+       "rtcIntersect1 per ray, or a batch range through rtcIntersectNp (camera rays flagged coherent)",
+       choice<parse_embree_queries, &P::accelerator, &A::embree, &EmbreeOptions::queries>},
+      {"accel.bvh.leaf_size", T::integer, std::int64_t{4}, 1, 16, {}, "most triangles per BVH leaf",
+       integer<&P::accelerator, &A::bvh, &BvhOptions::max_leaf_size>},
+      {"accel.bvh.layout", T::text, std::string("depth_first"), 0, 0, {"depth_first", "breadth_first", "veb"},
+       "BVH node order in memory",
+       choice<parse_node_layout, &P::accelerator, &A::bvh, &BvhOptions::layout>},
+      {"accel.bvh.triangle_order", T::text, std::string("input"), 0, 0, {"input", "morton", "leaf"},
+       "the BVH's indexed face set: the mesh's (input), a Morton-sorted copy, or a copy in leaf order",
+       choice<parse_triangle_order, &P::accelerator, &A::bvh, &BvhOptions::triangle_order>},
+      {"accel.bvh.bins", T::integer, std::int64_t{16}, 2, 64, {}, "SAH bins per axis",
+       read_bins},
+      {"accel.grid.density", T::real, 32.0, 0.01, 4096.0, {}, "cells per triangle (Woo's heuristic; the paper: 32)",
+       real<&P::accelerator, &A::grid, &HashedGridOptions::density>},
+      {"accel.grid.max_cells", T::integer, std::int64_t{1} << 30, 1, std::int64_t{1} << 36, {},
+       "resolution guard: most cells of the grid (the density is lowered to fit)",
+       integer<&P::accelerator, &A::grid, &HashedGridOptions::max_cells>},
+      {"accel.mlgrid.density", T::real, 32.0, 0.01, 4096.0, {}, "cells per triangle of mlgrid's fine grid",
+       real<&P::accelerator, &A::mlgrid, &HashedGridOptions::density>},
+      {"accel.mlgrid.max_cells", T::integer, std::int64_t{1} << 30, 1, std::int64_t{1} << 36, {},
+       "resolution guard of mlgrid",
+       integer<&P::accelerator, &A::mlgrid, &HashedGridOptions::max_cells>},
+      {"accel.mlgrid.macrocell_factor", T::integer, std::int64_t{6}, 2, 64, {},
+       "fine cells per macrocell side, per level (the paper: 6)",
+       integer<&P::accelerator, &A::mlgrid, &HashedGridOptions::macrocell_factor>},
+      {"accel.arraygrid.density", T::real, 4.0, 0.01, 4096.0, {}, "cells per triangle of each nested grid (the paper: 4)",
+       real<&P::accelerator, &A::arraygrid, &ArrayGridOptions::density>},
+      {"accel.arraygrid.refine_items", T::integer, std::int64_t{8}, 2, 1 << 20, {},
+       "a cell holding this many triangles is refined",
+       integer<&P::accelerator, &A::arraygrid, &ArrayGridOptions::refine_items>},
+      {"accel.arraygrid.max_depth", T::integer, std::int64_t{2}, 0, 4, {}, "deepest nested grid (root: 0)",
+       integer<&P::accelerator, &A::arraygrid, &ArrayGridOptions::max_depth>},
+      {"accel.arraygrid.max_cells", T::integer, std::int64_t{1} << 28, 1, std::int64_t{1} << 34, {},
+       "resolution guard: refinement stops once the grids hold this many cells",
+       integer<&P::accelerator, &A::arraygrid, &ArrayGridOptions::max_cells>},
+      {"accel.arraygrid.max_entries", T::integer, std::int64_t{1} << 28, 1, std::int64_t{1} << 34, {},
+       "resolution guard: refinement stops once the triangle lists made hold this many entries",
+       integer<&P::accelerator, &A::arraygrid, &ArrayGridOptions::max_entries>},
+      {"accel.raystrips.submesh_triangles", T::integer, std::int64_t{256}, 2, 65535, {},
+       "sub-mesh threshold: the SAH tree is cut where a subtree holds at most this many triangles, then stripified",
+       integer<&P::accelerator, &A::raystrips, &RayStripsOptions::submesh_triangles>},
+      {"accel.raystrips.stripifier", T::text, std::string("openmesh"), 0, 0, {"dual_path", "openmesh"},
+       "dual_path: ours (long, compact strips); openmesh: OpenMesh's StripifierT",
+       choice<parse_stripifier, &P::accelerator, &A::raystrips, &RayStripsOptions::stripifier>},
+      {"accel.raystrips.strips_per_leaf", T::integer, std::int64_t{1}, 1, 16, {},
+       "most strips per top BVH leaf (1: the paper's one strip per leaf)",
+       integer<&P::accelerator, &A::raystrips, &RayStripsOptions::strips_per_leaf>},
+      {"accel.raystrips.run_triangles", T::integer, std::int64_t{6}, 2, 64, {},
+       "the strip's kd-tree is descended to spans of at most this many triangles, tested together (the paper: 2)",
+       integer<&P::accelerator, &A::raystrips, &RayStripsOptions::run_triangles>},
+      {"accel.raystrips.packets", T::boolean, true, 0, 0, {}, "camera rays as 2x2 packets",
+       boolean<&P::accelerator, &A::raystrips, &RayStripsOptions::packets>},
+      {"accel.raystrips.width", T::integer, std::int64_t{2}, 2, 8, {},
+       "top over the strips: 2, binary 32-byte nodes; 8, quantized 8-wide nodes (no packets)",
+       integer<&P::accelerator, &A::raystrips, &RayStripsOptions::width>, recorded_integer<&P::accelerator, &A::raystrips, &RayStripsOptions::width>},
+      {"accel.raystrips.packet_min_active", T::integer, std::int64_t{2}, 1, 4, {},
+       "below this many active rays a packet continues as single rays",
+       integer<&P::accelerator, &A::raystrips, &RayStripsOptions::packet_min_active>},
+      {"accel.hmq.bits", T::integer, std::int64_t{16}, 1, 24, {}, "global grid bits per axis (the paper: 16)",
+       integer<&P::accelerator, &A::hmq, &HmqOptions::bits>},
+      {"accel.hmq.epsilon", T::real, 0.0, 0.0, 1e30, {"pixel"},
+       "error bound in scene units instead of bits (0: unset), or pixel: half a pixel's footprint at the nearest "
+       "surface in view; the grid is the coarsest that keeps every vertex within it",
+       read_hmq_epsilon,
+       [](const RenderPlan& plan) -> Recorded {
+         return plan.accelerator.hmq.epsilon > 0.0 ? Recorded(plan.accelerator.hmq.epsilon) : std::nullopt;
+       }},
+      {"accel.hmq.leaf_size", T::integer, std::int64_t{8}, 1, 14, {}, "most triangles per leaf (the paper: 4, 8, 12)",
+       integer<&P::accelerator, &A::hmq, &HmqOptions::leaf_size>},
+      {"accel.hmq.top_fraction", T::real, 0.05, 0.0, 1.0, {},
+       "share of the BVH's nodes kept uncompressed at the top (width 2 only)",
+       real<&P::accelerator, &A::hmq, &HmqOptions::top_fraction>},
+      {"accel.hmq.width", T::integer, std::int64_t{2}, 2, 8, {},
+       "2: the paper's binary 4-byte nodes in blocks; 8: 64-byte nodes of 8 children, 8-bit planes, AVX2",
+       integer<&P::accelerator, &A::hmq, &HmqOptions::width>, recorded_integer<&P::accelerator, &A::hmq, &HmqOptions::width>},
+      {"accel.bvh.width", T::integer, std::int64_t{2}, 2, 8, {}, "2: binary 32-byte nodes; 8: AVX2 8-wide nodes",
+       integer<&P::accelerator, &A::bvh, &BvhOptions::width>, recorded_integer<&P::accelerator, &A::bvh, &BvhOptions::width>},
+
+      {"build.chunk_triangles", T::integer, std::int64_t{1} << 22, std::int64_t{1024}, std::int64_t{1} << 30, {},
+       "scenes of more triangles are built in chunks of at most this many under a top BVH (hmq, raystrips, bvh)",
+       integer<&P::accelerator, &A::chunk_triangles>},
+
+      {"memory.budget", T::text, std::string("none"), 0, 0, {},
+       "the page pool (simulated, or real with memory.backing = file): none, a share of the world (20%) or a size "
+       "(512MiB, 2GB); not accel.memory_budget, which bounds the whole process for auto",
+       read_memory_budget},
+      {"memory.page_bytes", T::integer, std::int64_t{4} << 20, 4096, std::int64_t{1} << 30, {},
+       "page size of the pool in bytes, a power of two (the paper: 4 MiB)",
+       integer<&P::memory, &MemoryPlan::page_bytes>},
+      {"memory.backing", T::text, std::string("memory"), 0, 0, {"memory", "file"},
+       "where a world file's pages live: memory (mapped, the OS pages it) or file (real paging: read on demand "
+       "with O_DIRECT into a pool of memory.budget, evicted LRU)",
+       read_backing},
+      {"memory.io", T::text, std::string("disk"), 0, 0, {"disk", "nvme"},
+       "simulated device per fault: disk (the paper's, 101 MB/s, 8 ms) or nvme (3.5 GB/s, 80 us)",
+       read_io},
+      {"memory.cache", T::text, std::string("none"), 0, 0, {"none", "paper_l2", "l1d", "l2", "custom"},
+       "simulated cache per thread: paper_l2 (6 MiB, 24-way), l1d (32 KiB, 8-way), l2 (512 KiB, 8-way)",
+       read_cache},
+      {"memory.cache_line_bytes", T::integer, std::nullopt, 4, 4096, {}, "cache line bytes (overrides the preset)",
+       read_cache_size<&CacheGeometry::line_bytes>},
+      {"memory.cache_bytes", T::integer, std::nullopt, 64, std::int64_t{1} << 34, {},
+       "cache capacity bytes (overrides the preset)",
+       read_cache_size<&CacheGeometry::capacity_bytes>},
+      {"memory.cache_ways", T::integer, std::nullopt, 1, 256, {}, "cache associativity (overrides the preset)",
+       read_cache_size<&CacheGeometry::ways>},
+
+      {"proxy.share", T::real, 0.02, 1e-6, 1.0, {}, "proxy triangles as a share of the scene's (the paper: 0.02)",
+       real<&P::proxy, &ProxyOptions::share>},
+      {"proxy.method", T::text, std::string("auto"), 0, 0, {"auto", "cluster", "stochastic"},
+       "simplification: vertex clustering with quadrics, stochastic pruning, or the better of both on test rays",
+       choice<parse_proxy_method, &P::proxy, &ProxyOptions::method>},
+      {"proxy.accel", T::text, std::string("embree"), 0, 0, {"embree", "bvh"},
+       "the proxy's accelerator (bvh: its reads can be observed by [memory])",
+       read_proxy_accel},
+
+      {"reorder.heuristic", T::text, std::string("none"), 0, 0,
+       {"none", "origin", "origin_dir", "hph", "hph_origin", "hph_dir"}, "ray ordering keys (none: no reordering)",
+       choice<parse_reorder_heuristic, &P::reorder, &ZSortOptions::heuristic>},
+      {"reorder.curve", T::text, std::string("morton"), 0, 0, {"morton", "hilbert"}, "space-filling curve of the keys",
+       choice<parse_curve_kind, &P::reorder, &ZSortOptions::curve>},
+      {"reorder.buffer_rays", T::integer, std::int64_t{1} << 18, 1, std::int64_t{1} << 32, {},
+       "rays zsort holds before it sorts (it also flushes when it holds every live ray)",
+       integer<&P::reorder, &ZSortOptions::buffer_rays>},
+      {"reorder.buffer_bytes", T::integer, std::nullopt, 1024, std::int64_t{1} << 40, {},
+       "the buffer given in bytes instead (overrides buffer_rays; the paper: 88 MB)",
+       read_buffer_bytes},
+      {"reorder.sort", T::text, std::string("radix"), 0, 0, {"radix", "parallel"},
+       "zsort's sort: a stable LSD radix sort or tbb::parallel_sort",
+       read_sort},
+
+      {"pipeline.stages", T::text_list, std::vector<std::string>{"auto"}, 0, 0,
+       {"auto", "generate", "approx_hit", "zsort", "repack", "trace", "shade", "spawn"},
+       "the stage chain; spawn at the end loops back. auto: the chain reorder.heuristic needs",
+       read_stages},
+      {"pipeline.mode", T::text, std::string("wavefront"), 0, 0, {"wavefront", "megakernel"},
+       "wavefront: batches through the stage graph; megakernel: one path at a time per worker (the control)",
+       choice<parse_pipeline_mode, &P::pipeline, &PipelineOptions::mode>},
+      {"pipeline.tile", T::integer, std::int64_t{16}, 1, 4096, {},
+       "megakernel: side in pixels of the square tiles workers take",
+       integer<&P::pipeline, &PipelineOptions::tile_side>},
+  };
+  return schema;
+}
+
+}  // namespace wavetrace

@@ -1,0 +1,195 @@
+// Config to plan: every key read by its row of the key table (config_keys.cpp), then the
+// checks across keys, the stage chain and the megakernel's limits.
+#include "wavetrace/setup/plan_render.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <limits>
+#include <stdexcept>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+namespace wavetrace {
+namespace {
+
+void check_stage_order(const std::vector<std::string>& names, ReorderHeuristic heuristic) {
+  const auto position = [&](std::string_view name) {
+    return std::find(names.begin(), names.end(), name) - names.begin();
+  };
+  const auto present = [&](std::string_view name) { return position(name) < std::ptrdiff_t(names.size()); };
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (std::count(names.begin(), names.end(), names[i]) > 1) {
+      throw ConfigError(fmt::format("pipeline.stages: '{}' appears more than once", names[i]));
+    }
+  }
+  if (names.empty() || names.front() != "generate") {
+    throw ConfigError("pipeline.stages: must start with 'generate'");
+  }
+  if (present("shade") && (!present("trace") || position("trace") > position("shade"))) {
+    throw ConfigError("pipeline.stages: 'shade' needs 'trace' before it");
+  }
+  if (present("spawn") && (!present("shade") || position("shade") > position("spawn"))) {
+    throw ConfigError("pipeline.stages: 'spawn' needs 'shade' before it");
+  }
+  if (present("approx_hit") && (!present("trace") || position("approx_hit") > position("trace"))) {
+    throw ConfigError("pipeline.stages: 'approx_hit' needs 'trace' after it");
+  }
+  if (present("zsort") && (!present("trace") || position("zsort") > position("trace"))) {
+    throw ConfigError("pipeline.stages: 'zsort' needs 'trace' after it");
+  }
+  if (present("repack") && (!present("trace") || position("repack") > position("trace"))) {
+    throw ConfigError("pipeline.stages: 'repack' needs 'trace' after it");
+  }
+  if (present("repack") && present("zsort")) {
+    throw ConfigError("pipeline.stages: 'repack' and 'zsort' both buffer rays: use one (zsort's batches are full)");
+  }
+  if (present("zsort") && present("approx_hit") && position("approx_hit") > position("zsort")) {
+    throw ConfigError("pipeline.stages: 'approx_hit' must come before 'zsort' (zsort sorts by its points)");
+  }
+  if (uses_hit_points(heuristic) && present("zsort") && !present("approx_hit")) {
+    throw ConfigError(fmt::format("pipeline.stages: reorder.heuristic = '{}' needs 'approx_hit' before 'zsort'",
+                                  to_string(heuristic)));
+  }
+  if (present("spawn") && names.back() != "spawn") {
+    throw ConfigError("pipeline.stages: 'spawn' must be last (its rays go back to the start of the chain)");
+  }
+}
+
+// The megakernel runs generate, trace, shade and spawn one path at a time: settings that
+// only the wavefront can honour are refused rather than ignored.
+void check_megakernel_plan(const RenderPlan& plan) {
+  if (plan.reorder.heuristic != ReorderHeuristic::none) {
+    throw ConfigError(fmt::format("reorder.heuristic = '{}' reorders batches of rays: pipeline.mode = megakernel has "
+                                  "none (set reorder.heuristic = none or pipeline.mode = wavefront)",
+                                  to_string(plan.reorder.heuristic)));
+  }
+  const std::vector<std::string> chain = {"generate", "trace", "shade", "spawn"};
+  if (plan.stages != chain) {
+    throw ConfigError(fmt::format("pipeline.stages = [{}]: pipeline.mode = megakernel runs generate, trace, shade, "
+                                  "spawn (set pipeline.stages = auto)",
+                                  fmt::join(plan.stages, ", ")));
+  }
+  if (plan.memory.enabled()) {
+    throw ConfigError("[memory] observation (pager, cache) counts the wavefront's stages: set pipeline.mode = wavefront");
+  }
+}
+
+}  // namespace
+
+void check_accelerator_options(const Config& config, const AcceleratorOptions& options) {
+  // epsilon chooses the bits: both given (even bits = 16, the default) is a conflict.
+  if ((config.given("accel.hmq.bits") && config.given("accel.hmq.epsilon")) ||
+      (options.hmq.epsilon > 0.0 && options.hmq.bits != HmqOptions{}.bits)) {
+    throw ConfigError(fmt::format("accel.hmq.bits = {} and accel.hmq.epsilon = {}: set one of them (epsilon "
+                                  "chooses the bits)",
+                                  options.hmq.bits, options.hmq.epsilon));
+  }
+  for (const auto& [key, width] : {std::pair{"accel.bvh.width", options.bvh.width},
+                                   std::pair{"accel.raystrips.width", options.raystrips.width},
+                                   std::pair{"accel.hmq.width", options.hmq.width}}) {
+    if (width != 2 && width != 8) throw ConfigError(fmt::format("{} = {}: must be 2 or 8", key, width));
+  }
+  // A top share set for the wide layout, which has no float top, is refused, not ignored.
+  if (options.hmq.width == 8 &&
+      (config.given("accel.hmq.top_fraction") || options.hmq.top_fraction != HmqOptions{}.top_fraction)) {
+    throw ConfigError(fmt::format("accel.hmq.top_fraction = {} applies to the binary layout (width 2): width 8 "
+                                  "quantizes every node",
+                                  options.hmq.top_fraction));
+  }
+}
+
+void check_memory_plan(const Config& config, const MemoryPlan& plan) {
+  if (!std::has_single_bit(plan.page_bytes)) {
+    throw ConfigError(fmt::format("memory.page_bytes = {} is not a power of two", plan.page_bytes));
+  }
+  if (plan.file_backing && !plan.budget) {
+    throw ConfigError("memory.backing = file pages a world file under memory.budget: set one (for example 20%)");
+  }
+  if (!plan.cache) return;
+  if (plan.cache->name == "custom" && !(config.has("memory.cache_bytes") && config.has("memory.cache_ways"))) {
+    throw ConfigError("memory.cache = 'custom' needs memory.cache_bytes and memory.cache_ways");
+  }
+  try {
+    validate_cache_geometry(*plan.cache);
+  } catch (const std::invalid_argument& error) {
+    throw ConfigError(fmt::format("memory.cache: {}", error.what()));
+  }
+}
+
+void read_plan_keys(const Config& config, RenderPlan& plan, std::string_view prefix) {
+  for (const ConfigKey& row : config_schema()) {
+    if (row.name.starts_with(prefix)) row.read(config, row.name, plan);
+  }
+}
+
+void record_built_accelerator(Config& config, const RenderPlan& plan) {
+  config.set_value("accel.type", plan.accelerator.type);
+  const std::string section = "accel." + plan.accelerator.type + ".";
+  for (const ConfigKey& key : config_schema()) {
+    if (key.record == nullptr || !key.name.starts_with(section)) continue;
+    if (const std::optional<ConfigValue> value = key.record(plan)) config.set_value(key.name, *value);
+  }
+}
+
+AcceleratorOptions accelerator_options(const Config& config) {
+  RenderPlan plan;
+  read_plan_keys(config, plan, "accel.");
+  read_plan_keys(config, plan, "build.");
+  read_plan_keys(config, plan, "render.threads");
+  check_accelerator_options(config, plan.accelerator);
+  return plan.accelerator;
+}
+
+AccelGoal accel_goal(const Config& config) {
+  RenderPlan plan;
+  read_plan_keys(config, plan, "accel.");
+  return plan.accel_goal;
+}
+
+MemoryPlan plan_memory(const Config& config) {
+  RenderPlan plan;
+  read_plan_keys(config, plan, "memory.");
+  check_memory_plan(config, plan.memory);
+  return plan.memory;
+}
+
+RenderPlan plan_render(const Config& config) {
+  RenderPlan plan;
+  read_plan_keys(config, plan);
+  if (std::uint64_t(plan.image.width) * plan.image.height * plan.image.samples_per_pixel > (std::uint64_t{1} << 40)) {
+    throw ConfigError("render: width x height x spp is over 2^40 rays");
+  }
+  if ((std::uint64_t(plan.image.seed) + 1) * plan.image.samples_per_pixel > std::numeric_limits<std::uint32_t>::max()) {
+    throw ConfigError(fmt::format("render.seed = {} with render.spp = {}: the sample numbers, up to (seed + 1) x spp, "
+                                  "must stay under 2^32",
+                                  config.integer("render.seed"), plan.image.samples_per_pixel));
+  }
+  check_accelerator_options(config, plan.accelerator);
+  check_memory_plan(config, plan.memory);
+  // The proxy's accelerator takes the main one's options, of its own type (proxy.accel).
+  const std::string proxy_type = plan.proxy.accelerator.type;
+  plan.proxy.accelerator = plan.accelerator;
+  plan.proxy.accelerator.type = proxy_type;
+  if (config.given("reorder.buffer_rays") && config.has("reorder.buffer_bytes")) {
+    throw ConfigError("reorder.buffer_rays and reorder.buffer_bytes both size the reorder buffer: set one of them");
+  }
+
+  if (plan.stages == std::vector<std::string>{"auto"}) plan.stages = stages_for(plan.reorder.heuristic);
+  if (std::count(plan.stages.begin(), plan.stages.end(), "auto") > 0) {
+    throw ConfigError("pipeline.stages: 'auto' stands alone");
+  }
+  check_stage_order(plan.stages, plan.reorder.heuristic);
+  if (!config.has("render.rays_in_flight")) {
+    plan.pipeline.rays_in_flight =
+        std::find(plan.stages.begin(), plan.stages.end(), "zsort") != plan.stages.end()
+            ? plan.reorder.buffer_rays  // so that the buffer can fill
+            // Without a buffer to fill, rays in flight only keep the workers busy; more would
+            // cost memory (and first-touch page faults) for nothing.
+            : 4 * std::size_t(worker_count(plan.pipeline)) * plan.pipeline.batch_size;
+  }
+  if (plan.pipeline.mode == PipelineMode::megakernel) check_megakernel_plan(plan);
+  return plan;
+}
+
+}  // namespace wavetrace

@@ -1,0 +1,34 @@
+// One call from a plan and a world to an image: the chain run through the pipeline (or the
+// megakernel), with what each stage did.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "wavetrace/scene/camera.hpp"
+#include "wavetrace/stages/hit_rates.hpp"
+#include "wavetrace/pipeline/pipeline.hpp"
+#include "wavetrace/setup/render_plan.hpp"
+#include "wavetrace/stages/world.hpp"
+
+namespace wavetrace {
+
+struct RenderOutput {
+  PipelineRun run;
+  std::vector<float> image;  // linear RGB, top row first
+  std::vector<DepthHitRate> hit_rates;  // closest-hit rays per path depth
+  // Set when [memory] asks for observation but the accelerator's reads cannot be seen.
+  std::optional<std::string> memory_unobserved;
+  double sort_seconds = 0.0;  // zsort's sorting alone (within its stage seconds)
+  double closest_mrays_per_s = 0.0;  // trace's closest-hit (camera and bounce) rays per busy second
+  double any_mrays_per_s = 0.0;      // trace's shadow rays per busy second
+  std::uint64_t rejected_contributions = 0;
+};
+
+RenderOutput render_image(const RenderPlan& plan, const World& world, const Camera& camera,
+                          const std::function<void(const Progress&)>& on_progress = {});
+
+}  // namespace wavetrace

@@ -1,0 +1,24 @@
+// The plan's derived answers: the chain auto stands for, the worker count, whether a proxy is needed.
+#include "wavetrace/setup/render_plan.hpp"
+
+#include <algorithm>
+
+#include <tbb/info.h>
+
+namespace wavetrace {
+
+int worker_count(const PipelineOptions& options) {
+  return options.threads > 0 ? options.threads : tbb::info::default_concurrency();
+}
+
+bool RenderPlan::needs_proxy() const { return std::find(stages.begin(), stages.end(), "approx_hit") != stages.end(); }
+
+std::vector<std::string> stages_for(ReorderHeuristic heuristic) {
+  std::vector<std::string> stages = {"generate"};
+  if (uses_hit_points(heuristic)) stages.push_back("approx_hit");
+  if (heuristic != ReorderHeuristic::none) stages.push_back("zsort");
+  stages.insert(stages.end(), {"trace", "shade", "spawn"});
+  return stages;
+}
+
+}  // namespace wavetrace
