@@ -47,6 +47,11 @@ std::string memory_lines(const std::vector<StageStats>& stages) {
                            stage.name, stage.disk->page_bytes >> 10, double(stage.disk->budget_bytes) / (1 << 20),
                            c.faults, double(c.bytes_read) * 1e-6, c.read_seconds);
     }
+    if (stage.spill) {
+      lines += fmt::format("{} spill: {} runs on disk, {:.1f} MB written, {:.1f} MB read, {:.3f} s of I/O\n", stage.name,
+                           stage.spill->runs, double(stage.spill->bytes_written) * 1e-6,
+                           double(stage.spill->bytes_read) * 1e-6, stage.spill->seconds);
+    }
     if (stage.cache) {
       const CacheGeometry& g = stage.cache->geometry;
       const CacheCounters& c = stage.cache->counters;
@@ -97,6 +102,12 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
                        {"read_seconds", stage.disk->counters.read_seconds}};
     }
     if (stage.cache) entry["cache"] = cache_json(*stage.cache);
+    if (stage.spill) {
+      entry["spill"] = {{"bytes_written", stage.spill->bytes_written},
+                        {"bytes_read", stage.spill->bytes_read},
+                        {"seconds", stage.spill->seconds},
+                        {"runs", stage.spill->runs}};
+    }
     stages.push_back(entry);
   }
   nlohmann::json hit_rates = nlohmann::json::array();

@@ -80,10 +80,15 @@ class RayBatch {
   // copies, writes or reads whole columns needs, without a list of its own.
   template <typename Visit>
   void for_each_column(Visit&& visit) {
+    for_each_column(visit, has_approx_hit(), has_sort_key());
+  }
+  // The same over the optional sets asked for, which must be enabled (a spill block's).
+  template <typename Visit>
+  void for_each_column(Visit&& visit, bool with_approx_hit, bool with_sort_key) {
 #define WAVETRACE_VISIT(type, name) visit(#name, static_cast<void*>(name), sizeof(type));
     WAVETRACE_RAY_COLUMNS(WAVETRACE_VISIT)
-    if (has_approx_hit()) { WAVETRACE_APPROX_HIT_COLUMNS(WAVETRACE_VISIT) }
-    if (has_sort_key()) { WAVETRACE_SORT_KEY_COLUMNS(WAVETRACE_VISIT) }
+    if (with_approx_hit) { WAVETRACE_APPROX_HIT_COLUMNS(WAVETRACE_VISIT) }
+    if (with_sort_key) { WAVETRACE_SORT_KEY_COLUMNS(WAVETRACE_VISIT) }
 #undef WAVETRACE_VISIT
   }
 

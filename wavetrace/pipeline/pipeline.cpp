@@ -53,9 +53,15 @@ void PipelineContext::retire_rays(std::size_t count) {
   if (buffer_node_ != nullptr) {
     const auto waiting = std::int64_t(buffer_stage_->buffered_rays());
     if (waiting > 0 && now <= waiting) buffer_node_->try_put(nullptr);
+    // A draining disk buffer emits more as the rays in memory make room.
+    if (buffer_stage_->draining() && in_core_rays() < std::int64_t(budget_)) buffer_node_->try_put(nullptr);
   }
+  wake_generator();
+}
+
+void PipelineContext::wake_generator() {
   if (generator_node_ != nullptr && !generator_stage_->exhausted() &&
-      now + std::int64_t(pool_.batch_capacity()) <= std::int64_t(budget_)) {
+      in_core_rays() + std::int64_t(pool_.batch_capacity()) <= std::int64_t(budget_)) {
     generator_node_->try_put(tbb::flow::continue_msg());
   }
 }
@@ -67,7 +73,7 @@ std::unique_ptr<GenerateNode> make_generate_node(tbb::flow::graph& graph, Genera
   auto node = std::make_unique<GenerateNode>(
       graph, tbb::flow::unlimited, [&stage, &context, &counters](tbb::flow::continue_msg, GenerateNode::output_ports_type& ports) {
         const std::size_t capacity = context.pool().batch_capacity();
-        while (!stage.exhausted() && context.live_rays() + std::int64_t(capacity) <= std::int64_t(context.budget())) {
+        while (!stage.exhausted() && context.in_core_rays() + std::int64_t(capacity) <= std::int64_t(context.budget())) {
           const Clock::time_point start = Clock::now();
           const GenerateStage::Claim claimed = stage.claim(capacity);
           if (claimed.count == 0) return;
@@ -119,9 +125,16 @@ std::unique_ptr<BatchNode> make_buffering_node(tbb::flow::graph& graph, const Bu
         const Clock::time_point start = Clock::now();
         BufferedOutput out(context, ports);
         const std::size_t rays_in = batch != nullptr ? batch->rays.count : 0;
+        const std::size_t spilled = stage.spilled_rays();
         std::size_t rays_out = batch != nullptr ? stage.take(batch, out) : 0;
         const std::size_t waiting = stage.buffered_rays();
-        if (waiting > 0 && std::int64_t(waiting) >= context.live_rays()) rays_out += stage.flush(out);
+        if (!stage.draining() && waiting > 0 && std::int64_t(waiting) >= context.live_rays()) rays_out += stage.flush(out);
+        if (stage.draining()) {
+          // Emit the merged stream as far as the budget allows; a retiring ray pokes for more.
+          const std::int64_t room = std::int64_t(context.budget()) - context.in_core_rays();
+          if (room > 0) rays_out += stage.drain(out, std::size_t(room));
+        }
+        if (stage.spilled_rays() > spilled) context.wake_generator();  // the spilled rays left memory
         if (rays_in > 0 || rays_out > 0) counters.record(rays_in, rays_out, nanoseconds_since(start));
       });
   context.attach_buffer(node.get(), &stage);

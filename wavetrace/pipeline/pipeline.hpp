@@ -38,7 +38,13 @@ class PipelineContext {
 
   BatchPool& pool() { return pool_; }
   std::int64_t live_rays() const { return live_rays_.load(std::memory_order_acquire); }
+  // Live rays in memory: all but those a buffer holds on disk. The flight budget bounds these.
+  std::int64_t in_core_rays() const {
+    return live_rays() - (buffer_stage_ != nullptr ? std::int64_t(buffer_stage_->spilled_rays()) : 0);
+  }
   std::size_t budget() const { return budget_; }
+  // Lets the generator run on if the budget has room (after a buffer moved rays to disk).
+  void wake_generator();
 
   // Rays entering the graph (made by generate or spawn).
   void add_rays(std::size_t count) { live_rays_.fetch_add(std::int64_t(count), std::memory_order_acq_rel); }

@@ -8,6 +8,7 @@
 
 #include "wavetrace/memory/cache_simulator.hpp"
 #include "wavetrace/memory/file_pager.hpp"
+#include "wavetrace/memory/ray_spill.hpp"
 #include "wavetrace/memory/simulated_pager.hpp"
 
 namespace wavetrace {
@@ -42,6 +43,8 @@ struct StageStats {
   std::optional<CacheStats> cache;
   // Real paging of a world file (memory.backing = file), measured.
   std::optional<DiskStats> disk;
+  // A disk ray buffer's runs (zsort with reorder.buffer = disk), measured.
+  std::optional<SpillCounters> spill;
 };
 
 class StageCounters {

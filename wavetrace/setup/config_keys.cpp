@@ -351,6 +351,15 @@ const std::vector<ConfigKey>& config_schema() {
       {"reorder.buffer_bytes", T::integer, std::nullopt, 1024, std::int64_t{1} << 40, {},
        "the buffer given in bytes instead (overrides buffer_rays; the paper: 88 MB)",
        read_buffer_bytes},
+      {"reorder.buffer", T::text, std::string("memory"), 0, 0, {"memory", "disk"},
+       "memory: zsort sorts and emits its buffer whenever it fills; disk (the paper's): the buffer is the in-core "
+       "part (88 MB by default), written to sorted runs on disk when full, and every ray of a generation is merged "
+       "by key once all live rays wait in it",
+       choice<parse_ray_buffer_kind, &P::reorder, &ZSortOptions::buffer>},
+      {"reorder.spill_dir", T::text, std::string(""), 0, 0, {},
+       "reorder.buffer = disk: the directory of the runs (empty: the system's temporary directory); their files have "
+       "no name and vanish with the render",
+       text<&P::reorder, &ZSortOptions::spill_dir>},
       {"reorder.sort", T::text, std::string("radix"), 0, 0, {"radix", "parallel"},
        "zsort's sort: a stable LSD radix sort or tbb::parallel_sort",
        read_sort},

@@ -13,6 +13,9 @@
 namespace wavetrace {
 namespace {
 
+// The paper's in-core ray buffer (§4): 88 MB, reorder.buffer = disk's default.
+constexpr std::size_t kPaperInCoreBufferBytes = 88'000'000;
+
 void check_stage_order(const std::vector<std::string>& names, ReorderHeuristic heuristic) {
   const auto position = [&](std::string_view name) {
     return std::find(names.begin(), names.end(), name) - names.begin();
@@ -174,6 +177,10 @@ RenderPlan plan_render(const Config& config) {
   if (config.given("reorder.buffer_rays") && config.has("reorder.buffer_bytes")) {
     throw ConfigError("reorder.buffer_rays and reorder.buffer_bytes both size the reorder buffer: set one of them");
   }
+  if (plan.reorder.buffer == RayBufferKind::disk && !config.given("reorder.buffer_rays") &&
+      !config.has("reorder.buffer_bytes")) {
+    plan.reorder.buffer_rays = kPaperInCoreBufferBytes / ZSortStage::kBytesPerBufferedRay;  // the paper's in-core part
+  }
 
   if (plan.stages == std::vector<std::string>{"auto"}) plan.stages = stages_for(plan.reorder.heuristic);
   if (std::count(plan.stages.begin(), plan.stages.end(), "auto") > 0) {
@@ -187,6 +194,16 @@ RenderPlan plan_render(const Config& config) {
             // Without a buffer to fill, rays in flight only keep the workers busy; more would
             // cost memory (and first-touch page faults) for nothing.
             : 4 * std::size_t(worker_count(plan.pipeline)) * plan.pipeline.batch_size;
+  }
+  if (plan.reorder.buffer == RayBufferKind::disk) {
+    if (std::find(plan.stages.begin(), plan.stages.end(), "zsort") == plan.stages.end()) {
+      throw ConfigError("reorder.buffer = disk is zsort's buffer, and the chain has no zsort: set a reorder.heuristic");
+    }
+    if (plan.pipeline.rays_in_flight < plan.reorder.buffer_rays) {
+      throw ConfigError(fmt::format("render.rays_in_flight = {} is under the disk buffer's in-core part ({} rays): "
+                                    "the in-core part must be able to fill",
+                                    plan.pipeline.rays_in_flight, plan.reorder.buffer_rays));
+    }
   }
   if (plan.pipeline.mode == PipelineMode::megakernel) check_megakernel_plan(plan);
   return plan;

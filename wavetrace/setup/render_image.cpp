@@ -1,6 +1,8 @@
 // Plan and world to image.
 #include "wavetrace/setup/render_image.hpp"
 
+#include <filesystem>
+
 #include <fmt/format.h>
 
 #include "wavetrace/pipeline/megakernel.hpp"
@@ -10,9 +12,30 @@
 #include "wavetrace/stages/trace.hpp"
 
 namespace wavetrace {
+namespace {
+
+// A disk ray buffer writes at most a generation of rays: every path's bounce and shadow ray
+// (two per camera sample), each its ray, approximate hit and key columns. Checked before
+// anything is traced, so that a render never stops for want of disk halfway through.
+void check_spill_space(const RenderPlan& plan) {
+  if (plan.reorder.buffer != RayBufferKind::disk) return;
+  const std::string directory =
+      plan.reorder.spill_dir.empty() ? std::filesystem::temp_directory_path().string() : plan.reorder.spill_dir;
+  const std::uint64_t free = spill_directory_free_bytes(directory);
+  const std::uint64_t needed = 2 * std::uint64_t(plan.image.pixel_count()) * plan.image.samples_per_pixel *
+                               (RayBatch::kBytesPerRay + RayBatch::kApproxHitBytesPerRay + RayBatch::kSortKeyBytesPerRay);
+  if (needed > free) {
+    throw SpillError(fmt::format("reorder.spill_dir = {}: a generation of this render's rays may need {:.2f} GB on "
+                                 "disk and {:.2f} GB are free",
+                                 directory, double(needed) * 1e-9, double(free) * 1e-9));
+  }
+}
+
+}  // namespace
 
 RenderOutput render_image(const RenderPlan& plan, const World& world, const Camera& camera,
                           const std::function<void(const Progress&)>& on_progress) {
+  check_spill_space(plan);
   const int workers = worker_count(plan.pipeline);
   Film film(plan.image.width, plan.image.height, plan.film_per_thread ? std::uint32_t(workers) : 0);
   GenerateStage generate(camera, plan.image, plan.pixel_order);
@@ -43,7 +66,14 @@ RenderOutput render_image(const RenderPlan& plan, const World& world, const Came
     Pipeline pipeline(generate, chain.stages(), chain.loops(), plan.pipeline);
     output.run = pipeline.run(on_progress);
     if (observation) observation->report(output.run.stages);
-    if (chain.zsort() != nullptr) output.sort_seconds = chain.zsort()->sort_seconds();
+    if (chain.zsort() != nullptr) {
+      output.sort_seconds = chain.zsort()->sort_seconds();
+      if (plan.reorder.buffer == RayBufferKind::disk) {
+        for (StageStats& stage : output.run.stages) {
+          if (stage.name == chain.zsort()->name()) stage.spill = chain.zsort()->spill();
+        }
+      }
+    }
     output.closest_mrays_per_s = chain.trace_times().closest_mrays_per_s();
     output.any_mrays_per_s = chain.trace_times().any_mrays_per_s();
     output.hit_rates = chain.hit_rates().snapshot();

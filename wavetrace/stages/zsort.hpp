@@ -6,10 +6,13 @@
 
 #include <atomic>
 #include <cstdint>
+#include <memory>
+#include <string>
 #include <vector>
 
-#include "wavetrace/stages/reorder_keys.hpp"
+#include "wavetrace/memory/ray_spill.hpp"
 #include "wavetrace/stages/buffering_stage.hpp"
+#include "wavetrace/stages/reorder_keys.hpp"
 
 namespace wavetrace {
 
@@ -17,11 +20,22 @@ namespace wavetrace {
 // tbb::parallel_sort. Radix measured faster here (docs/reordering.md), so it is the default.
 enum class SortAlgorithm { radix, parallel };
 
+// memory: the buffer is `buffer_rays` in memory, sorted and emitted whenever it fills.
+// disk (the paper's, §4): `buffer_rays` is the in-core part; when it fills, its rays are
+// sorted and written to a run on disk (memory/ray_spill.hpp), and once every live ray waits
+// in the buffer the whole generation (the in-core part and every run) is merged by key and
+// emitted as the flight budget makes room.
+enum class RayBufferKind { memory, disk };
+RayBufferKind parse_ray_buffer_kind(const std::string& text);
+std::string to_string(RayBufferKind kind);
+
 struct ZSortOptions {
   ReorderHeuristic heuristic = ReorderHeuristic::none;
   CurveKind curve = CurveKind::morton;
   std::size_t buffer_rays = std::size_t{1} << 18;
   SortAlgorithm sort = SortAlgorithm::radix;
+  RayBufferKind buffer = RayBufferKind::memory;
+  std::string spill_dir;  // disk: where runs are written (empty: the system's temporary directory)
   bool operator==(const ZSortOptions&) const = default;
 };
 
@@ -46,29 +60,50 @@ class ZSortStage final : public BufferingStage {
                                                       RayBatch::kSortKeyBytesPerRay + HitBatch::kBytesPerHit +
                                                       sizeof(SortEntry);
 
-  ZSortStage(const ZSortOptions& options, const Bounds3& scene_bounds) : options_(options), bounds_(scene_bounds) {}
+  ZSortStage(const ZSortOptions& options, const Bounds3& scene_bounds);
   std::string name() const override { return "zsort"; }
   // Outside the pipeline's zsort node (a hand-wired chain): sorts one batch on its own.
   void process(Batch* batch, StageOutput& out) const override;
 
-  // Holds the batch; true when the buffer is full.
+  ~ZSortStage() override;
+
+  // Holds the batch; true when the buffer (its in-core part, with a disk buffer) is full.
   bool buffer(Batch* batch) const;
-  // Holds the batch, and sorts and emits the buffer once it is full.
-  std::size_t take(Batch* batch, StageOutput& out) const override { return buffer(batch) ? flush(out) : 0; }
+  // Holds the batch; once the buffer is full, sorts and emits it (memory) or writes it to a
+  // run on disk (disk).
+  std::size_t take(Batch* batch, StageOutput& out) const override;
   // Sorts and emits every buffered ray in key order through `out` (acquiring batches from
-  // it and releasing the buffered ones); returns the rays emitted.
+  // it and releasing the buffered ones); returns the rays emitted. With runs on disk it
+  // starts draining instead: drain emits the merged stream.
   std::size_t flush(StageOutput& out) const override;
   std::size_t buffered_rays() const override { return buffered_rays_.load(std::memory_order_seq_cst); }
+  std::size_t spilled_rays() const override { return spilled_rays_.load(std::memory_order_seq_cst); }
+  bool draining() const override { return draining_.load(std::memory_order_seq_cst); }
+  std::size_t drain(StageOutput& out, std::size_t max_rays) const override;
   double sort_seconds() const { return sort_seconds_; }  // sorting alone, summed over flushes
   std::size_t flushes() const { return flushes_; }
+  const SpillCounters& spill() const { return spill_; }
   const ZSortOptions& options() const { return options_; }
 
  private:
+  // The held batches' rays in key order, in batches acquired from `out` (the held ones
+  // released); arrival order among equal keys.
+  std::vector<Batch*> sort_held(StageOutput& out) const;
+  // Writes the in-core part, sorted, as one more run of the next generation.
+  void spill_held(StageOutput& out) const;
+  struct Merge;  // the runs of the generation being drained, merged by (key, run)
+
   ZSortOptions options_;
   Bounds3 bounds_;
+  std::string spill_dir_;
   mutable std::vector<Batch*> held_;
+  mutable std::size_t held_rays_ = 0;
   mutable std::vector<SortEntry> entries_, scratch_;  // kept across flushes: no page faults per flush
-  mutable std::atomic<std::size_t> buffered_rays_{0};
+  mutable std::atomic<std::size_t> buffered_rays_{0}, spilled_rays_{0};
+  mutable std::atomic<bool> draining_{false};
+  mutable std::vector<std::unique_ptr<SpillRun>> runs_;  // the next generation's
+  mutable std::unique_ptr<Merge> merge_;
+  mutable SpillCounters spill_;
   mutable double sort_seconds_ = 0.0;
   mutable std::size_t flushes_ = 0;
 };
