@@ -43,9 +43,10 @@ std::string memory_lines(const std::vector<StageStats>& stages) {
     if (stage.disk) {
       const DiskCounters& c = stage.disk->counters;
       lines += fmt::format("{} disk: {} KiB pages, pool {:.1f} MiB: {} real faults, {:.1f} MB read in {:.3f} s "
-                           "(O_DIRECT, in the measured time)\n",
+                           "(O_DIRECT, in the measured time), {:.3f} s waited for pages, up to {} reads at once\n",
                            stage.name, stage.disk->page_bytes >> 10, double(stage.disk->budget_bytes) / (1 << 20),
-                           c.faults, double(c.bytes_read) * 1e-6, c.read_seconds);
+                           c.faults, double(c.bytes_read) * 1e-6, c.read_seconds, c.wait_seconds,
+                           stage.disk->reads_in_flight_max);
     }
     if (stage.spill) {
       lines += fmt::format("{} spill: {} runs on disk, {:.1f} MB written, {:.1f} MB read, {:.3f} s of I/O\n", stage.name,
@@ -99,7 +100,9 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
                        {"budget_bytes", stage.disk->budget_bytes},
                        {"faults", stage.disk->counters.faults},
                        {"bytes_read", stage.disk->counters.bytes_read},
-                       {"read_seconds", stage.disk->counters.read_seconds}};
+                       {"read_seconds", stage.disk->counters.read_seconds},
+                       {"wait_seconds", stage.disk->counters.wait_seconds},
+                       {"reads_in_flight_max", stage.disk->reads_in_flight_max}};
     }
     if (stage.cache) entry["cache"] = cache_json(*stage.cache);
     if (stage.spill) {

@@ -180,12 +180,15 @@ INSTANTIATE_TEST_SUITE_P(
                       std::vector<std::string>{"accel.type=raystrips", "build.chunk_triangles=4096"},
                       std::vector<std::string>{"accel.type=bvh", "build.chunk_triangles=4096"}));
 
-TEST(WorldFile, RealPagingChangesNoPixelAndCountsItsReads) {
+// Reads happen outside the pool's lock, several at once: any number of threads gets the same
+// image, and every thread that waited for a page is counted.
+TEST(WorldFile, RealPagingChangesNoPixelAndCountsItsReadsOnTwoAndEightThreads) {
   const std::string path = temp_path("paged.wtw");
   const std::vector<std::string> build = {"accel.type=hmq", "build.chunk_triangles=4096"};
   const std::vector<float> fresh = build_and_save(build, path);
+  for (const char* threads : {"render.threads=2", "render.threads=8"}) {
   std::vector<std::string> paged = build;
-  for (const char* s : {"memory.backing=file", "memory.budget=5%", "memory.page_bytes=4096"}) paged.emplace_back(s);
+  for (const char* s : {"memory.backing=file", "memory.budget=5%", "memory.page_bytes=4096", threads}) paged.emplace_back(s);
   const Config config = small_render(paged);
   const RenderPlan plan = plan_render(config);
   const std::unique_ptr<LoadedWorld> world = load_world(path, world_paging(plan), 2);
@@ -204,9 +207,12 @@ TEST(WorldFile, RealPagingChangesNoPixelAndCountsItsReads) {
     EXPECT_GT(stage.disk->counters.faults, 0u);
     EXPECT_EQ(stage.disk->counters.bytes_read, stage.disk->counters.faults * 4096);
     EXPECT_GT(stage.disk->counters.read_seconds, 0.0);
+    EXPECT_GE(stage.disk->counters.wait_seconds, stage.disk->counters.read_seconds * 0.5) << threads;
+    EXPECT_GE(stage.disk->reads_in_flight_max, 1u);
     counted = true;
   }
-  EXPECT_TRUE(counted);
+  EXPECT_TRUE(counted) << threads;
+  }
   fs::remove(path);
 }
 
@@ -423,6 +429,16 @@ TEST(WorldFileCli, BuildRenderAndInfo) {
                                                 "--set memory.budget=10% --out " + temp_path("y.exr"));
   EXPECT_EQ(not_world.exit_code, 1);
   EXPECT_NE(not_world.output.find("is not one"), std::string::npos) << not_world.output;
+  // A pool smaller than one page could hold nothing: refused, not rounded up.
+  const auto built_again = testing::run_wavetrace("build builtin:room:20k --accel hmq --out " + world);
+  ASSERT_EQ(built_again.exit_code, 0) << built_again.output;
+  const auto tiny = testing::run_wavetrace("render " + world + " --size 8x8 --out " + temp_path("z.exr") +
+                                           " --set memory.backing=file --set memory.budget=1000 "
+                                           "--set memory.page_bytes=65536");
+  EXPECT_EQ(tiny.exit_code, 1);
+  EXPECT_NE(tiny.output.find("memory.budget (1000 bytes) is under one page (memory.page_bytes = 65536)"),
+            std::string::npos)
+      << tiny.output;
 }
 
 }  // namespace

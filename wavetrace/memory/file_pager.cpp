@@ -1,5 +1,7 @@
 // The real pager: a PROT_NONE reservation for the file's range, page slots in a memfd
-// mapped over it on demand, a SIGSEGV handler for reads no probe announced.
+// mapped over it on demand, a SIGSEGV handler for reads no probe announced. Reads happen
+// outside the pool's lock, straight into their slot: threads reading different pages keep
+// that many reads in flight.
 #include "wavetrace/memory/file_pager.hpp"
 
 #include <algorithm>
@@ -10,6 +12,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
+#include <optional>
 #include <stdexcept>
 
 #include <fcntl.h>
@@ -79,6 +82,11 @@ FilePager::FilePager(const std::string& path, std::uint64_t file_bytes, std::siz
   if (!std::has_single_bit(page_bytes) || page_bytes < 4096) {
     throw std::invalid_argument(fmt::format("page size {} bytes: real paging needs a power of two of 4096 or more", page_bytes));
   }
+  if (budget_bytes < page_bytes) {
+    throw std::invalid_argument(fmt::format("{}: memory.budget ({} bytes) is under one page (memory.page_bytes = {}): "
+                                            "nothing could stay resident",
+                                            path, budget_bytes, page_bytes));
+  }
   page_shift_ = static_cast<unsigned>(std::countr_zero(page_bytes));
   const std::size_t pages = (file_bytes + page_bytes - 1) / page_bytes;
   if (pages >= kNone) throw std::invalid_argument(fmt::format("{}: {} pages of {} bytes is too many", path, pages, page_bytes));
@@ -102,14 +110,15 @@ FilePager::FilePager(const std::string& path, std::uint64_t file_bytes, std::siz
     throw std::runtime_error(fmt::format("{}: cannot create a page pool of {} bytes: {}", path, slots_ * page_bytes, reason));
   }
   void* range = ::mmap(nullptr, reserved_bytes_, PROT_NONE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
-  staging_ = static_cast<std::byte*>(std::aligned_alloc(4096, page_bytes));
-  if (range == MAP_FAILED || staging_ == nullptr) {
+  void* view = ::mmap(nullptr, slots_ * page_bytes, PROT_READ | PROT_WRITE, MAP_SHARED, pool_fd_, 0);
+  if (range == MAP_FAILED || view == MAP_FAILED) {
     ::close(direct_fd_);
     ::close(pool_fd_);
     if (range != MAP_FAILED) ::munmap(range, reserved_bytes_);
-    std::free(staging_);
+    if (view != MAP_FAILED) ::munmap(view, slots_ * page_bytes);
     throw std::runtime_error(fmt::format("{}: cannot reserve {} bytes of address space", path, reserved_bytes_));
   }
+  pool_view_ = static_cast<std::byte*>(view);
   base_ = static_cast<std::byte*>(range);
   slot_of_.assign(pages, kNone);
   previous_.assign(pages, kNone);
@@ -135,11 +144,11 @@ void FilePager::release() {
   }
   if (base_ != nullptr) ::munmap(base_, reserved_bytes_);
   base_ = nullptr;
+  if (pool_view_ != nullptr) ::munmap(pool_view_, slots_ * page_bytes_);
+  pool_view_ = nullptr;
   if (direct_fd_ >= 0) ::close(direct_fd_);
   if (pool_fd_ >= 0) ::close(pool_fd_);
   direct_fd_ = pool_fd_ = -1;
-  std::free(staging_);
-  staging_ = nullptr;
 }
 
 std::size_t FilePager::client_index() const {
@@ -169,71 +178,95 @@ void FilePager::evict_locked(std::uint32_t page) {
   slot_of_[page] = kNone;
 }
 
-std::string FilePager::load_locked(std::uint32_t page) {
+std::string FilePager::load(std::uint32_t page, std::unique_lock<std::mutex>& lock) {
+  std::optional<std::chrono::steady_clock::time_point> waiting_since;
+  for (;;) {
+    const std::uint32_t state = slot_of_[page];
+    if (state != kNone && state != kLoading) {
+      if (head_ != page) {
+        unlink_locked(page);
+        push_front_locked(page);
+      }
+      if (waiting_since) {
+        clients_[client_index()].wait_seconds +=
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - *waiting_since).count();
+      }
+      return {};
+    }
+    if (!waiting_since) waiting_since = std::chrono::steady_clock::now();
+    // Another thread reads this page, or every slot is taken by reads under way: wait.
+    if (state == kLoading || (free_slots_.empty() && tail_ == kNone)) {
+      loaded_.wait(lock);
+      continue;
+    }
+    break;
+  }
   if (free_slots_.empty()) evict_locked(tail_);
   const std::uint32_t slot = free_slots_.back();
+  free_slots_.pop_back();
+  slot_of_[page] = kLoading;
+  reads_in_flight_max_ = std::max(reads_in_flight_max_, ++reads_in_flight_);
+  lock.unlock();
+
+  std::string error;
   const std::uint64_t offset = std::uint64_t(page) << page_shift_;
   const std::size_t bytes = static_cast<std::size_t>(std::min<std::uint64_t>(page_bytes_, file_bytes_ - offset));
   // O_DIRECT wants whole blocks: read the page's full size (a section file's size is a
   // multiple of 4096, so the read ends at or before the file's end on a block boundary).
   const std::size_t request = (bytes + 4095) / 4096 * 4096;
+  std::byte* into = pool_view_ + std::size_t(slot) * page_bytes_;
   const auto start = std::chrono::steady_clock::now();
-  std::size_t done = 0;
-  while (done < bytes) {
-    const ssize_t got = ::pread(direct_fd_, staging_ + done, request - done, off_t(offset + done));
+  for (std::size_t done = 0; done < bytes && error.empty();) {
+    const ssize_t got = ::pread(direct_fd_, into + done, request - done, off_t(offset + done));
     if (got < 0 && errno == EINTR) continue;
     if (got <= 0) {
-      return fmt::format("{}: reading page {} (bytes {}..{}) failed: {}", path_, page, offset, offset + bytes,
-                         got < 0 ? std::strerror(errno) : "the file ends early");
+      error = fmt::format("{}: reading page {} (bytes {}..{}) failed: {}", path_, page, offset, offset + bytes,
+                          got < 0 ? std::strerror(errno) : "the file ends early");
     }
-    done += std::size_t(got);
+    done += got > 0 ? std::size_t(got) : 0;
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (bytes < page_bytes_) std::memset(staging_ + bytes, 0, page_bytes_ - bytes);
-  // The page enters the pool through the kernel (pwrite), then appears at its address
-  // read-only in one mmap: no reader ever sees it half written.
-  for (std::size_t written = 0; written < page_bytes_;) {
-    const ssize_t put = ::pwrite(pool_fd_, staging_ + written, page_bytes_ - written, off_t(std::size_t(slot) * page_bytes_ + written));
-    if (put < 0 && errno == EINTR) continue;
-    if (put <= 0) return fmt::format("{}: the page pool refused page {}: {}", path_, page, std::strerror(errno));
-    written += std::size_t(put);
+  if (error.empty()) {
+    if (bytes < page_bytes_) std::memset(into + bytes, 0, page_bytes_ - bytes);
+    // The page appears at its address read-only in one mmap, once it is whole: no reader
+    // ever sees it half read. MAP_POPULATE maps every 4 KiB of it now: one call instead of a
+    // minor fault each.
+    if (::mmap(base_ + offset, page_bytes_, PROT_READ, MAP_SHARED | MAP_FIXED | MAP_POPULATE, pool_fd_,
+               off_t(std::size_t(slot) * page_bytes_)) == MAP_FAILED) {
+      error = fmt::format("{}: mapping page {} failed: {}", path_, page, std::strerror(errno));
+    }
   }
-  void* at = base_ + (std::size_t(page) << page_shift_);
-  // MAP_POPULATE maps every 4 KiB of the page now: one call instead of a minor fault each.
-  if (::mmap(at, page_bytes_, PROT_READ, MAP_SHARED | MAP_FIXED | MAP_POPULATE, pool_fd_,
-             off_t(std::size_t(slot) * page_bytes_)) == MAP_FAILED) {
-    return fmt::format("{}: mapping page {} failed: {}", path_, page, std::strerror(errno));
-  }
-  free_slots_.pop_back();
-  slot_of_[page] = slot;
-  push_front_locked(page);
+
+  lock.lock();
+  --reads_in_flight_;
   DiskCounters& counters = clients_[client_index()];
-  ++counters.faults;
-  counters.bytes_read += bytes;
-  counters.read_seconds += seconds;
-  return {};
+  counters.wait_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - *waiting_since).count();
+  if (!error.empty()) {
+    free_slots_.push_back(slot);
+    slot_of_[page] = kNone;
+  } else {
+    slot_of_[page] = slot;
+    push_front_locked(page);
+    ++counters.faults;
+    counters.bytes_read += bytes;
+    counters.read_seconds += seconds;
+  }
+  loaded_.notify_all();
+  return error;
 }
 
 void FilePager::touch(const void* address) {
   if (!contains(address)) return;
   const auto page = static_cast<std::uint32_t>(std::size_t(static_cast<const std::byte*>(address) - base_) >> page_shift_);
-  std::lock_guard lock(mutex_);
-  if (slot_of_[page] != kNone) {
-    if (head_ != page) {
-      unlink_locked(page);
-      push_front_locked(page);
-    }
-    return;
-  }
-  if (std::string error = load_locked(page); !error.empty()) throw std::runtime_error(error);
+  std::unique_lock lock(mutex_);
+  if (std::string error = load(page, lock); !error.empty()) throw std::runtime_error(error);
 }
 
 bool FilePager::handle_fault(const void* address) noexcept {
   if (!contains(address)) return false;
   const auto page = static_cast<std::uint32_t>(std::size_t(static_cast<const std::byte*>(address) - base_) >> page_shift_);
-  std::lock_guard lock(mutex_);
-  if (slot_of_[page] != kNone) return true;  // another thread loaded it while this one waited
-  const std::string error = load_locked(page);
+  std::unique_lock lock(mutex_);
+  const std::string error = load(page, lock);
   if (!error.empty()) {
     // No exception can leave a signal handler: say what failed and stop.
     const std::string line = "wavetrace: " + error + "\n";
@@ -247,6 +280,12 @@ void FilePager::reset() {
   std::lock_guard lock(mutex_);
   while (tail_ != kNone) evict_locked(tail_);
   for (DiskCounters& counters : clients_) counters = {};
+  reads_in_flight_max_ = 0;
+}
+
+std::size_t FilePager::reads_in_flight_max() const {
+  std::lock_guard lock(mutex_);
+  return reads_in_flight_max_;
 }
 
 DiskCounters FilePager::counters(std::size_t client) const {
@@ -261,6 +300,7 @@ DiskCounters FilePager::total() const {
     sum.faults += c.faults;
     sum.bytes_read += c.bytes_read;
     sum.read_seconds += c.read_seconds;
+    sum.wait_seconds += c.wait_seconds;
   }
   return sum;
 }

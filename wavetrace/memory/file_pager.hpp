@@ -10,6 +10,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <condition_variable>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -20,12 +21,16 @@ struct DiskCounters {
   std::uint64_t faults = 0;      // pages read from the file
   std::uint64_t bytes_read = 0;
   double read_seconds = 0.0;     // measured around the reads
+  // Time a reader waited for a page to become resident: its own read and mapping, or another
+  // thread's read of the same page. Reads of different pages overlap, so this can exceed
+  // read_seconds on one thread and fall short of it summed over threads.
+  double wait_seconds = 0.0;
 };
 
 class FilePager {
  public:
   // `page_bytes`: a power of two, at least 4096; `budget_bytes` is rounded down to whole
-  // pages, at least one. `clients` counters are kept apart (one per stage that reads), plus
+  // pages, and less than one page is an error naming memory.budget. `clients` counters are kept apart (one per stage that reads), plus
   // one for reads outside any client scope (loading). Throws std::runtime_error naming the
   // file when it cannot be opened for direct reads or the address range reserved.
   FilePager(const std::string& path, std::uint64_t file_bytes, std::size_t page_bytes, std::size_t budget_bytes,
@@ -50,6 +55,8 @@ class FilePager {
 
   DiskCounters counters(std::size_t client) const;
   DiskCounters total() const;
+  // The most page reads under way at once since the last reset (one per thread reading).
+  std::size_t reads_in_flight_max() const;
   std::size_t page_bytes() const { return page_bytes_; }
   std::size_t budget_bytes() const { return slots_ * page_bytes_; }
   std::size_t page_count() const { return slot_of_.size(); }
@@ -72,9 +79,12 @@ class FilePager {
 
  private:
   static constexpr std::uint32_t kNone = 0xFFFFFFFFu;
-  // With mutex_ held: makes `page` resident (evicting the LRU page when the pool is full).
-  // Returns an error message, empty on success, so the signal path never throws.
-  std::string load_locked(std::uint32_t page);
+  static constexpr std::uint32_t kLoading = 0xFFFFFFFEu;  // slot_of_: a thread is reading the page
+  // Makes `page` resident and most recently used; `lock` (of mutex_) is held on entry and on
+  // return, and released while the page is read, so reads of different pages overlap. A
+  // reader of a page being loaded waits for it. Returns an error message, empty on success,
+  // so the signal path never throws.
+  std::string load(std::uint32_t page, std::unique_lock<std::mutex>& lock);
   void evict_locked(std::uint32_t page);
   void unlink_locked(std::uint32_t page);
   void push_front_locked(std::uint32_t page);
@@ -90,9 +100,13 @@ class FilePager {
   int direct_fd_ = -1;  // the file, O_DIRECT
   int pool_fd_ = -1;    // the memfd of page slots
   std::byte* base_ = nullptr;
-  std::byte* staging_ = nullptr;  // one page, aligned for O_DIRECT
+  // The whole pool mapped writable once: reads land in their slot directly (O_DIRECT into
+  // the memfd's pages), then the slot is mapped read-only at the page's address.
+  std::byte* pool_view_ = nullptr;
 
   mutable std::mutex mutex_;
+  std::condition_variable loaded_;  // a page finished loading (or failed to)
+  std::size_t reads_in_flight_ = 0, reads_in_flight_max_ = 0;
   std::vector<std::uint32_t> slot_of_;        // per page: its pool slot, kNone when not resident
   std::vector<std::uint32_t> previous_, next_; // the LRU list, most recent at head_
   std::uint32_t head_ = kNone, tail_ = kNone;

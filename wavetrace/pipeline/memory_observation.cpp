@@ -25,7 +25,10 @@ void MemoryObservation::report(std::vector<StageStats>& stages) const {
       if (stage.name != to_string(ObservedStage(client))) continue;
       if (pager_) stage.pager = PagerStats{pager_->page_bytes(), pager_->budget_bytes(), pager_->counters(client)};
       if (caches_) stage.cache = CacheStats{caches_->geometry(), caches_->total(client)};
-      if (file_pager_) stage.disk = DiskStats{file_pager_->page_bytes(), file_pager_->budget_bytes(), file_pager_->counters(client)};
+      if (file_pager_) {
+        stage.disk = DiskStats{file_pager_->page_bytes(), file_pager_->budget_bytes(), file_pager_->counters(client),
+                               file_pager_->reads_in_flight_max()};
+      }
     }
   }
 }

@@ -23,6 +23,7 @@ struct DiskStats {
   std::size_t page_bytes = 0;
   std::size_t budget_bytes = 0;
   DiskCounters counters;
+  std::size_t reads_in_flight_max = 0;  // the pager's, over every stage
 };
 
 struct CacheStats {
