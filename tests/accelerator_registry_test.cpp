@@ -63,7 +63,9 @@ TEST(AcceleratorRegistry, RowsSayWhatAutoAndTheWorldBuilderAsk) {
   std::vector<std::string> candidates;
   for (const AcceleratorType& type : accelerator_types()) {
     if (type.automatic.relative_speed > 0.0) candidates.emplace_back(type.name);
-    if (type.holds_own_geometry) EXPECT_TRUE(type.builds_in_chunks) << type.name;
+    if (type.holds_own_geometry) {
+      EXPECT_TRUE(type.builds_in_chunks) << type.name;
+    }
     if (type.automatic.relative_speed > 0.0) {
       AcceleratorOptions options;
       options.type = std::string(type.name);

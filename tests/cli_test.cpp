@@ -182,17 +182,12 @@ TEST(Cli, OutOfMemoryIsReportedWithWhatWasBeingBuilt) {
   // AddressSanitizer reserves terabytes of shadow memory, which no address-space limit allows.
   if (kAddressSanitizer) GTEST_SKIP() << "an address-space limit cannot hold AddressSanitizer's shadow";
   // 300 MB of address space: the scene loads, its BVH build runs out.
-  const std::string command = "ulimit -v 300000; exec " + std::string(WAVETRACE_BINARY) +
-                              " render builtin:sphere:2M --accel bvh --size 8x8 --spp 1 --threads 1 --out " +
-                              testing::write_temp_file("oom.exr", "") + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  ASSERT_NE(pipe, nullptr);
-  std::string output;
-  char buffer[4096];
-  while (std::size_t read = std::fread(buffer, 1, sizeof buffer, pipe)) output.append(buffer, read);
-  const int status = pclose(pipe);
-  ASSERT_TRUE(WIFEXITED(status)) << "killed, not an error: " << output;
-  EXPECT_EQ(WEXITSTATUS(status), 1) << output;
+  const auto [exit_code, output] = testing::run_wavetrace(
+      "render builtin:sphere:2M --accel bvh --size 8x8 --spp 1 --threads 1 --out " +
+          testing::write_temp_file("oom.exr", ""),
+      "ulimit -v 300000;");
+  ASSERT_NE(exit_code, -1) << "killed, not an error: " << output;
+  EXPECT_EQ(exit_code, 1) << output;
   EXPECT_NE(output.find("wavetrace: error: out of memory building 'bvh' over 1997120 triangles"), std::string::npos)
       << output;
 }

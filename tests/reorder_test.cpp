@@ -181,6 +181,31 @@ TEST(ZSort, EmitsEveryRayOnceInKeyOrderWithShadowRaysLast) {
   EXPECT_EQ(pixels.size(), 250u);
 }
 
+// `ray_count` bounce rays in batches of 100 (in pixel order; the pool's batches must hold
+// 100), scattered over the box [-1, 1]^3 in origin, direction and approximate hit.
+std::vector<Batch*> scattered_arrivals(BatchPool& pool, std::uint32_t ray_count) {
+  std::vector<Batch*> batches;
+  for (std::uint32_t pixel = 0; pixel < ray_count; ++pixel) {
+    if (pixel % 100 == 0) batches.push_back(pool.acquire());
+    RayBatch& rays = batches.back()->rays;
+    rays.enable_approx_hit();
+    const std::size_t i = rays.count++;
+    const UnitPair xy = unit_pair(random_bits(pixel, 0, 0, RandomPurpose::benchmark));
+    const UnitPair zd = unit_pair(random_bits(pixel, 0, 1, RandomPurpose::benchmark));
+    const UnitPair hit = unit_pair(random_bits(pixel, 0, 2, RandomPurpose::benchmark));
+    const glm::vec3 direction = glm::normalize(glm::vec3(zd.second - 0.5f, xy.first - 0.5f, 0.3f));
+    rays.set_geometry(i, glm::vec3(xy.first, xy.second, zd.first) * 2.0f - 1.0f, direction, 0.0f, 10.0f);
+    rays.approx_hit_x[i] = hit.first * 2 - 1;
+    rays.approx_hit_y[i] = hit.second * 2 - 1;
+    rays.approx_hit_z[i] = zd.second * 2 - 1;
+    rays.pixel[i] = pixel;
+    rays.sample[i] = 7 * pixel;
+    rays.kind[i] = RayKind::bounce;
+    rays.flags[i] = ray_flags::alive;
+  }
+  return batches;
+}
+
 // Every heuristic changes the order zsort emits rays in (none keeps their arrival order),
 // and emits them in non-decreasing key order: the image tests above cannot tell a sort that
 // does nothing from one that works.
@@ -189,27 +214,7 @@ TEST(ZSort, EveryHeuristicReordersWhatNoneKeepsInArrivalOrder) {
   box.extend(glm::vec3(-1.0f));
   box.extend(glm::vec3(1.0f));
   constexpr std::uint32_t kRays = 400;
-  const auto arrivals = [&](BatchPool& pool) {
-    std::vector<Batch*> batches;
-    for (std::uint32_t pixel = 0; pixel < kRays; ++pixel) {
-      if (pixel % 100 == 0) batches.push_back(pool.acquire());
-      RayBatch& rays = batches.back()->rays;
-      rays.enable_approx_hit();
-      const std::size_t i = rays.count++;
-      const UnitPair xy = unit_pair(random_bits(pixel, 0, 0, RandomPurpose::benchmark));
-      const UnitPair zd = unit_pair(random_bits(pixel, 0, 1, RandomPurpose::benchmark));
-      const UnitPair hit = unit_pair(random_bits(pixel, 0, 2, RandomPurpose::benchmark));
-      const glm::vec3 direction = glm::normalize(glm::vec3(zd.second - 0.5f, xy.first - 0.5f, 0.3f));
-      rays.set_geometry(i, glm::vec3(xy.first, xy.second, zd.first) * 2.0f - 1.0f, direction, 0.0f, 10.0f);
-      rays.approx_hit_x[i] = hit.first * 2 - 1;
-      rays.approx_hit_y[i] = hit.second * 2 - 1;
-      rays.approx_hit_z[i] = zd.second * 2 - 1;
-      rays.pixel[i] = pixel;
-      rays.kind[i] = RayKind::bounce;
-      rays.flags[i] = ray_flags::alive;
-    }
-    return batches;
-  };
+  const auto arrivals = [](BatchPool& pool) { return scattered_arrivals(pool, kRays); };
   std::map<std::string, std::vector<std::uint32_t>> orders;
   for (ReorderHeuristic heuristic : {ReorderHeuristic::none, ReorderHeuristic::origin, ReorderHeuristic::origin_dir,
                                     ReorderHeuristic::hph, ReorderHeuristic::hph_origin, ReorderHeuristic::hph_dir}) {
@@ -248,6 +253,53 @@ TEST(ZSort, EveryHeuristicReordersWhatNoneKeepsInArrivalOrder) {
   }
   // The two curves order the same keys' cells differently.
   EXPECT_NE(orders.at("hph/morton"), orders.at("hph/hilbert"));
+}
+
+// The disk buffer's runs merge into the order one in-core sort of the whole generation
+// gives, every column travelling with its ray, for a hit-point heuristic as for origin.
+TEST(ZSort, DiskRunsMergeIntoTheOrderOfOneInCoreSort) {
+  Bounds3 box;
+  box.extend(glm::vec3(-1.0f));
+  box.extend(glm::vec3(1.0f));
+  const auto order = [](const CollectingOutput& out) {
+    std::vector<std::uint32_t> pixels;
+    for (const Batch* batch : out.emitted) {
+      for (std::size_t i = 0; i < batch->rays.count; ++i) {
+        pixels.push_back(batch->rays.pixel[i]);
+        EXPECT_EQ(batch->rays.sample[i], 7 * batch->rays.pixel[i]);
+      }
+    }
+    return pixels;
+  };
+  for (ReorderHeuristic heuristic : {ReorderHeuristic::origin, ReorderHeuristic::hph}) {
+    ZSortOptions options;
+    options.heuristic = heuristic;
+    options.buffer_rays = 1 << 20;
+    BatchPool pool(128);  // scattered_arrivals fills batches of 100
+    const ZSortStage memory(options, box);
+    CollectingOutput in_core(pool);
+    for (Batch* batch : scattered_arrivals(pool, 600)) EXPECT_EQ(memory.take(batch, in_core), 0u);
+    EXPECT_EQ(memory.flush(in_core), 600u);
+
+    options.buffer = RayBufferKind::disk;
+    options.buffer_rays = 400;  // a run of the first four batches; the last two stay in core until the flush
+    const ZSortStage disk(options, box);
+    CollectingOutput spilled(pool);
+    for (Batch* batch : scattered_arrivals(pool, 600)) EXPECT_EQ(disk.take(batch, spilled), 0u);
+    EXPECT_EQ(disk.buffered_rays(), 600u);
+    EXPECT_EQ(disk.spilled_rays(), 400u);
+    EXPECT_EQ(disk.flush(spilled), 0u);
+    EXPECT_TRUE(disk.draining());
+    EXPECT_EQ(disk.spilled_rays(), 600u);  // the in-core part went to the last run
+    std::size_t drained = 0;
+    while (disk.draining()) drained += disk.drain(spilled, 64);
+    EXPECT_EQ(drained, 600u);
+    EXPECT_EQ(disk.spilled_rays(), 0u);
+    EXPECT_EQ(order(spilled), order(in_core)) << to_string(heuristic);
+    EXPECT_EQ(disk.spill().runs, 2u);
+    EXPECT_GT(disk.spill().bytes_written, 600u * RayBatch::kBytesPerRay);
+    EXPECT_EQ(disk.spill().bytes_read, disk.spill().bytes_written);
+  }
 }
 
 // A ray's key is its curve's index of the cell its point falls in (origin for `origin`,

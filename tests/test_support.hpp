@@ -44,10 +44,9 @@ struct CommandResult {
   std::string output;  // stdout and stderr together
 };
 
-// Runs the wavetrace binary with `arguments` (shell syntax).
-inline CommandResult run_wavetrace(const std::string& arguments) {
+// Runs `command` through the shell; exit_code -1 when a signal ended it.
+inline CommandResult run_shell(const std::string& command) {
   CommandResult result;
-  const std::string command = std::string(WAVETRACE_BINARY) + " " + arguments + " 2>&1";
   FILE* pipe = popen(command.c_str(), "r");
   if (pipe == nullptr) return result;
   char buffer[4096];
@@ -55,6 +54,12 @@ inline CommandResult run_wavetrace(const std::string& arguments) {
   const int status = pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;
+}
+
+// Runs the wavetrace binary with `arguments` (shell syntax), after `limits` (shell commands
+// such as "ulimit -v 300000;") when given.
+inline CommandResult run_wavetrace(const std::string& arguments, const std::string& limits = "") {
+  return run_shell(limits + " exec " + std::string(WAVETRACE_BINARY) + " " + arguments + " 2>&1");
 }
 
 }  // namespace wavetrace::testing
