@@ -80,7 +80,8 @@ std::string configuration_markdown() {
       section = key_section;
       md += fmt::format("\n## [{}]\n\n| key | type | default | range | what it does |\n|---|---|---|---|---|\n", section);
     }
-    const std::string default_text = key.default_value ? "`" + to_string(*key.default_value) + "`" : "(unset)";
+    const std::string shown = key.default_value ? to_string(*key.default_value) : std::string();
+    const std::string default_text = !key.default_value ? "(unset)" : shown.empty() ? "(empty)" : "`" + shown + "`";
     md += fmt::format("| `{}` | {} | {} | {} | {} |\n", key.name, type_name(key.type), cell(default_text),
                       range_of(key), cell(key.help));
   }
