@@ -212,6 +212,16 @@ TEST(Cli, BenchReorderReportsEveryHeuristicWithTheIssuesKeys) {
   }
   EXPECT_EQ(json["results"][0]["approx_hit_seconds"].get<double>(), 0.0);  // none has no approx_hit
   EXPECT_GT(json["results"][2]["approx_hit_seconds"].get<double>(), 0.0);
+
+  // With the disk buffer (an in-core part of 64 rays: every generation spills) beside none,
+  // which has no buffer: the same image.
+  const auto disk = testing::run_wavetrace(
+      "bench reorder --scene builtin:room:5000 --accel bvh --size 16x12 --spp 1 --threads 2 --heuristics none,hph "
+      "--set reorder.buffer=disk --set reorder.buffer_rays=64 --json " + json_path);
+  ASSERT_EQ(disk.exit_code, 0) << disk.output;
+  const nlohmann::json spilled = nlohmann::json::parse(std::ifstream(json_path));
+  ASSERT_EQ(spilled["results"].size(), 2u);
+  EXPECT_TRUE(spilled["results"][1]["image_identical"].get<bool>());
 }
 
 TEST(Cli, BenchPipelineComparesTheMegakernelWithEachHeuristic) {

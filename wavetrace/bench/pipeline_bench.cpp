@@ -58,7 +58,7 @@ PipelineBenchReport run_pipeline_bench(const Config& config, const PipelineBench
   for (int threads : request.threads) {
     if (threads < 0) throw ConfigError(fmt::format("--threads {}: must be 0 (all cores) or more", threads));
   }
-  const RenderPlan base = plan_render(config);
+  const RenderPlan base = plan_render(heuristic_variant(config, request.heuristics.front()));
   if (base.memory.enabled()) {
     throw ConfigError("bench pipeline compares with the megakernel, which [memory] observation cannot see: "
                       "use bench reorder for pager and cache counts");
@@ -88,9 +88,8 @@ PipelineBenchReport run_pipeline_bench(const Config& config, const PipelineBench
   std::vector<float> megakernel_image;
   for (int repeat = 0; repeat < request.repeats; ++repeat) {
     for (Row& row : rows) {
-      Config variant = config;
+      Config variant = heuristic_variant(config, row.heuristic);
       variant.set_value("pipeline.mode", to_string(row.mode));
-      variant.set_value("reorder.heuristic", to_string(row.heuristic));
       variant.set("render.threads=" + std::to_string(row.threads));
       RenderOutput output = render_image(plan_render(variant), world, camera);
       if (megakernel_image.empty()) megakernel_image = output.image;

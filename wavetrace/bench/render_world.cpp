@@ -6,6 +6,13 @@
 
 namespace wavetrace {
 
+Config heuristic_variant(const Config& config, ReorderHeuristic heuristic) {
+  Config variant = config;
+  variant.set_value("reorder.heuristic", to_string(heuristic));
+  if (heuristic == ReorderHeuristic::none) variant.set_value("reorder.buffer", std::string("memory"));
+  return variant;
+}
+
 RenderWorld::RenderWorld(const RenderPlan& base, bool needs_proxy) {
   if (is_world_file(base.scene.source)) {
     saved_ = load_world(base.scene.source, world_paging(base), base.pipeline.threads);

@@ -15,6 +15,10 @@
 
 namespace wavetrace {
 
+// One heuristic's render of a benchmark's config. No reordering has no zsort and so no
+// buffer: a disk buffer asked of the others is not asked of it.
+Config heuristic_variant(const Config& config, ReorderHeuristic heuristic);
+
 class RenderWorld {
  public:
   // Throws ConfigError where the plan cannot be met (a world file without the proxy asked

@@ -21,7 +21,7 @@ const StageStats* find_stage(const PipelineRun& run, std::string_view name) {
 
 ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<ReorderHeuristic>& heuristics) {
   if (heuristics.empty()) throw ConfigError("--heuristics names no heuristic");
-  const RenderPlan base = plan_render(config);
+  const RenderPlan base = plan_render(heuristic_variant(config, heuristics.front()));
   if (base.rules.max_depth < 3) {
     throw ConfigError(fmt::format("render.max_depth = {}: the reorder benchmark path traces to depth 3 or more",
                                   base.rules.max_depth));
@@ -65,9 +65,7 @@ ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<Reo
 
   std::vector<float> first_image;
   for (ReorderHeuristic heuristic : heuristics) {
-    Config variant = config;
-    variant.set_value("reorder.heuristic", to_string(heuristic));
-    const RenderPlan plan = plan_render(variant);
+    const RenderPlan plan = plan_render(heuristic_variant(config, heuristic));
     const RenderOutput output = render_image(plan, world, camera);
     report.threads = output.run.threads;
 
