@@ -3,6 +3,9 @@
 
 #include <fmt/format.h>
 
+#include "wavetrace/bench/json_fields.hpp"
+#include "wavetrace/stages/trace.hpp"
+
 namespace wavetrace {
 
 nlohmann::json bounds_json(const Bounds3& bounds) {
@@ -47,6 +50,17 @@ std::string memory_lines(const std::vector<StageStats>& stages) {
                            stage.name, stage.disk->page_bytes >> 10, double(stage.disk->budget_bytes) / (1 << 20),
                            c.faults, double(c.bytes_read) * 1e-6, c.read_seconds, c.wait_seconds,
                            stage.disk->reads_in_flight_max);
+      if (!stage.disk->faults_by_part.empty()) {
+        std::string parts;
+        for (const auto& [part, faults] : stage.disk->faults_by_part) {
+          parts += fmt::format("{}{} {}", parts.empty() ? "" : ", ", part, faults);
+        }
+        lines += fmt::format("{} disk faults by part: {}\n", stage.name, parts);
+      }
+      if (stage.disk->ray_windows.windows > 0) {
+        lines += fmt::format("{} disk: {:.1f} distinct pages touched per {} consecutive rays ({} windows)\n", stage.name,
+                             stage.disk->pages_per_window(), TraceStage::kRayWindow, stage.disk->ray_windows.windows);
+      }
     }
     if (stage.spill) {
       lines += fmt::format("{} spill: {} runs on disk, {:.1f} MB written, {:.1f} MB read, {:.3f} s of I/O\n", stage.name,
@@ -64,6 +78,12 @@ std::string memory_lines(const std::vector<StageStats>& stages) {
     }
   }
   return lines;
+}
+
+nlohmann::json disk_parts_json(const DiskStats& disk) {
+  nlohmann::json parts = nlohmann::json::object();
+  for (const auto& [part, faults] : disk.faults_by_part) parts[part] = faults;
+  return parts;
 }
 
 nlohmann::json proxy_json(const Proxy& proxy) {
@@ -102,7 +122,11 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
                        {"bytes_read", stage.disk->counters.bytes_read},
                        {"read_seconds", stage.disk->counters.read_seconds},
                        {"wait_seconds", stage.disk->counters.wait_seconds},
-                       {"reads_in_flight_max", stage.disk->reads_in_flight_max}};
+                       {"reads_in_flight_max", stage.disk->reads_in_flight_max},
+                       {"faults_by_part", disk_parts_json(*stage.disk)},
+                       {"pages_per_1000_rays", json_or_null(stage.disk->ray_windows.windows > 0
+                                                                ? std::optional(stage.disk->pages_per_window())
+                                                                : std::nullopt)}};
     }
     if (stage.cache) entry["cache"] = cache_json(*stage.cache);
     if (stage.spill) {

@@ -10,6 +10,7 @@
 #include <random>
 
 #include <xxhash.h>
+#include <nlohmann/json.hpp>
 
 #include "wavetrace/accel/registry.hpp"
 #include "wavetrace/accel/hmq/global_grid.hpp"
@@ -409,12 +410,26 @@ TEST(WorldFileCli, BuildRenderAndInfo) {
   ASSERT_EQ(built.exit_code, 0) << built.output;
   EXPECT_NE(built.output.find("bytes/triangle"), std::string::npos) << built.output;
   const std::string stats = temp_path("cli_stats.json");
-  const auto rendered = testing::run_wavetrace("render " + world + " --size 32x24 --spp 1 --out " +
+  const auto rendered = testing::run_wavetrace("render " + world + " --size 64x48 --spp 1 --out " +
                                                temp_path("cli.exr") + " --set memory.backing=file --set memory.budget=10% "
                                                "--set memory.page_bytes=4096 --stats " + stats);
   ASSERT_EQ(rendered.exit_code, 0) << rendered.output;
   EXPECT_NE(rendered.output.find("real faults"), std::string::npos) << rendered.output;
-  EXPECT_NE(read_all(stats).find("\"disk\""), std::string::npos);
+  // Where the reads go: every trace fault counted to one part of the file, and the distinct
+  // pages of each 1,000 consecutive rays.
+  for (const nlohmann::json& stage : nlohmann::json::parse(read_all(stats))["stages"]) {
+    if (stage["name"] != "trace") continue;
+    const nlohmann::json& disk = stage.at("disk");
+    std::uint64_t by_part = 0;
+    for (const auto& [part, faults] : disk.at("faults_by_part").items()) by_part += faults.get<std::uint64_t>();
+    EXPECT_EQ(by_part, disk.at("faults").get<std::uint64_t>()) << disk.dump();
+    EXPECT_TRUE(disk["faults_by_part"].contains("accel/raystrips.nodes") ||
+                disk["faults_by_part"].contains("accel/raystrips.strips"))
+        << disk.dump();
+    EXPECT_GE(disk.at("pages_per_1000_rays").get<double>(), 1.0) << disk.dump();
+  }
+  EXPECT_NE(rendered.output.find("distinct pages touched per 1000 consecutive rays"), std::string::npos)
+      << rendered.output;
   const auto bench = testing::run_wavetrace("bench accel --scene " + world + " --rays diffuse --count 2000 --repeat 1");
   ASSERT_EQ(bench.exit_code, 0) << bench.output;
   EXPECT_NE(bench.output.find("raystrips (world file)"), std::string::npos) << bench.output;

@@ -120,11 +120,16 @@ FilePager::FilePager(const std::string& path, std::uint64_t file_bytes, std::siz
   }
   pool_view_ = static_cast<std::byte*>(view);
   base_ = static_cast<std::byte*>(range);
-  slot_of_.assign(pages, kNone);
+  page_count_ = pages;
+  slot_of_ = std::make_unique<std::atomic<std::uint32_t>[]>(pages);
+  headed_at_ = std::make_unique<std::atomic<std::uint64_t>[]>(pages);
+  for (std::size_t p = 0; p < pages; ++p) slot_of_[p].store(kNone, std::memory_order_relaxed);
+  fresh_ticks_ = std::max<std::uint64_t>(slots_ / 4, 1);
   previous_.assign(pages, kNone);
   next_.assign(pages, kNone);
   for (std::size_t s = slots_; s-- > 0;) free_slots_.push_back(static_cast<std::uint32_t>(s));
   clients_.resize(clients + 1);
+  part_faults_.assign(clients_.size() * part_names_.size(), 0);
 
   install_handler();
   for (auto& slot : active_pagers) {
@@ -163,6 +168,7 @@ void FilePager::unlink_locked(std::uint32_t page) {
 }
 
 void FilePager::push_front_locked(std::uint32_t page) {
+  headed_at_[page].store(lru_clock_.fetch_add(1, std::memory_order_relaxed) + 1, std::memory_order_relaxed);
   previous_[page] = kNone;
   next_[page] = head_;
   if (head_ != kNone) previous_[head_] = page;
@@ -174,14 +180,14 @@ void FilePager::evict_locked(std::uint32_t page) {
   unlink_locked(page);
   // From here a reader of this page faults and waits for the mutex; its slot is free again.
   reserve_range(base_ + (std::size_t(page) << page_shift_), page_bytes_);
-  free_slots_.push_back(slot_of_[page]);
-  slot_of_[page] = kNone;
+  free_slots_.push_back(slot_of_[page].load(std::memory_order_relaxed));
+  slot_of_[page].store(kNone, std::memory_order_relaxed);
 }
 
-std::string FilePager::load(std::uint32_t page, std::unique_lock<std::mutex>& lock) {
+std::string FilePager::load(std::uint32_t page, std::uint64_t address_offset, std::unique_lock<std::mutex>& lock) {
   std::optional<std::chrono::steady_clock::time_point> waiting_since;
   for (;;) {
-    const std::uint32_t state = slot_of_[page];
+    const std::uint32_t state = slot_of_[page].load(std::memory_order_relaxed);
     if (state != kNone && state != kLoading) {
       if (head_ != page) {
         unlink_locked(page);
@@ -204,7 +210,7 @@ std::string FilePager::load(std::uint32_t page, std::unique_lock<std::mutex>& lo
   if (free_slots_.empty()) evict_locked(tail_);
   const std::uint32_t slot = free_slots_.back();
   free_slots_.pop_back();
-  slot_of_[page] = kLoading;
+  slot_of_[page].store(kLoading, std::memory_order_relaxed);
   reads_in_flight_max_ = std::max(reads_in_flight_max_, ++reads_in_flight_);
   lock.unlock();
 
@@ -221,7 +227,8 @@ std::string FilePager::load(std::uint32_t page, std::unique_lock<std::mutex>& lo
     if (got < 0 && errno == EINTR) continue;
     if (got <= 0) {
       error = fmt::format("{}: reading page {} (bytes {}..{}) failed: {}", path_, page, offset, offset + bytes,
-                          got < 0 ? std::strerror(errno) : "the file ends early");
+                          got < 0 ? std::strerror(errno)
+                                  : "the file ends early (truncated or replaced while it was paged?)");
     }
     done += got > 0 ? std::size_t(got) : 0;
   }
@@ -243,11 +250,12 @@ std::string FilePager::load(std::uint32_t page, std::unique_lock<std::mutex>& lo
   counters.wait_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - *waiting_since).count();
   if (!error.empty()) {
     free_slots_.push_back(slot);
-    slot_of_[page] = kNone;
+    slot_of_[page].store(kNone, std::memory_order_relaxed);
   } else {
-    slot_of_[page] = slot;
+    slot_of_[page].store(slot, std::memory_order_relaxed);
     push_front_locked(page);
     ++counters.faults;
+    ++part_faults_[client_index() * part_names_.size() + part_of(address_offset)];
     counters.bytes_read += bytes;
     counters.read_seconds += seconds;
   }
@@ -257,21 +265,31 @@ std::string FilePager::load(std::uint32_t page, std::unique_lock<std::mutex>& lo
 
 void FilePager::touch(const void* address) {
   if (!contains(address)) return;
-  const auto page = static_cast<std::uint32_t>(std::size_t(static_cast<const std::byte*>(address) - base_) >> page_shift_);
+  const std::uint32_t page = page_of(address);
+  // Resident and near the LRU head: nothing to do, and no lock taken. Should the page be
+  // evicted right after this check, the read it announces faults and loads it again.
+  const std::uint32_t slot = slot_of_[page].load(std::memory_order_relaxed);
+  if (slot < kLoading &&
+      lru_clock_.load(std::memory_order_relaxed) - headed_at_[page].load(std::memory_order_relaxed) < fresh_ticks_) {
+    return;
+  }
   std::unique_lock lock(mutex_);
-  if (std::string error = load(page, lock); !error.empty()) throw std::runtime_error(error);
+  const std::uint64_t offset = std::uint64_t(static_cast<const std::byte*>(address) - base_);
+  if (std::string error = load(page, offset, lock); !error.empty()) throw std::runtime_error(error);
 }
 
 bool FilePager::handle_fault(const void* address) noexcept {
   if (!contains(address)) return false;
-  const auto page = static_cast<std::uint32_t>(std::size_t(static_cast<const std::byte*>(address) - base_) >> page_shift_);
   std::unique_lock lock(mutex_);
-  const std::string error = load(page, lock);
+  const std::string error = load(page_of(address), std::uint64_t(static_cast<const std::byte*>(address) - base_), lock);
   if (!error.empty()) {
-    // No exception can leave a signal handler: say what failed and stop.
+    // No exception can leave a signal handler, and the read that faulted cannot go on: say
+    // what failed and stop as any failed command does (exit 1). Nothing is written after
+    // this (no partial image), and a disk ray buffer's spill files, unnamed (O_TMPFILE),
+    // vanish with the process.
     const std::string line = "wavetrace: " + error + "\n";
     [[maybe_unused]] const ssize_t ignored = ::write(STDERR_FILENO, line.data(), line.size());
-    std::_Exit(3);
+    std::_Exit(1);
   }
   return true;
 }
@@ -280,7 +298,50 @@ void FilePager::reset() {
   std::lock_guard lock(mutex_);
   while (tail_ != kNone) evict_locked(tail_);
   for (DiskCounters& counters : clients_) counters = {};
+  std::fill(part_faults_.begin(), part_faults_.end(), 0);
+  ray_windows_ = {};
   reads_in_flight_max_ = 0;
+}
+
+void FilePager::name_parts(std::vector<std::string> names, std::vector<FilePart> extents) {
+  std::lock_guard lock(mutex_);
+  std::sort(extents.begin(), extents.end(), [](const FilePart& a, const FilePart& b) { return a.offset < b.offset; });
+  for (const FilePart& extent : extents) {
+    if (extent.part >= names.size()) throw std::invalid_argument(fmt::format("{}: a part index out of range", path_));
+  }
+  names.push_back("other");
+  part_names_ = std::move(names);
+  parts_ = std::move(extents);
+  part_faults_.assign(clients_.size() * part_names_.size(), 0);
+}
+
+std::uint32_t FilePager::part_of(std::uint64_t offset) const {
+  const auto after = std::upper_bound(parts_.begin(), parts_.end(), offset,
+                                      [](std::uint64_t at, const FilePart& part) { return at < part.offset; });
+  if (after == parts_.begin()) return static_cast<std::uint32_t>(part_names_.size() - 1);
+  const FilePart& part = *(after - 1);
+  return offset - part.offset < part.bytes ? part.part : static_cast<std::uint32_t>(part_names_.size() - 1);
+}
+
+std::vector<std::uint64_t> FilePager::faults_by_part(std::size_t client) const {
+  std::lock_guard lock(mutex_);
+  std::vector<std::uint64_t> faults(part_names_.size(), 0);
+  for (std::size_t c = 0; c < clients_.size(); ++c) {
+    if (client != std::size_t(-1) && c != client) continue;
+    for (std::size_t p = 0; p < faults.size(); ++p) faults[p] += part_faults_[c * faults.size() + p];
+  }
+  return faults;
+}
+
+void FilePager::add_ray_windows(const RayWindowCounters& windows) {
+  std::lock_guard lock(mutex_);
+  ray_windows_.windows += windows.windows;
+  ray_windows_.distinct_pages += windows.distinct_pages;
+}
+
+RayWindowCounters FilePager::ray_windows() const {
+  std::lock_guard lock(mutex_);
+  return ray_windows_;
 }
 
 std::size_t FilePager::reads_in_flight_max() const {

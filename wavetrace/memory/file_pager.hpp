@@ -10,7 +10,9 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <atomic>
 #include <condition_variable>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -25,6 +27,20 @@ struct DiskCounters {
   // thread's read of the same page. Reads of different pages overlap, so this can exceed
   // read_seconds on one thread and fall short of it summed over threads.
   double wait_seconds = 0.0;
+};
+
+// A byte range of the paged file that belongs to one named part of it (a world's chunk
+// nodes, leaf records, vertices...), so that faults can be counted by part.
+struct FilePart {
+  std::uint64_t offset = 0, bytes = 0;
+  std::uint32_t part = 0;  // index into the names given with the parts
+};
+
+// How many distinct pages runs of consecutive rays touched: the reordering's sharing seen
+// from the pager. A window is a fixed number of rays in the order they were traced.
+struct RayWindowCounters {
+  std::uint64_t windows = 0;
+  std::uint64_t distinct_pages = 0;  // summed over the windows
 };
 
 class FilePager {
@@ -53,13 +69,26 @@ class FilePager {
   // Evicts every page and zeroes the counters, so a render starts from an empty pool.
   void reset();
 
+  // Names the file's parts: each extent's faults count to names[extent.part]; bytes no
+  // extent covers count to a last part, "other". Extents may come in any order but must
+  // not overlap. Call before the first read.
+  void name_parts(std::vector<std::string> names, std::vector<FilePart> extents);
+  // The part names, "other" last, and the faults of `client` (every client's when
+  // `client` is npos) by part, in that order.
+  const std::vector<std::string>& part_names() const { return part_names_; }
+  std::vector<std::uint64_t> faults_by_part(std::size_t client) const;
+
+  // Adds windows of consecutive rays, each with the distinct pages it touched.
+  void add_ray_windows(const RayWindowCounters& windows);
+  RayWindowCounters ray_windows() const;
+
   DiskCounters counters(std::size_t client) const;
   DiskCounters total() const;
   // The most page reads under way at once since the last reset (one per thread reading).
   std::size_t reads_in_flight_max() const;
   std::size_t page_bytes() const { return page_bytes_; }
   std::size_t budget_bytes() const { return slots_ * page_bytes_; }
-  std::size_t page_count() const { return slot_of_.size(); }
+  std::size_t page_count() const { return page_count_; }
 
   // The client this thread's faults count to while the scope lives.
   class ClientScope {
@@ -84,7 +113,12 @@ class FilePager {
   // return, and released while the page is read, so reads of different pages overlap. A
   // reader of a page being loaded waits for it. Returns an error message, empty on success,
   // so the signal path never throws.
-  std::string load(std::uint32_t page, std::unique_lock<std::mutex>& lock);
+  std::string load(std::uint32_t page, std::uint64_t offset, std::unique_lock<std::mutex>& lock);
+  // The part of the file holding byte `offset`.
+  std::uint32_t part_of(std::uint64_t offset) const;
+  std::uint32_t page_of(const void* address) const {
+    return static_cast<std::uint32_t>(std::size_t(static_cast<const std::byte*>(address) - base_) >> page_shift_);
+  }
   void evict_locked(std::uint32_t page);
   void unlink_locked(std::uint32_t page);
   void push_front_locked(std::uint32_t page);
@@ -107,11 +141,25 @@ class FilePager {
   mutable std::mutex mutex_;
   std::condition_variable loaded_;  // a page finished loading (or failed to)
   std::size_t reads_in_flight_ = 0, reads_in_flight_max_ = 0;
-  std::vector<std::uint32_t> slot_of_;        // per page: its pool slot, kNone when not resident
+  // Per page: its pool slot, kNone when not resident. Written under mutex_, read without it
+  // by touch's fast path.
+  std::unique_ptr<std::atomic<std::uint32_t>[]> slot_of_;
+  std::size_t page_count_ = 0;
+  // The LRU list's clock: one tick per page put at its head. A resident page put there fewer
+  // than `fresh_ticks_` ticks ago sits in the list's first quarter, far from eviction, so a
+  // touch leaves it where it is without taking the lock: LRU order is exact except within
+  // that first quarter, which eviction never reaches.
+  std::atomic<std::uint64_t> lru_clock_{0};
+  std::unique_ptr<std::atomic<std::uint64_t>[]> headed_at_;
+  std::uint64_t fresh_ticks_ = 1;
   std::vector<std::uint32_t> previous_, next_; // the LRU list, most recent at head_
   std::uint32_t head_ = kNone, tail_ = kNone;
   std::vector<std::uint32_t> free_slots_;
   std::vector<DiskCounters> clients_;
+  std::vector<std::string> part_names_ = {"other"};
+  std::vector<FilePart> parts_;                  // sorted by offset
+  std::vector<std::uint64_t> part_faults_;       // clients_.size() rows of part_names_.size()
+  RayWindowCounters ray_windows_;
 };
 
 }  // namespace wavetrace

@@ -6,8 +6,10 @@
 #include <cstddef>
 #include <cstdint>
 
+#include <algorithm>
 #include <bit>
 #include <optional>
+#include <vector>
 
 #include "wavetrace/memory/cache_simulator.hpp"
 #include "wavetrace/memory/file_pager.hpp"
@@ -48,6 +50,24 @@ class RecordingProbe {
   RecordingProbe& operator=(const RecordingProbe&) = delete;
   ~RecordingProbe() {
     if (pager_ != nullptr && repeated_page_reads_ > 0) pager_->add_accesses(repeated_page_reads_, client_);
+    if (file_pager_ != nullptr && windows_.windows > 0) file_pager_->add_ray_windows(windows_);
+  }
+
+  // Real paging only: from now on the probe keeps the pages each window of rays touched.
+  void count_ray_windows() { counting_windows_ = file_pager_ != nullptr; }
+  // Closes a window of consecutive rays (real paging only): a full one (`counted`) adds the
+  // distinct file pages its reads touched to the windows' counters; a short one, the tail
+  // of a run of one ray kind, is dropped, so every counted window has the same ray count.
+  void end_ray_window(bool counted) {
+    if (!counting_windows_) return;
+    if (counted) {
+      std::sort(window_pages_.begin(), window_pages_.end());
+      windows_.distinct_pages +=
+          std::size_t(std::unique(window_pages_.begin(), window_pages_.end()) - window_pages_.begin());
+      ++windows_.windows;
+    }
+    window_pages_.clear();
+    last_file_page_ = ~std::uintptr_t{0};  // the next window's first page counts to it
   }
 
   void read(const void* address, std::size_t bytes) {
@@ -56,8 +76,14 @@ class RecordingProbe {
       // The page is loaded now, before the read it announces; a page change is a touch.
       const auto first = reinterpret_cast<std::uintptr_t>(address) >> file_page_shift_;
       const auto last = (reinterpret_cast<std::uintptr_t>(address) + bytes - 1) >> file_page_shift_;
-      if (first != last_file_page_) file_pager_->touch(address);
-      if (last != first) file_pager_->touch(static_cast<const std::byte*>(address) + bytes - 1);
+      if (first != last_file_page_) {
+        file_pager_->touch(address);
+        if (counting_windows_) window_pages_.push_back(first);
+      }
+      if (last != first) {
+        file_pager_->touch(static_cast<const std::byte*>(address) + bytes - 1);
+        if (counting_windows_) window_pages_.push_back(last);
+      }
       last_file_page_ = last;
     }
     if (pager_ == nullptr) return;
@@ -86,6 +112,9 @@ class RecordingProbe {
   unsigned file_page_shift_ = 0;
   std::uintptr_t last_file_page_ = ~std::uintptr_t{0};
   std::optional<FilePager::ClientScope> client_scope_;
+  std::vector<std::uintptr_t> window_pages_;  // file pages touched in this window, with repeats
+  RayWindowCounters windows_;
+  bool counting_windows_ = false;
   std::uint32_t last_page_ = SimulatedPager::kNoPage;
   std::uint64_t repeated_page_reads_ = 0;
 };

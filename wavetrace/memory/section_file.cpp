@@ -166,6 +166,7 @@ std::shared_ptr<const SectionFile> SectionFile::open(const std::string& path, co
       throw SectionFileError(error.what());
     }
     file->base_ = file->pager_->base();
+    file->name_paged_parts();
   } else {
     void* mapping = ::mmap(nullptr, actual_size, PROT_READ, MAP_SHARED, fd.get(), 0);
     if (mapping == MAP_FAILED) file->fail({}, fmt::format("cannot be mapped: {}", std::strerror(errno)));
@@ -180,6 +181,36 @@ std::shared_ptr<const SectionFile> SectionFile::open(const std::string& path, co
   }
   file->verify_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - verify_start).count();
   return file;
+}
+
+void SectionFile::name_paged_parts() {
+  // A part is a section's name with its chunk number dropped ("accel/chunk.17/hmq8.nodes" is
+  // part "accel/chunk.*/hmq8.nodes"): the reads of every chunk's nodes count together.
+  const auto part_name = [](const std::string& name) {
+    std::string part;
+    for (std::size_t at = 0; at < name.size();) {
+      std::size_t digits = name.compare(at, 6, "chunk.") == 0 ? at + 6 : at;
+      while (digits > at && digits < name.size() && name[digits] >= '0' && name[digits] <= '9') ++digits;
+      if (digits > at + 6 && digits < name.size() && name[digits] == '/') {
+        part += "chunk.*";
+        at = digits;
+      } else {
+        part += name[at++];
+      }
+    }
+    return part;
+  };
+  std::vector<std::string> names;
+  std::vector<FilePart> extents;
+  for (const SectionInfo& section : sections_) {
+    const std::string name = part_name(section.name);
+    auto known = std::find(names.begin(), names.end(), name);
+    if (known == names.end()) known = names.insert(names.end(), name);
+    // A section owns its padding up to the next 4 KiB: reads never land there, pages may.
+    const std::uint64_t bytes = (section.size + kDataAlignment - 1) / kDataAlignment * kDataAlignment;
+    extents.push_back({section.offset, bytes, static_cast<std::uint32_t>(known - names.begin())});
+  }
+  pager_->name_parts(std::move(names), std::move(extents));
 }
 
 SectionFile::~SectionFile() {

@@ -67,6 +67,8 @@ class SectionFile {
   [[noreturn]] void fail(std::string_view section, const std::string& problem) const;
 
  private:
+  // Tells the pager which sections its pages belong to, so faults are counted by part.
+  void name_paged_parts();
   SectionFile() = default;
   std::span<const std::byte> checked(std::string_view name, std::size_t element_bytes) const;
   const SectionInfo* find(std::string_view name) const;

@@ -26,8 +26,16 @@ void MemoryObservation::report(std::vector<StageStats>& stages) const {
       if (pager_) stage.pager = PagerStats{pager_->page_bytes(), pager_->budget_bytes(), pager_->counters(client)};
       if (caches_) stage.cache = CacheStats{caches_->geometry(), caches_->total(client)};
       if (file_pager_) {
-        stage.disk = DiskStats{file_pager_->page_bytes(), file_pager_->budget_bytes(), file_pager_->counters(client),
-                               file_pager_->reads_in_flight_max()};
+        stage.disk.emplace();
+        stage.disk->page_bytes = file_pager_->page_bytes();
+        stage.disk->budget_bytes = file_pager_->budget_bytes();
+        stage.disk->counters = file_pager_->counters(client);
+        stage.disk->reads_in_flight_max = file_pager_->reads_in_flight_max();
+        const std::vector<std::uint64_t> faults = file_pager_->faults_by_part(client);
+        for (std::size_t part = 0; part < faults.size(); ++part) {
+          if (faults[part] > 0) stage.disk->faults_by_part.emplace_back(file_pager_->part_names()[part], faults[part]);
+        }
+        if (ObservedStage(client) == ObservedStage::trace) stage.disk->ray_windows = file_pager_->ray_windows();
       }
     }
   }

@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "wavetrace/memory/cache_simulator.hpp"
 #include "wavetrace/memory/file_pager.hpp"
@@ -24,6 +26,14 @@ struct DiskStats {
   std::size_t budget_bytes = 0;
   DiskCounters counters;
   std::size_t reads_in_flight_max = 0;  // the pager's, over every stage
+  // Faults by part of the file (a world's top tree, chunk nodes, leaf records...), "other"
+  // last: where the reads go.
+  std::vector<std::pair<std::string, std::uint64_t>> faults_by_part;
+  // Windows of consecutive traced rays and the distinct pages they touched (trace only).
+  RayWindowCounters ray_windows;
+  double pages_per_window() const {
+    return ray_windows.windows ? double(ray_windows.distinct_pages) / double(ray_windows.windows) : 0.0;
+  }
 };
 
 struct CacheStats {

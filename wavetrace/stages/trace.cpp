@@ -2,6 +2,7 @@
 // rays to any hit, camera rays to the coherent (packet) query, bounce rays to closest hit.
 #include "wavetrace/stages/trace.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <optional>
 
@@ -17,6 +18,7 @@ void TraceStage::process(Batch* batch, StageOutput& out) const {
   if (instruments_.observers != nullptr) {
     probe.emplace(*instruments_.observers, std::size_t(ObservedStage::trace),
                   std::size_t(tbb::this_task_arena::current_thread_index()));
+    probe->count_ray_windows();
   }
   std::uint32_t begin = 0;
   const auto count = static_cast<std::uint32_t>(rays.count);
@@ -41,6 +43,20 @@ void TraceStage::process(Batch* batch, StageOutput& out) const {
 }
 
 void TraceStage::trace_run(Batch& batch, RayRange range, RecordingProbe* probe) const {
+  if (probe != nullptr) {
+    // Observed, the run is traced in windows of consecutive rays, so the pager can count the
+    // distinct pages each window touched (the same hits: each ray is traced on its own).
+    for (std::uint32_t begin = range.begin; begin < range.end; begin += kRayWindow) {
+      const std::uint32_t end = std::min(range.end, begin + kRayWindow);
+      trace_window(batch, {begin, end}, probe);
+      probe->end_ray_window(end - begin == kRayWindow);
+    }
+    return;
+  }
+  trace_window(batch, range, nullptr);
+}
+
+void TraceStage::trace_window(Batch& batch, RayRange range, RecordingProbe* probe) const {
   const RayBatch& rays = batch.rays;
   HitBatch& hits = batch.hits;
   const RayKind kind = rays.kind[range.begin];

@@ -49,7 +49,13 @@ class TraceStage final : public Stage {
   // for one ray at a time. `probe` sees every read (null: unobserved).
   void trace_run(Batch& batch, RayRange range, RecordingProbe* probe = nullptr) const;
 
+  // Observed runs are traced this many rays at a time, the window in which the pager
+  // counts the distinct pages consecutive rays touch (`disk.pages_per_1000_rays`).
+  static constexpr std::uint32_t kRayWindow = 1000;
+
  private:
+  void trace_window(Batch& batch, RayRange range, RecordingProbe* probe) const;
+
   const Accelerator& accelerator_;
   const MaterialRuns& materials_;
   TraceInstruments instruments_;

@@ -1,0 +1,90 @@
+// The real pager on a small file of numbered 4 KiB pages: the bytes it shows, its LRU
+// eviction, faults counted by part, and a file cut short while it is paged.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include "wavetrace/memory/file_pager.hpp"
+
+namespace wavetrace {
+namespace {
+
+constexpr std::size_t kPage = 4096;
+constexpr std::size_t kPages = 16;
+
+// Every 32-bit word of page p holds p * 1000 + its index in the page.
+std::string numbered_file(const std::string& name) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "wavetrace_tests";
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / (std::to_string(::getpid()) + "_" + name)).string();
+  std::vector<std::uint32_t> words(kPages * kPage / 4);
+  for (std::size_t i = 0; i < words.size(); ++i) words[i] = std::uint32_t(i / (kPage / 4) * 1000 + i % (kPage / 4));
+  std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(words.data()), std::streamsize(words.size() * 4));
+  return path;
+}
+
+std::uint32_t word(const FilePager& pager, std::size_t page, std::size_t index) {
+  return reinterpret_cast<const volatile std::uint32_t*>(pager.base() + page * kPage)[index];
+}
+
+TEST(FilePager, ShowsTheFileAndEvictsTheLeastRecentlyUsedPage) {
+  const std::string path = numbered_file("pager_lru.bin");
+  FilePager pager(path, kPages * kPage, kPage, 4 * kPage, 1);
+  for (std::size_t page : {0, 1, 2, 3}) pager.touch(pager.base() + page * kPage);
+  EXPECT_EQ(pager.total().faults, 4u);
+  pager.touch(pager.base());             // page 0 becomes the most recent: page 1 is now the oldest
+  pager.touch(pager.base() + 4 * kPage);  // evicts page 1
+  EXPECT_EQ(pager.total().faults, 5u);
+  pager.touch(pager.base());  // still resident
+  EXPECT_EQ(pager.total().faults, 5u);
+  EXPECT_EQ(word(pager, 1, 7), 1007u);  // unannounced read of the evicted page: faults and loads it
+  EXPECT_EQ(pager.total().faults, 6u);
+  for (std::size_t page = 0; page < kPages; ++page) EXPECT_EQ(word(pager, page, 100), page * 1000 + 100) << page;
+}
+
+TEST(FilePager, CountsFaultsByPartOfTheFile) {
+  const std::string path = numbered_file("pager_parts.bin");
+  FilePager pager(path, kPages * kPage, kPage, 4 * kPage, 2);
+  pager.name_parts({"nodes", "leaves"}, {{8 * kPage, 4 * kPage, 1}, {0, 8 * kPage, 0}});
+  ASSERT_EQ(pager.part_names(), (std::vector<std::string>{"nodes", "leaves", "other"}));
+  {
+    const FilePager::ClientScope scope(1);
+    pager.touch(pager.base() + 1 * kPage);
+    pager.touch(pager.base() + 2 * kPage + 100);
+    pager.touch(pager.base() + 9 * kPage);
+  }
+  EXPECT_EQ(word(pager, 14, 0), 14000u);  // a fault outside any client and any part
+  EXPECT_EQ(pager.faults_by_part(1), (std::vector<std::uint64_t>{2, 1, 0}));
+  EXPECT_EQ(pager.faults_by_part(2), (std::vector<std::uint64_t>{0, 0, 1}));
+  EXPECT_EQ(pager.faults_by_part(std::size_t(-1)), (std::vector<std::uint64_t>{2, 1, 1}));
+  pager.reset();
+  EXPECT_EQ(pager.faults_by_part(std::size_t(-1)), (std::vector<std::uint64_t>{0, 0, 0}));
+}
+
+TEST(FilePagerDeathTest, AFileCutShortWhilePagedIsAClearErrorNamingIt) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  const std::string path = numbered_file("pager_truncated.bin");
+  FilePager pager(path, kPages * kPage, kPage, 4 * kPage, 1);
+  EXPECT_EQ(word(pager, 2, 3), 2003u);
+  std::filesystem::resize_file(path, 4 * kPage);
+  // A probe's announced read: an exception naming the file.
+  try {
+    pager.touch(pager.base() + 10 * kPage);
+    ADD_FAILURE() << "a read past the file's new end succeeded";
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find(path + ": reading page 10"), std::string::npos) << error.what();
+    EXPECT_NE(std::string(error.what()).find("the file ends early"), std::string::npos) << error.what();
+  }
+  // A read no probe announced faults inside a signal handler: the message, then exit 1.
+  EXPECT_EXIT((void)word(pager, 12, 0), ::testing::ExitedWithCode(1), "reading page 12 .* the file ends early");
+  EXPECT_EQ(word(pager, 3, 5), 3005u);  // the pages still in the file read as before
+}
+
+}  // namespace
+}  // namespace wavetrace
