@@ -222,6 +222,10 @@ TEST(Cli, BenchReorderReportsEveryHeuristicWithTheIssuesKeys) {
   const nlohmann::json spilled = nlohmann::json::parse(std::ifstream(json_path));
   ASSERT_EQ(spilled["results"].size(), 2u);
   EXPECT_TRUE(spilled["results"][1]["image_identical"].get<bool>());
+  EXPECT_TRUE(spilled["results"][0]["spill"].is_null());  // none has no buffer
+  EXPECT_GT(spilled["results"][1]["spill"]["bytes_written"].get<std::uint64_t>(), 0u) << spilled["results"][1].dump();
+  EXPECT_EQ(spilled["results"][1]["spill"]["bytes_read"], spilled["results"][1]["spill"]["bytes_written"]);
+  EXPECT_TRUE(spilled["results"][1]["disk_pages_per_1000_rays"].is_null());  // no world file paged
 }
 
 TEST(Cli, BenchPipelineComparesTheMegakernelWithEachHeuristic) {

@@ -62,9 +62,9 @@ TEST(FilePager, CountsFaultsByPartOfTheFile) {
   EXPECT_EQ(word(pager, 14, 0), 14000u);  // a fault outside any client and any part
   EXPECT_EQ(pager.faults_by_part(1), (std::vector<std::uint64_t>{2, 1, 0}));
   EXPECT_EQ(pager.faults_by_part(2), (std::vector<std::uint64_t>{0, 0, 1}));
-  EXPECT_EQ(pager.faults_by_part(std::size_t(-1)), (std::vector<std::uint64_t>{2, 1, 1}));
+  EXPECT_EQ(pager.faults_by_part(FilePager::kAllClients), (std::vector<std::uint64_t>{2, 1, 1}));
   pager.reset();
-  EXPECT_EQ(pager.faults_by_part(std::size_t(-1)), (std::vector<std::uint64_t>{0, 0, 0}));
+  EXPECT_EQ(pager.faults_by_part(FilePager::kAllClients), (std::vector<std::uint64_t>{0, 0, 0}));
 }
 
 TEST(FilePagerDeathTest, AFileCutShortWhilePagedIsAClearErrorNamingIt) {

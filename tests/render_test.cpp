@@ -1,7 +1,10 @@
 // Rendering through the pipeline: exact answers where the physics gives one, and
 // bit-identical images across thread counts, batch sizes, pixel orders, films and modes.
+#include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <map>
+#include <mutex>
 #include <stdexcept>
 #include <thread>
 
@@ -11,6 +14,7 @@
 #include "wavetrace/scene/builtin_scenes.hpp"
 #include "wavetrace/scene/lights.hpp"
 #include "wavetrace/setup/render_setup.hpp"
+#include "wavetrace/stages/buffering_stage.hpp"
 
 namespace wavetrace {
 namespace {
@@ -112,6 +116,75 @@ TEST(Render, AStageErrorDuringProgressReportsReachesTheCaller) {
     FAIL() << "no error";
   } catch (const std::runtime_error& error) {
     EXPECT_STREQ(error.what(), "the fourth batch fails");
+  }
+}
+
+// A buffering stage's flush reaches the next stage in its order, on any number of threads:
+// each batch starts within a few places of its place in the flush (without the pipeline's
+// ordered gate, the emitting thread would take the last batches first while the other took
+// the first ones: the threads would walk a sorted stream from both ends).
+TEST(Render, BatchesLeaveABufferingStageInTheirOrder) {
+  class HoldingStage final : public BufferingStage {
+   public:
+    std::string name() const override { return "hold"; }
+    void process(Batch* batch, StageOutput& out) const override { take(batch, out); }
+    std::size_t take(Batch* batch, StageOutput&) const override {
+      held_.push_back(batch);
+      rays_ += batch->rays.count;
+      return 0;
+    }
+    std::size_t flush(StageOutput& out) const override {
+      for (Batch* batch : held_) {
+        place_[batch] = place_.size();
+        out.emit(batch);
+      }
+      held_.clear();
+      const std::size_t rays = rays_;
+      rays_ = 0;
+      return rays;
+    }
+    std::size_t buffered_rays() const override { return rays_; }
+    std::size_t place(Batch* batch) const { return place_.at(batch); }
+
+   private:
+    mutable std::vector<Batch*> held_;
+    mutable std::map<Batch*, std::size_t> place_;
+    mutable std::size_t rays_ = 0;
+  };
+  class RecordingStage final : public Stage {
+   public:
+    explicit RecordingStage(const HoldingStage& hold) : hold_(hold) {}
+    std::string name() const override { return "record"; }
+    void process(Batch* batch, StageOutput& out) const override {
+      {
+        const std::lock_guard lock(mutex_);
+        started.push_back(hold_.place(batch));
+      }
+      std::this_thread::sleep_for(std::chrono::microseconds(200));  // long enough for the threads to overlap
+      out.release(batch);
+    }
+    mutable std::vector<std::size_t> started;
+
+   private:
+    const HoldingStage& hold_;
+    mutable std::mutex mutex_;
+  };
+  for (int threads : {1, 2, 4}) {
+    const ImageSpec image{.width = 64, .height = 64, .samples_per_pixel = 4};
+    GenerateStage generate(resolve_camera({}, default_scene()), image, PixelOrder::scanline);
+    const HoldingStage hold;
+    const RecordingStage record(hold);
+    PipelineOptions options;
+    options.batch_size = 256;
+    options.threads = threads;
+    options.rays_in_flight = 1 << 20;  // every batch held before the flush
+    Pipeline(generate, {&hold, &record}, false, options).run();
+    ASSERT_EQ(record.started.size(), 64u);
+    for (std::size_t position = 0; position < record.started.size(); ++position) {
+      const auto distance = std::max(record.started[position], position) - std::min(record.started[position], position);
+      EXPECT_LE(distance, std::size_t(2 * threads)) << threads << " threads: batch " << record.started[position]
+                                                    << " of the flush started " << position << "th";
+    }
   }
 }
 

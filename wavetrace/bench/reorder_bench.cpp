@@ -89,6 +89,10 @@ ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<Reo
         result.disk_faults = trace->disk->counters.faults;
         result.disk_bytes_read = trace->disk->counters.bytes_read;
         result.disk_read_seconds = trace->disk->counters.read_seconds;
+        result.disk_wait_seconds = trace->disk->counters.wait_seconds;
+        result.disk_reads_in_flight_max = trace->disk->reads_in_flight_max;
+        if (trace->disk->ray_windows.windows > 0) result.disk_pages_per_1000_rays = trace->disk->pages_per_window();
+        result.disk_faults_by_part = trace->disk->faults_by_part;
       }
     }
     if (const StageStats* approx = find_stage(output.run, "approx_hit")) {
@@ -102,7 +106,10 @@ ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<Reo
       }
       if (approx->cache && result.cache_misses) *result.cache_misses += approx->cache->counters.misses;
     }
-    if (const StageStats* zsort = find_stage(output.run, "zsort")) result.sort_seconds = zsort->seconds;
+    if (const StageStats* zsort = find_stage(output.run, "zsort")) {
+      result.sort_seconds = zsort->seconds;
+      result.spill = zsort->spill;
+    }
     result.overhead_share = (result.approx_hit_seconds + result.sort_seconds) / thread_seconds;
     if (first_image.empty()) first_image = output.image;
     result.image_identical = output.image == first_image;
@@ -114,6 +121,13 @@ ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<Reo
 nlohmann::json to_json(const ReorderBenchReport& report) {
   nlohmann::json results = nlohmann::json::array();
   for (const ReorderBenchResult& r : report.results) {
+    nlohmann::json parts = nlohmann::json::object();
+    for (const auto& [part, faults] : r.disk_faults_by_part) parts[part] = faults;
+    nlohmann::json spill = nullptr;
+    if (r.spill) {
+      spill = {{"bytes_written", r.spill->bytes_written}, {"bytes_read", r.spill->bytes_read},
+               {"seconds", r.spill->seconds}, {"runs", r.spill->runs}};
+    }
     results.push_back({{"heuristic", r.heuristic},
                        {"render_seconds", r.render_seconds},
                        {"trace_seconds", r.trace_seconds},
@@ -132,6 +146,11 @@ nlohmann::json to_json(const ReorderBenchReport& report) {
                        {"disk_faults", json_or_null(r.disk_faults)},
                        {"disk_bytes_read", json_or_null(r.disk_bytes_read)},
                        {"disk_read_seconds", json_or_null(r.disk_read_seconds)},
+                       {"disk_wait_seconds", json_or_null(r.disk_wait_seconds)},
+                       {"disk_reads_in_flight_max", json_or_null(r.disk_reads_in_flight_max)},
+                       {"disk_pages_per_1000_rays", json_or_null(r.disk_pages_per_1000_rays)},
+                       {"disk_faults_by_part", parts},
+                       {"spill", spill},
                        {"image_identical", r.image_identical}});
   }
   return {{"scene", {{"source", report.scene}, {"triangles", report.triangles}}},
@@ -154,8 +173,8 @@ std::string to_table(const ReorderBenchReport& report) {
   table += fmt::format("{:<11} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>8} {:>9} {:>10} {:>9} {:>11} {:>11} {:>9} {:>10}",
                        "heuristic", "render s", "trace s", "Mr/s/thr", "closest", "shadow", "approx s", "sort s",
                        "overhead", "faults", "sim I/O s", "misses", "vs first", "speedup", "identical");
-  table += disk ? fmt::format(" {:>11} {:>9} {:>9} {:>9} {:>10}\n", "disk faults", "disk MB", "read s", "disk vs 1st",
-                              "rays/page")
+  table += disk ? fmt::format(" {:>11} {:>9} {:>9} {:>9} {:>9} {:>10} {:>10}\n", "disk faults", "disk MB", "read s",
+                              "wait s", "disk vs 1st", "rays/page", "pages/1k")
                 : "\n";
   const ReorderBenchResult* first = report.results.empty() ? nullptr : &report.results.front();
   const auto optional = [](const auto& value, const char* format) {
@@ -174,10 +193,11 @@ std::string to_table(const ReorderBenchReport& report) {
                          ratio(first->page_faults, r.page_faults), first->render_seconds / r.render_seconds,
                          r.image_identical ? "yes" : "NO");
     if (disk) {
-      table += fmt::format(" {:>11} {:>9.1f} {:>9.2f} {:>9} {:>10.0f}", optional(r.disk_faults, "{}"),
+      table += fmt::format(" {:>11} {:>9.1f} {:>9.2f} {:>9.2f} {:>11} {:>10.0f} {:>10}", optional(r.disk_faults, "{}"),
                            double(r.disk_bytes_read.value_or(0)) * 1e-6, r.disk_read_seconds.value_or(0.0),
-                           ratio(first->disk_faults, r.disk_faults),
-                           double(r.rays_traced) / double(std::max<std::size_t>(report.page_count, 1)));
+                           r.disk_wait_seconds.value_or(0.0), ratio(first->disk_faults, r.disk_faults),
+                           double(r.rays_traced) / double(std::max<std::size_t>(report.page_count, 1)),
+                           optional(r.disk_pages_per_1000_rays, "{:.1f}"));
     }
     table += "\n";
   }
@@ -185,7 +205,8 @@ std::string to_table(const ReorderBenchReport& report) {
            "vs first: the first heuristic's page faults over this one's; speedup: its render seconds over this one's\n";
   if (disk) {
     table += "disk: real faults of trace (pages read from the world file with O_DIRECT), their bytes and measured read\n"
-             "seconds (inside render s); rays/page: rays traced per page of the world file\n";
+             "seconds (inside render s); wait s: trace's threads waiting for pages (their own reads included);\n"
+             "rays/page: rays traced per page of the world file; pages/1k: distinct pages 1,000 consecutive traced rays touch\n";
   }
   return table;
 }

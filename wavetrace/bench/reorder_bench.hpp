@@ -5,11 +5,13 @@
 #pragma once
 
 #include <optional>
+#include <utility>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "wavetrace/memory/ray_spill.hpp"
 #include "wavetrace/setup/config.hpp"
 #include "wavetrace/stages/reorder_keys.hpp"
 
@@ -35,6 +37,11 @@ struct ReorderBenchResult {
   std::optional<std::uint64_t> disk_faults;
   std::optional<std::uint64_t> disk_bytes_read;
   std::optional<double> disk_read_seconds;
+  std::optional<double> disk_wait_seconds;          // trace's threads waiting for pages, summed
+  std::optional<std::size_t> disk_reads_in_flight_max;
+  std::optional<double> disk_pages_per_1000_rays;   // distinct pages of 1,000 consecutive traced rays
+  std::vector<std::pair<std::string, std::uint64_t>> disk_faults_by_part;
+  std::optional<SpillCounters> spill;               // a disk ray buffer's runs
   bool image_identical = false;  // to the first heuristic's image (none, when listed first)
 };
 

@@ -327,7 +327,7 @@ std::vector<std::uint64_t> FilePager::faults_by_part(std::size_t client) const {
   std::lock_guard lock(mutex_);
   std::vector<std::uint64_t> faults(part_names_.size(), 0);
   for (std::size_t c = 0; c < clients_.size(); ++c) {
-    if (client != std::size_t(-1) && c != client) continue;
+    if (client != kAllClients && c != client) continue;
     for (std::size_t p = 0; p < faults.size(); ++p) faults[p] += part_faults_[c * faults.size() + p];
   }
   return faults;

@@ -73,8 +73,9 @@ class FilePager {
   // extent covers count to a last part, "other". Extents may come in any order but must
   // not overlap. Call before the first read.
   void name_parts(std::vector<std::string> names, std::vector<FilePart> extents);
-  // The part names, "other" last, and the faults of `client` (every client's when
-  // `client` is npos) by part, in that order.
+  // The part names, "other" last, and the faults of `client` (every client's with
+  // kAllClients) by part, in that order.
+  static constexpr std::size_t kAllClients = ~std::size_t{0};
   const std::vector<std::string>& part_names() const { return part_names_; }
   std::vector<std::uint64_t> faults_by_part(std::size_t client) const;
 
@@ -146,9 +147,10 @@ class FilePager {
   std::unique_ptr<std::atomic<std::uint32_t>[]> slot_of_;
   std::size_t page_count_ = 0;
   // The LRU list's clock: one tick per page put at its head. A resident page put there fewer
-  // than `fresh_ticks_` ticks ago sits in the list's first quarter, far from eviction, so a
-  // touch leaves it where it is without taking the lock: LRU order is exact except within
-  // that first quarter, which eviction never reaches.
+  // than `fresh_ticks_` (a quarter of the pool) ticks ago is still in the list's first
+  // quarter, far from eviction, so a touch of it takes no lock and leaves it where it is:
+  // the order is LRU's but for such touches, which may leave a page up to a quarter of the
+  // pool further back than exact LRU would (2-3% more faults on room:8M, 3-5% less time).
   std::atomic<std::uint64_t> lru_clock_{0};
   std::unique_ptr<std::atomic<std::uint64_t>[]> headed_at_;
   std::uint64_t fresh_ticks_ = 1;

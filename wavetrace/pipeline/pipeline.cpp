@@ -88,10 +88,17 @@ std::unique_ptr<GenerateNode> make_generate_node(tbb::flow::graph& graph, Genera
   return node;
 }
 
+Batch* OrderedHandOff::pop() {
+  Batch* batch = nullptr;
+  if (!queue_.try_pop(batch)) throw std::logic_error("an ordered hand-off was asked for a batch it does not hold");
+  return batch;
+}
+
 std::unique_ptr<BatchNode> make_stage_node(tbb::flow::graph& graph, const Stage& stage, PipelineContext& context,
-                                           StageCounters& counters) {
+                                           StageCounters& counters, OrderedHandOff* hand_off) {
   return std::make_unique<BatchNode>(
-      graph, tbb::flow::unlimited, [&stage, &context, &counters](Batch* batch, BatchNode::output_ports_type& ports) {
+      graph, tbb::flow::unlimited, [&stage, &context, &counters, hand_off](Batch* batch, BatchNode::output_ports_type& ports) {
+        if (hand_off != nullptr) batch = hand_off->pop();
         const Clock::time_point start = Clock::now();
         const std::size_t rays_in = batch->rays.count;
         PortOutput out(context, ports);
@@ -106,24 +113,30 @@ namespace {
 // A buffering stage's output: its rays are already counted alive, so emitting adds nothing.
 class BufferedOutput final : public StageOutput {
  public:
-  BufferedOutput(PipelineContext& context, BatchNode::output_ports_type& ports) : context_(context), ports_(ports) {}
-  void emit(Batch* batch) override { std::get<0>(ports_).try_put(batch); }
+  BufferedOutput(PipelineContext& context, BatchNode::output_ports_type& ports, OrderedHandOff* hand_off)
+      : context_(context), ports_(ports), hand_off_(hand_off) {}
+  void emit(Batch* batch) override {
+    if (hand_off_ != nullptr) hand_off_->push(batch);
+    std::get<0>(ports_).try_put(batch);
+  }
   Batch* acquire() override { return context_.pool().acquire(); }
   void release(Batch* batch) override { context_.pool().release(batch); }
 
  private:
   PipelineContext& context_;
   BatchNode::output_ports_type& ports_;
+  OrderedHandOff* hand_off_;
 };
 
 }  // namespace
 
 std::unique_ptr<BatchNode> make_buffering_node(tbb::flow::graph& graph, const BufferingStage& stage,
-                                               PipelineContext& context, StageCounters& counters) {
+                                               PipelineContext& context, StageCounters& counters,
+                                               OrderedHandOff* hand_off) {
   auto node = std::make_unique<BatchNode>(
-      graph, tbb::flow::serial, [&stage, &context, &counters](Batch* batch, BatchNode::output_ports_type& ports) {
+      graph, tbb::flow::serial, [&stage, &context, &counters, hand_off](Batch* batch, BatchNode::output_ports_type& ports) {
         const Clock::time_point start = Clock::now();
-        BufferedOutput out(context, ports);
+        BufferedOutput out(context, ports, hand_off);
         const std::size_t rays_in = batch != nullptr ? batch->rays.count : 0;
         const std::size_t spilled = stage.spilled_rays();
         std::size_t rays_out = batch != nullptr ? stage.take(batch, out) : 0;
@@ -179,12 +192,16 @@ PipelineRun Pipeline::run(const std::function<void(const Progress&)>& on_progres
   arena.execute([&] {
     tbb::flow::graph graph;
     auto generate_node = make_generate_node(graph, generate_, context, generate_counters);
+    std::vector<std::unique_ptr<OrderedHandOff>> hand_offs(chain_.size());  // [i]: from stage i to stage i + 1
     std::vector<std::unique_ptr<BatchNode>> nodes;
     for (std::size_t i = 0; i < chain_.size(); ++i) {
       if (const auto* buffering = dynamic_cast<const BufferingStage*>(chain_[i])) {
-        nodes.push_back(make_buffering_node(graph, *buffering, context, *counters[i]));
+        if (i + 1 < chain_.size() && dynamic_cast<const BufferingStage*>(chain_[i + 1]) == nullptr) {
+          hand_offs[i] = std::make_unique<OrderedHandOff>();
+        }
+        nodes.push_back(make_buffering_node(graph, *buffering, context, *counters[i], hand_offs[i].get()));
       } else {
-        nodes.push_back(make_stage_node(graph, *chain_[i], context, *counters[i]));
+        nodes.push_back(make_stage_node(graph, *chain_[i], context, *counters[i], i > 0 ? hand_offs[i - 1].get() : nullptr));
       }
     }
     std::unique_ptr<tbb::flow::function_node<Batch*>> retire;

@@ -1,0 +1,54 @@
+#!/usr/bin/env python3
+"""Table III with real I/O as Markdown, from bench/out_of_core_suite.sh's JSON: every paged run
+beside the same heuristic's render of the world mapped whole (the fraction of in-core speed),
+then where the trace's reads went (faults by part of the world file).
+Usage: bench/out_of_core_table.py OUT_DIR"""
+import glob
+import json
+import os
+import re
+import sys
+
+out = sys.argv[1] if len(sys.argv) > 1 else "out/out_of_core"
+in_core = json.load(open(os.path.join(out, "in_core.json")))
+in_core_rate = {r["heuristic"]: r["rays_traced"] / r["render_seconds"] for r in in_core["results"]}
+cpu = open(os.path.join(out, "cpu.txt")).read().strip().replace("\n", "; ") if os.path.exists(
+    os.path.join(out, "cpu.txt")) else "(cpu not recorded)"
+
+runs = []
+for path in glob.glob(os.path.join(out, "paged_*pct_*.json")):
+    match = re.search(r"paged_(\d+)pct_(\w+)\.json$", path)
+    runs.append((-int(match.group(1)), match.group(2) != "memory", match.group(2), int(match.group(1)), path))
+
+print(f"{in_core['scene']['source']}: {in_core['scene']['triangles']} triangles, {in_core['image']}, "
+      f"{in_core['accel']}, {in_core['threads']} threads; {cpu}")
+print()
+print("| budget | buffer | heuristic | rays traced | rays/page | real reads | MB read | read s | wait s | "
+      "pages/1k rays | render s | Mrays/s | of in-core | reads vs none | time vs none | identical |")
+print("| --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |")
+parts = []
+for _, _, buffer, budget, path in sorted(runs):
+    report = json.load(open(path))
+    pages = max(report["page_count"], 1)
+    none = next((r for r in report["results"] if r["heuristic"] == "none"), None)
+    for r in report["results"]:
+        rate = r["rays_traced"] / r["render_seconds"]
+        versus = lambda key: f"{none[key] / r[key]:.2f}x" if none and r[key] else "-"
+        pages_1k = r.get("disk_pages_per_1000_rays")
+        print(f"| {budget}% | {buffer} | {r['heuristic']} | {r['rays_traced']:,} | {r['rays_traced'] / pages:,.0f} | "
+              f"{r['disk_faults']:,} | {r['disk_bytes_read'] / 1e6:,.0f} | {r['disk_read_seconds']:.1f} | "
+              f"{r['disk_wait_seconds']:.1f} | {pages_1k:.1f} | {r['render_seconds']:.1f} | {rate / 1e6:.3f} | "
+              f"{100 * rate / in_core_rate[r['heuristic']]:.1f}% | {versus('disk_faults')} | "
+              f"{versus('render_seconds')} | {'yes' if r['image_identical'] else 'NO'} |")
+        parts.append((budget, buffer, r["heuristic"], r.get("disk_faults_by_part", {}), r["disk_faults"]))
+print()
+print("In core (mapped whole): " + ", ".join(
+    f"{r['heuristic']} {r['render_seconds']:.2f} s ({in_core_rate[r['heuristic']] / 1e6:.3f} Mrays/s)"
+    for r in in_core["results"]))
+print()
+names = sorted({name for *_, by_part, _ in parts for name in by_part})
+print("| budget | buffer | heuristic | " + " | ".join(names) + " |")
+print("| --- | --- | --- | " + " | ".join("---:" for _ in names) + " |")
+for budget, buffer, heuristic, by_part, faults in parts:
+    cells = [f"{100 * by_part.get(n, 0) / max(faults, 1):.1f}%" for n in names]
+    print(f"| {budget}% | {buffer} | {heuristic} | " + " | ".join(cells) + " |")
