@@ -417,7 +417,8 @@ TEST(WorldFileCli, BuildRenderAndInfo) {
   EXPECT_NE(rendered.output.find("real faults"), std::string::npos) << rendered.output;
   // Where the reads go: every trace fault counted to one part of the file, and the distinct
   // pages of each 1,000 consecutive rays.
-  for (const nlohmann::json& stage : nlohmann::json::parse(read_all(stats))["stages"]) {
+  const nlohmann::json report = nlohmann::json::parse(read_all(stats));
+  for (const nlohmann::json& stage : report.at("stages")) {
     if (stage["name"] != "trace") continue;
     const nlohmann::json& disk = stage.at("disk");
     std::uint64_t by_part = 0;
