@@ -50,6 +50,10 @@ std::string memory_lines(const std::vector<StageStats>& stages) {
                            stage.name, stage.disk->page_bytes >> 10, double(stage.disk->budget_bytes) / (1 << 20),
                            c.faults, double(c.bytes_read) * 1e-6, c.read_seconds, c.wait_seconds,
                            stage.disk->reads_in_flight_max);
+      if (stage.disk->prefetched > 0) {
+        lines += fmt::format("{} disk: {} of those pages read ahead by its look-ahead, {} of them used before evicted\n",
+                             stage.name, stage.disk->prefetched, stage.disk->prefetch_hits);
+      }
       if (!stage.disk->faults_by_part.empty()) {
         std::string parts;
         for (const auto& [part, faults] : stage.disk->faults_by_part) {
@@ -123,6 +127,8 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
                        {"read_seconds", stage.disk->counters.read_seconds},
                        {"wait_seconds", stage.disk->counters.wait_seconds},
                        {"reads_in_flight_max", stage.disk->reads_in_flight_max},
+                       {"prefetched", stage.disk->prefetched},
+                       {"prefetch_hits", stage.disk->prefetch_hits},
                        {"faults_by_part", disk_parts_json(*stage.disk)},
                        {"pages_per_1000_rays", json_or_null(stage.disk->ray_windows.windows > 0
                                                                 ? std::optional(stage.disk->pages_per_window())

@@ -3,7 +3,8 @@
 # mapped whole (in core) and paged from disk at each budget, every heuristic with the memory
 # and the disk ray buffer; bench/out_of_core_table.py turns the JSON into the Markdown table.
 # Usage: bench/out_of_core_suite.sh WORLD.wtw OUT_DIR
-# Settings (environment): SIZE (640x480), SPP (16), DEPTH (3), PAGE (131072), BUDGETS ("24 10"),
+# Settings (environment): SIZE (640x480), SPP (16), DEPTH (3), PAGES (page sizes in bytes, the
+#   sweep of item 2: "131072"), BUDGETS ("24 10"),
 #   HEURISTICS (none,origin,origin_dir,hph,hph_origin,hph_dir), BUFFERS ("memory disk"),
 #   LOW_HEURISTICS (the heuristics at budgets after the first; default HEURISTICS).
 # The paper's setting is a world of about 3,200 pages of 4 MB and over 10,000 rays a page: a
@@ -26,11 +27,13 @@ for budget in ${BUDGETS:-24 10}; do
   list=$heuristics
   [[ $first == 1 ]] || list=${LOW_HEURISTICS:-$heuristics}
   first=0
-  for buffer in ${BUFFERS:-memory disk}; do
-    drop_caches
-    "$wavetrace" bench reorder "${common[@]}" --heuristics "$list" --set memory.backing=file \
-        --set "memory.budget=${budget}%" --set "memory.page_bytes=${PAGE:-131072}" --set "reorder.buffer=$buffer" \
-        --json "$out/paged_${budget}pct_${buffer}.json" | tee "$out/paged_${budget}pct_${buffer}.txt"
+  for page in ${PAGES:-131072}; do
+    for buffer in ${BUFFERS:-memory disk}; do
+      drop_caches
+      "$wavetrace" bench reorder "${common[@]}" --heuristics "$list" --set memory.backing=file \
+          --set "memory.budget=${budget}%" --set "memory.page_bytes=$page" --set "reorder.buffer=$buffer" \
+          --json "$out/paged_${budget}pct_${buffer}_${page}B.json" | tee "$out/paged_${budget}pct_${buffer}_${page}B.txt"
+    done
   done
 done
 /usr/bin/python3 bench/out_of_core_table.py "$out" | tee "$out/table.md"

@@ -16,18 +16,19 @@ cpu = open(os.path.join(out, "cpu.txt")).read().strip().replace("\n", "; ") if o
     os.path.join(out, "cpu.txt")) else "(cpu not recorded)"
 
 runs = []
-for path in glob.glob(os.path.join(out, "paged_*pct_*.json")):
-    match = re.search(r"paged_(\d+)pct_(\w+)\.json$", path)
-    runs.append((-int(match.group(1)), match.group(2) != "memory", match.group(2), int(match.group(1)), path))
+for path in glob.glob(os.path.join(out, "paged_*pct_*_*B.json")):
+    match = re.search(r"paged_(\d+)pct_([a-z]+)_(\d+)B\.json$", path)
+    budget, buffer, page = int(match.group(1)), match.group(2), int(match.group(3))
+    runs.append((-budget, buffer != "memory", page, buffer, budget, path))
 
 print(f"{in_core['scene']['source']}: {in_core['scene']['triangles']} triangles, {in_core['image']}, "
       f"{in_core['accel']}, {in_core['threads']} threads; {cpu}")
 print()
-print("| budget | buffer | heuristic | rays traced | rays/page | real reads | MB read | read s | wait s | "
+print("| budget | buffer | page KiB | heuristic | rays traced | rays/page | real reads | MB read | read s | wait s | "
       "pages/1k rays | render s | Mrays/s | of in-core | reads vs none | time vs none | identical |")
-print("| --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |")
+print("| --- | --- | ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |")
 parts = []
-for _, _, buffer, budget, path in sorted(runs):
+for _, _, page, buffer, budget, path in sorted(runs):
     report = json.load(open(path))
     pages = max(report["page_count"], 1)
     none = next((r for r in report["results"] if r["heuristic"] == "none"), None)
@@ -35,20 +36,20 @@ for _, _, buffer, budget, path in sorted(runs):
         rate = r["rays_traced"] / r["render_seconds"]
         versus = lambda key: f"{none[key] / r[key]:.2f}x" if none and r[key] else "-"
         pages_1k = r.get("disk_pages_per_1000_rays")
-        print(f"| {budget}% | {buffer} | {r['heuristic']} | {r['rays_traced']:,} | {r['rays_traced'] / pages:,.0f} | "
+        print(f"| {budget}% | {buffer} | {page >> 10:,} | {r['heuristic']} | {r['rays_traced']:,} | {r['rays_traced'] / pages:,.0f} | "
               f"{r['disk_faults']:,} | {r['disk_bytes_read'] / 1e6:,.0f} | {r['disk_read_seconds']:.1f} | "
               f"{r['disk_wait_seconds']:.1f} | {pages_1k:.1f} | {r['render_seconds']:.1f} | {rate / 1e6:.3f} | "
               f"{100 * rate / in_core_rate[r['heuristic']]:.1f}% | {versus('disk_faults')} | "
               f"{versus('render_seconds')} | {'yes' if r['image_identical'] else 'NO'} |")
-        parts.append((budget, buffer, r["heuristic"], r.get("disk_faults_by_part", {}), r["disk_faults"]))
+        parts.append((budget, buffer, page, r["heuristic"], r.get("disk_faults_by_part", {}), r["disk_faults"]))
 print()
 print("In core (mapped whole): " + ", ".join(
     f"{r['heuristic']} {r['render_seconds']:.2f} s ({in_core_rate[r['heuristic']] / 1e6:.3f} Mrays/s)"
     for r in in_core["results"]))
 print()
 names = sorted({name for *_, by_part, _ in parts for name in by_part})
-print("| budget | buffer | heuristic | " + " | ".join(names) + " |")
-print("| --- | --- | --- | " + " | ".join("---:" for _ in names) + " |")
-for budget, buffer, heuristic, by_part, faults in parts:
+print("| budget | buffer | page KiB | heuristic | " + " | ".join(names) + " |")
+print("| --- | --- | ---: | --- | " + " | ".join("---:" for _ in names) + " |")
+for budget, buffer, page, heuristic, by_part, faults in parts:
     cells = [f"{100 * by_part.get(n, 0) / max(faults, 1):.1f}%" for n in names]
-    print(f"| {budget}% | {buffer} | {heuristic} | " + " | ".join(cells) + " |")
+    print(f"| {budget}% | {buffer} | {page >> 10:,} | {heuristic} | " + " | ".join(cells) + " |")

@@ -19,11 +19,11 @@ constexpr std::size_t kPage = 4096;
 constexpr std::size_t kPages = 16;
 
 // Every 32-bit word of page p holds p * 1000 + its index in the page.
-std::string numbered_file(const std::string& name) {
+std::string numbered_file(const std::string& name, std::size_t pages = kPages) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / "wavetrace_tests";
   std::filesystem::create_directories(dir);
   const std::string path = (dir / (std::to_string(::getpid()) + "_" + name)).string();
-  std::vector<std::uint32_t> words(kPages * kPage / 4);
+  std::vector<std::uint32_t> words(pages * kPage / 4);
   for (std::size_t i = 0; i < words.size(); ++i) words[i] = std::uint32_t(i / (kPage / 4) * 1000 + i % (kPage / 4));
   std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(words.data()), std::streamsize(words.size() * 4));
   return path;
@@ -48,6 +48,26 @@ TEST(FilePager, ShowsTheFileAndEvictsTheLeastRecentlyUsedPage) {
   for (std::size_t page = 0; page < kPages; ++page) EXPECT_EQ(word(pager, page, 100), page * 1000 + 100) << page;
 }
 
+// A full pool of 16 slots evicts its two least recently used pages at once (an eighth of
+// it): one TLB flush for both.
+TEST(FilePager, AFullPoolEvictsAGroupOfTheLeastRecentlyUsedPages) {
+  const std::string path = numbered_file("pager_group.bin", 32);
+  FilePager pager(path, 32 * kPage, kPage, 16 * kPage, 1);
+  for (std::size_t page = 0; page < 16; ++page) pager.touch(pager.base() + page * kPage);
+  pager.touch(pager.base() + 16 * kPage);  // evicts pages 0 and 1
+  EXPECT_EQ(pager.total().faults, 17u);
+  pager.touch(pager.base() + 17 * kPage);  // takes the second freed slot: no eviction
+  pager.touch(pager.base() + 2 * kPage);   // still resident
+  EXPECT_EQ(pager.total().faults, 18u);
+  EXPECT_EQ(word(pager, 1, 3), 1003u);  // evicted with page 0: faults and loads it (evicting 3 and 4)
+  EXPECT_EQ(pager.total().faults, 19u);
+  pager.touch(pager.base() + 5 * kPage);  // still resident
+  EXPECT_EQ(pager.total().faults, 19u);
+  EXPECT_EQ(word(pager, 4, 9), 4009u);
+  EXPECT_EQ(pager.total().faults, 20u);
+  for (std::size_t page = 0; page < 32; ++page) EXPECT_EQ(word(pager, page, 100), page * 1000 + 100) << page;
+}
+
 TEST(FilePager, CountsFaultsByPartOfTheFile) {
   const std::string path = numbered_file("pager_parts.bin");
   FilePager pager(path, kPages * kPage, kPage, 4 * kPage, 2);
@@ -65,6 +85,32 @@ TEST(FilePager, CountsFaultsByPartOfTheFile) {
   EXPECT_EQ(pager.faults_by_part(FilePager::kAllClients), (std::vector<std::uint64_t>{2, 1, 1}));
   pager.reset();
   EXPECT_EQ(pager.faults_by_part(FilePager::kAllClients), (std::vector<std::uint64_t>{0, 0, 0}));
+}
+
+// Pages the prefetch client loads are prefetched; the first read of one by another client
+// before its eviction is a hit, later reads and reads after the eviction are not.
+TEST(FilePager, CountsAPrefetchedPageReadByAnotherClientAsAHit) {
+  const std::string path = numbered_file("pager_prefetch.bin");
+  FilePager pager(path, kPages * kPage, kPage, 4 * kPage, 2);
+  pager.set_prefetch_client(1);
+  {
+    const FilePager::ClientScope prefetcher(1);
+    for (std::size_t page : {0, 1, 2}) pager.touch(pager.base() + page * kPage);
+  }
+  EXPECT_EQ(pager.counters(1).faults, 3u);
+  const FilePager::ClientScope reader(0);
+  pager.touch(pager.base());
+  pager.touch(pager.base() + 100);
+  EXPECT_EQ(word(pager, 1, 5), 1005u);  // resident: no fault, and a read the pager hears of only through touch
+  pager.touch(pager.base() + 1 * kPage);
+  EXPECT_EQ(pager.prefetch_hits(), 2u);
+  EXPECT_EQ(pager.counters(0).faults, 0u);
+  for (std::size_t page : {3, 4, 5, 6}) pager.touch(pager.base() + page * kPage);  // evicts 0, 1 and 2
+  pager.touch(pager.base() + 2 * kPage);  // read again, but by the reader: no hit
+  EXPECT_EQ(pager.prefetch_hits(), 2u);
+  EXPECT_EQ(pager.counters(0).faults, 5u);
+  pager.reset();
+  EXPECT_EQ(pager.prefetch_hits(), 0u);
 }
 
 TEST(FilePagerDeathTest, AFileCutShortWhilePagedIsAClearErrorNamingIt) {

@@ -188,6 +188,42 @@ TEST(Render, BatchesLeaveABufferingStageInTheirOrder) {
   }
 }
 
+// The look-ahead sees the queued batches in their order, never more than `depth` past the
+// next one taken, never one already taken; closing the hand-off ends its wait.
+TEST(Render, AHandOffsLookAheadSeesQueuedBatchesInOrderWithinItsDepth) {
+  BatchPool pool(4);
+  std::vector<Batch*> batches;
+  for (int i = 0; i < 5; ++i) {
+    batches.push_back(pool.acquire());
+    batches.back()->rays.count = std::size_t(i);  // names the batch
+  }
+  OrderedHandOff hand_off;
+  std::vector<std::size_t> seen;
+  const auto note = [&](const Batch& batch) { seen.push_back(batch.rays.count); };
+  for (Batch* batch : batches) hand_off.push(batch);
+  ASSERT_TRUE(hand_off.next_ahead(2, note));
+  ASSERT_TRUE(hand_off.next_ahead(2, note));
+  EXPECT_EQ(seen, (std::vector<std::size_t>{0, 1}));
+  std::atomic<bool> third_seen{false};
+  std::thread reader([&] {
+    if (hand_off.next_ahead(2, note)) third_seen = true;
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_FALSE(third_seen.load());  // batch 2 is two places past the next one taken
+  EXPECT_EQ(hand_off.pop()->rays.count, 0u);
+  reader.join();
+  EXPECT_TRUE(third_seen.load());
+  EXPECT_EQ(seen.back(), 2u);
+  for (std::size_t expected : {1, 2, 3}) EXPECT_EQ(hand_off.pop()->rays.count, expected);
+  ASSERT_TRUE(hand_off.next_ahead(2, note));  // batch 3 was taken unseen: the next is 4
+  EXPECT_EQ(seen.back(), 4u);
+  std::thread waiting([&] { EXPECT_FALSE(hand_off.next_ahead(2, note)); });
+  hand_off.close();
+  waiting.join();
+  EXPECT_EQ(hand_off.pop()->rays.count, 4u);
+  for (Batch* batch : batches) pool.release(batch);
+}
+
 TEST(Render, ConvexObjectUnderUniformSkyReflectsItsAlbedoExactly) {
   // Every bounce from a convex surface escapes to the sky, so each sample of the object
   // returns exactly albedo x sky: no noise, an exact expected value.

@@ -91,6 +91,8 @@ ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<Reo
         result.disk_read_seconds = trace->disk->counters.read_seconds;
         result.disk_wait_seconds = trace->disk->counters.wait_seconds;
         result.disk_reads_in_flight_max = trace->disk->reads_in_flight_max;
+        result.disk_prefetched = trace->disk->prefetched;
+        result.disk_prefetch_hits = trace->disk->prefetch_hits;
         if (trace->disk->ray_windows.windows > 0) result.disk_pages_per_1000_rays = trace->disk->pages_per_window();
         result.disk_faults_by_part = trace->disk->faults_by_part;
       }
@@ -148,6 +150,8 @@ nlohmann::json to_json(const ReorderBenchReport& report) {
                        {"disk_read_seconds", json_or_null(r.disk_read_seconds)},
                        {"disk_wait_seconds", json_or_null(r.disk_wait_seconds)},
                        {"disk_reads_in_flight_max", json_or_null(r.disk_reads_in_flight_max)},
+                       {"disk_prefetched", json_or_null(r.disk_prefetched)},
+                       {"disk_prefetch_hits", json_or_null(r.disk_prefetch_hits)},
                        {"disk_pages_per_1000_rays", json_or_null(r.disk_pages_per_1000_rays)},
                        {"disk_faults_by_part", parts},
                        {"spill", spill},
@@ -173,8 +177,8 @@ std::string to_table(const ReorderBenchReport& report) {
   table += fmt::format("{:<11} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>8} {:>9} {:>10} {:>9} {:>11} {:>11} {:>9} {:>10}",
                        "heuristic", "render s", "trace s", "Mr/s/thr", "closest", "shadow", "approx s", "sort s",
                        "overhead", "faults", "sim I/O s", "misses", "vs first", "speedup", "identical");
-  table += disk ? fmt::format(" {:>11} {:>9} {:>9} {:>9} {:>9} {:>10} {:>10}\n", "disk faults", "disk MB", "read s",
-                              "wait s", "disk vs 1st", "rays/page", "pages/1k")
+  table += disk ? fmt::format(" {:>11} {:>9} {:>9} {:>9} {:>9} {:>10} {:>10} {:>10} {:>10}\n", "disk faults", "disk MB",
+                              "read s", "wait s", "disk vs 1st", "rays/page", "pages/1k", "read ahead", "ahead hits")
                 : "\n";
   const ReorderBenchResult* first = report.results.empty() ? nullptr : &report.results.front();
   const auto optional = [](const auto& value, const char* format) {
@@ -197,7 +201,8 @@ std::string to_table(const ReorderBenchReport& report) {
                            double(r.disk_bytes_read.value_or(0)) * 1e-6, r.disk_read_seconds.value_or(0.0),
                            r.disk_wait_seconds.value_or(0.0), ratio(first->disk_faults, r.disk_faults),
                            double(r.rays_traced) / double(std::max<std::size_t>(report.page_count, 1)),
-                           optional(r.disk_pages_per_1000_rays, "{:.1f}"));
+                           optional(r.disk_pages_per_1000_rays, "{:.1f}"), optional(r.disk_prefetched, "{}"),
+                           optional(r.disk_prefetch_hits, "{}"));
     }
     table += "\n";
   }
@@ -206,7 +211,9 @@ std::string to_table(const ReorderBenchReport& report) {
   if (disk) {
     table += "disk: real faults of trace (pages read from the world file with O_DIRECT), their bytes and measured read\n"
              "seconds (inside render s); wait s: trace's threads waiting for pages (their own reads included);\n"
-             "rays/page: rays traced per page of the world file; pages/1k: distinct pages 1,000 consecutive traced rays touch\n";
+             "rays/page: rays traced per page of the world file; pages/1k: distinct pages 1,000 consecutive traced rays touch;\n"
+             "read ahead: of the faults, pages trace's look-ahead read before trace reached them (memory.look_ahead);\n"
+             "ahead hits: of those, pages trace read before they were evicted\n";
   }
   return table;
 }

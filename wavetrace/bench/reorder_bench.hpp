@@ -39,6 +39,8 @@ struct ReorderBenchResult {
   std::optional<double> disk_read_seconds;
   std::optional<double> disk_wait_seconds;          // trace's threads waiting for pages, summed
   std::optional<std::size_t> disk_reads_in_flight_max;
+  std::optional<std::uint64_t> disk_prefetched;     // of disk_faults, pages trace's look-ahead read
+  std::optional<std::uint64_t> disk_prefetch_hits;  // of those, pages trace read before they were evicted
   std::optional<double> disk_pages_per_1000_rays;   // distinct pages of 1,000 consecutive traced rays
   std::vector<std::pair<std::string, std::uint64_t>> disk_faults_by_part;
   std::optional<SpillCounters> spill;               // a disk ray buffer's runs

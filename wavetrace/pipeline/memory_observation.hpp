@@ -21,6 +21,9 @@ struct MemoryPlan {
   std::optional<MemoryBudget> budget;  // no pager without one
   bool file_backing = false;           // memory.backing = file: a world file really paged under the budget
   std::size_t page_bytes = std::size_t{4} << 20;
+  // Real paging: sorted batches queued for trace whose pages its look-ahead reads first (0: none).
+  std::size_t look_ahead_batches = 0;
+  bool simulate_beside_file = false;  // real paging: also count the reads in the simulated pager
   IoModel io = io_preset("disk");  // memory.io
   std::optional<CacheGeometry> cache;  // no cache simulation without one
   bool enabled() const { return budget.has_value() || cache.has_value(); }

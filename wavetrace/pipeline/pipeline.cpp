@@ -1,9 +1,12 @@
 // Flow-graph nodes around stages, ray accounting, and the threaded run.
 #include "wavetrace/pipeline/pipeline.hpp"
 
+#include <exception>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 #include "wavetrace/pipeline/tracing_arena.hpp"
 
@@ -88,10 +91,48 @@ std::unique_ptr<GenerateNode> make_generate_node(tbb::flow::graph& graph, Genera
   return node;
 }
 
+void OrderedHandOff::push(Batch* batch) {
+  {
+    std::lock_guard lock(mutex_);
+    queue_.push_back(batch);
+  }
+  changed_.notify_all();
+}
+
 Batch* OrderedHandOff::pop() {
   Batch* batch = nullptr;
-  if (!queue_.try_pop(batch)) throw std::logic_error("an ordered hand-off was asked for a batch it does not hold");
+  {
+    std::lock_guard lock(mutex_);
+    if (queue_.empty()) throw std::logic_error("an ordered hand-off was asked for a batch it does not hold");
+    batch = queue_.front();
+    queue_.pop_front();
+    ++popped_;
+  }
+  changed_.notify_all();
   return batch;
+}
+
+bool OrderedHandOff::next_ahead(std::size_t depth, const std::function<void(const Batch&)>& copy) {
+  std::unique_lock lock(mutex_);
+  for (;;) {
+    if (closed_) return false;
+    // A batch already taken is no longer worth reading ahead: skip to the queue's head.
+    seen_ = std::max(seen_, popped_);
+    const std::uint64_t place = seen_ - popped_;
+    if (place < queue_.size() && place < depth) break;
+    changed_.wait(lock);
+  }
+  copy(*queue_[seen_ - popped_]);
+  ++seen_;
+  return true;
+}
+
+void OrderedHandOff::close() {
+  {
+    std::lock_guard lock(mutex_);
+    closed_ = true;
+  }
+  changed_.notify_all();
 }
 
 std::unique_ptr<BatchNode> make_stage_node(tbb::flow::graph& graph, const Stage& stage, PipelineContext& context,
@@ -220,8 +261,43 @@ PipelineRun Pipeline::run(const std::function<void(const Progress&)>& on_progres
         tbb::flow::make_edge(tbb::flow::output_port<0>(*nodes.back()), *retire);
       }
     }
+    // Each stage that reads ahead gets a thread of its own beside the arena's workers: it
+    // mostly waits for the disk, and a worker taken by it would trace nothing meanwhile.
+    std::vector<std::jthread> readers_ahead;
+    std::exception_ptr look_ahead_error;
+    std::mutex look_ahead_error_mutex;
+    const auto stop_reading_ahead = [&] {
+      for (const auto& hand_off : hand_offs) {
+        if (hand_off) hand_off->close();
+      }
+      readers_ahead.clear();  // joins
+    };
+    for (std::size_t i = 1; i < chain_.size(); ++i) {
+      const std::size_t depth = chain_[i]->look_ahead_batches();
+      if (hand_offs[i - 1] == nullptr || depth == 0) continue;
+      readers_ahead.emplace_back([&, stage = chain_[i], hand_off = hand_offs[i - 1].get(), depth] {
+        Batch* copy = context.pool().acquire();
+        try {
+          while (hand_off->next_ahead(depth, [&](const Batch& upcoming) { stage->copy_ahead(upcoming, *copy); })) {
+            stage->look_ahead(*copy);
+          }
+        } catch (...) {
+          // The stage's own reads will meet the same failure; keep it to report should they not.
+          std::lock_guard lock(look_ahead_error_mutex);
+          look_ahead_error = std::current_exception();
+        }
+        context.pool().release(copy);
+      });
+    }
     generate_node->try_put(tbb::flow::continue_msg());
-    graph.wait_for_all();
+    try {
+      graph.wait_for_all();
+    } catch (...) {
+      stop_reading_ahead();
+      throw;
+    }
+    stop_reading_ahead();
+    if (look_ahead_error) std::rethrow_exception(look_ahead_error);
   });
   if (context.live_rays() != 0) {
     throw std::logic_error("the pipeline drained with " + std::to_string(context.live_rays()) + " rays still alive");

@@ -12,13 +12,15 @@
 
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
-#include <tbb/concurrent_queue.h>
 #include <tbb/flow_graph.h>
 
 #include "wavetrace/memory/batch_pool.hpp"
@@ -87,11 +89,23 @@ std::unique_ptr<GenerateNode> make_generate_node(tbb::flow::graph& graph, Genera
 // message that only stands for one: whichever task runs next takes the oldest batch.
 class OrderedHandOff {
  public:
-  void push(Batch* batch) { queue_.push(batch); }
+  void push(Batch* batch);
   Batch* pop();  // one batch was pushed for every message sent, so there is always one
 
+  // For the next stage's look-ahead (Stage::look_ahead_batches): waits for the oldest batch
+  // this reader has not seen among the first `depth` in the queue (the next to be popped is
+  // the first), hands it to `copy` (under the lock: a queued batch is no one's to change) and returns
+  // true; returns false once closed.
+  bool next_ahead(std::size_t depth, const std::function<void(const Batch&)>& copy);
+  void close();  // the graph is done: a waiting reader returns
+
  private:
-  tbb::concurrent_queue<Batch*> queue_;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::deque<Batch*> queue_;
+  std::uint64_t popped_ = 0;  // batches taken so far
+  std::uint64_t seen_ = 0;    // the look-ahead's next batch, counted from the first pushed
+  bool closed_ = false;
 };
 
 // A node running `stage` on any number of batches at once. With `hand_off`, each message

@@ -24,7 +24,11 @@ struct PagerStats {
 struct DiskStats {
   std::size_t page_bytes = 0;
   std::size_t budget_bytes = 0;
+  // For trace, its look-ahead's reads included (faults, bytes, read seconds, by part); the
+  // wait seconds are the stage's own threads'.
   DiskCounters counters;
+  std::uint64_t prefetched = 0;     // pages the look-ahead read (trace only)
+  std::uint64_t prefetch_hits = 0;  // of those, pages trace read before they were evicted
   std::size_t reads_in_flight_max = 0;  // the pager's, over every stage
   // Faults by part of the file (a world's top tree, chunk nodes, leaf records...), "other"
   // last: where the reads go.

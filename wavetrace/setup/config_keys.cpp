@@ -311,12 +311,22 @@ const std::vector<ConfigKey>& config_schema() {
        "(512MiB, 2GB); not accel.memory_budget, which bounds the whole process for auto",
        read_memory_budget},
       {"memory.page_bytes", T::integer, std::int64_t{4} << 20, 4096, std::int64_t{1} << 30, {},
-       "page size of the pool in bytes, a power of two (the paper: 4 MiB)",
+       "page size of the pool in bytes, a power of two (the paper: 4 MiB; real paging of room:8M on this project's "
+       "machines is fastest at 64 KiB: docs/measurements.md)",
        integer<&P::memory, &MemoryPlan::page_bytes>},
       {"memory.backing", T::text, std::string("memory"), 0, 0, {"memory", "file"},
        "where a world file's pages live: memory (mapped, the OS pages it) or file (real paging: read on demand "
        "with O_DIRECT into a pool of memory.budget, evicted LRU)",
        read_backing},
+      {"memory.look_ahead", T::integer, std::int64_t{0}, 0, 64, {},
+       "real paging (memory.backing = file): how many of the sorted batches queued for trace a thread of its own "
+       "traces ahead (every 4th ray, hits thrown away) so that their pages are read before trace needs them; 0: none "
+       "(on a disk that one read at a time already keeps busy it costs time: docs/measurements.md)",
+       integer<&P::memory, &MemoryPlan::look_ahead_batches>},
+      {"memory.simulate_beside_file", T::boolean, false, 0, 0, {},
+       "real paging: also run the simulated pager over the same reads (a cross-check of the real faults; it costs "
+       "render time, a lock per page change)",
+       boolean<&P::memory, &MemoryPlan::simulate_beside_file>},
       {"memory.io", T::text, std::string("disk"), 0, 0, {"disk", "nvme"},
        "simulated device per fault: disk (the paper's, 101 MB/s, 8 ms) or nvme (3.5 GB/s, 80 us)",
        read_io},

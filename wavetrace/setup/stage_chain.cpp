@@ -26,7 +26,8 @@ StageChain::StageChain(const RenderPlan& plan, const World& world, Film& film, c
     if (name == "repack") owned_.push_back(std::make_unique<RepackStage>(plan.pipeline.batch_size / 2));
     if (name == "trace") {
       owned_.push_back(std::make_unique<TraceStage>(world.accelerator, world.scene.material_runs,
-                                                    TraceInstruments{&hit_rates_, observers, &trace_times_}));
+                                                    TraceInstruments{&hit_rates_, observers, &trace_times_},
+                                                    plan.memory.look_ahead_batches));
     }
     if (name == "shade") owned_.push_back(std::make_unique<ShadeStage>(world, film, rules));
     if (name == "spawn") {

@@ -97,7 +97,7 @@ TriangleMesh read_mesh(const SectionFile& file, const std::string& prefix) {
 
 std::optional<PagingRequest> world_paging(const RenderPlan& plan) {
   if (!plan.memory.file_backing) return std::nullopt;
-  return PagingRequest{plan.memory.page_bytes, *plan.memory.budget, kObservedStageCount};
+  return PagingRequest{plan.memory.page_bytes, *plan.memory.budget, kFilePagerClients};
 }
 
 bool is_world_file(const std::string& path) { return path.size() > 4 && path.compare(path.size() - 4, 4, ".wtw") == 0; }

@@ -4,6 +4,7 @@
 // the batches it has taken until it flushes them, and its node runs one call at a time.
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 #include "wavetrace/memory/batch_pool.hpp"
@@ -26,6 +27,17 @@ class Stage {
   virtual std::string name() const = 0;
   // Owns `batch` on entry; must emit or release it (and any batch it acquires).
   virtual void process(Batch* batch, StageOutput& out) const = 0;
+
+  // Reading ahead: a stage that takes a buffering stage's batches in their order (the
+  // pipeline's ordered hand-off) may look at the batches queued for it, up to
+  // look_ahead_batches() places past the next one it takes, on a thread of its own, while
+  // the batches before them are processed. A trace whose world is paged from disk reads
+  // their pages then, so that its own reads find them loaded. `copy_ahead` runs while the
+  // queued batch cannot change (copy what the look needs into `copy`); `look_ahead` then
+  // runs on the copy. Neither may change what the stage computes. 0: no look-ahead.
+  virtual std::size_t look_ahead_batches() const { return 0; }
+  virtual void copy_ahead(const Batch& /*upcoming*/, Batch& /*copy*/) const {}
+  virtual void look_ahead(Batch& /*copy*/) const {}
 };
 
 }  // namespace wavetrace

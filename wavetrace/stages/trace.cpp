@@ -42,6 +42,35 @@ void TraceStage::process(Batch* batch, StageOutput& out) const {
   out.emit(batch);
 }
 
+void TraceStage::copy_ahead(const Batch& upcoming, Batch& copy) const {
+  const RayBatch& from = upcoming.rays;
+  RayBatch& to = copy.rays;
+  to.count = 0;
+  for (std::size_t i = 0; i < from.count; i += kLookAheadStride) {
+    if (!(from.flags[i] & ray_flags::alive)) continue;
+    const std::size_t k = to.count++;
+    to.set_geometry(k, {from.origin_x[i], from.origin_y[i], from.origin_z[i]},
+                    {from.direction_x[i], from.direction_y[i], from.direction_z[i]}, from.tmin[i], from.tmax[i]);
+    to.kind[k] = from.kind[i];
+    to.flags[k] = ray_flags::alive;
+  }
+}
+
+void TraceStage::look_ahead(Batch& copy) const {
+  RecordingProbe probe(look_ahead_observers_, kLookAheadClient, 0);
+  const RayBatch& rays = copy.rays;
+  const auto count = static_cast<std::uint32_t>(rays.count);
+  for (std::uint32_t begin = 0, end = 0; begin < count; begin = end) {
+    end = begin + 1;
+    while (end < count && rays.kind[end] == rays.kind[begin]) ++end;
+    if (rays.kind[begin] == RayKind::shadow) {
+      accelerator_.intersect_any_probed(rays, copy.hits, {begin, end}, probe);
+    } else {
+      accelerator_.intersect_closest_probed(rays, copy.hits, {begin, end}, probe);
+    }
+  }
+}
+
 void TraceStage::trace_run(Batch& batch, RayRange range, RecordingProbe* probe) const {
   if (probe != nullptr) {
     // Observed, the run is traced in windows of consecutive rays, so the pager can count the

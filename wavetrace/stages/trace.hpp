@@ -36,14 +36,29 @@ struct TraceInstruments {
 // material from `materials`, so that shade and spawn never read the mesh.
 class TraceStage final : public Stage {
  public:
-  TraceStage(const Accelerator& accelerator, const MaterialRuns& materials, const TraceInstruments& instruments = {})
+  // `look_ahead_batches`: with a world paged from a file (an observer with a file pager),
+  // the sorted batches queued for trace that its look-ahead reads the pages of; else unused.
+  TraceStage(const Accelerator& accelerator, const MaterialRuns& materials, const TraceInstruments& instruments = {},
+             std::size_t look_ahead_batches = 0)
       : accelerator_(accelerator), materials_(materials), instruments_(instruments) {
     if (instruments_.observers != nullptr && !(instruments_.observers->any() && accelerator.probed())) {
       instruments_.observers = nullptr;
     }
+    if (instruments_.observers != nullptr && instruments_.observers->file_pager != nullptr) {
+      look_ahead_batches_ = look_ahead_batches;
+      look_ahead_observers_.file_pager = instruments_.observers->file_pager;
+    }
   }
   std::string name() const override { return "trace"; }
   void process(Batch* batch, StageOutput& out) const override;
+
+  // The look-ahead traces every kLookAheadStride-th ray of a queued batch on the copy, its
+  // hits thrown away: its reads load the pages trace will read (the sorted neighbours of a
+  // ray share its pages), counted to the pager's look-ahead client.
+  std::size_t look_ahead_batches() const override { return look_ahead_batches_; }
+  void copy_ahead(const Batch& upcoming, Batch& copy) const override;
+  void look_ahead(Batch& copy) const override;
+  static constexpr std::uint32_t kLookAheadStride = 4;
 
   // Traces `range` of `batch`, whose rays are all of one kind; the megakernel calls it
   // for one ray at a time. `probe` sees every read (null: unobserved).
@@ -59,6 +74,8 @@ class TraceStage final : public Stage {
   const Accelerator& accelerator_;
   const MaterialRuns& materials_;
   TraceInstruments instruments_;
+  std::size_t look_ahead_batches_ = 0;
+  MemoryObservers look_ahead_observers_;  // the file pager alone: no simulated pager or cache counts the look
 };
 
 }  // namespace wavetrace
