@@ -307,14 +307,13 @@ void FilePager::touch(const void* address) {
     return;
   }
   std::unique_lock lock(mutex_);
-  const std::uint64_t offset = std::uint64_t(static_cast<const std::byte*>(address) - base_);
-  if (std::string error = load(page, offset, lock); !error.empty()) throw std::runtime_error(error);
+  if (std::string error = load(page, offset_of(address), lock); !error.empty()) throw std::runtime_error(error);
 }
 
 bool FilePager::handle_fault(const void* address) noexcept {
   if (!contains(address)) return false;
   std::unique_lock lock(mutex_);
-  const std::string error = load(page_of(address), std::uint64_t(static_cast<const std::byte*>(address) - base_), lock);
+  const std::string error = load(page_of(address), offset_of(address), lock);
   if (!error.empty()) {
     // No exception can leave a signal handler, and the read that faulted cannot go on: say
     // what failed and stop as any failed command does (exit 1). Nothing is written after

@@ -1,8 +1,9 @@
 // Real out-of-core paging of a file, the reordering paper's setting (§5) made real: the
 // file's bytes appear at one fixed address range, but only `budget` bytes of them are ever
 // resident, in a pool of page slots (a memfd), filled on demand by reads that bypass the OS
-// page cache (O_DIRECT) and evicted least recently used. Pages come in two ways: a probe
-// reports a read (touch, which also keeps the LRU order exact), or traversal reads a page
+// page cache (O_DIRECT) and evicted least recently used, a few at a time (one TLB flush for
+// the group). Pages come in two ways: a probe reports a read (touch, which also keeps the
+// LRU order), or traversal reads a page
 // no probe announced, which faults (SIGSEGV on the reserved range) and is loaded by the
 // signal handler before the read is retried. Either way the bytes a reader sees are the
 // file's; an eviction racing a reader only costs that reader another fault.
@@ -123,9 +124,10 @@ class FilePager {
   std::string load(std::uint32_t page, std::uint64_t offset, std::unique_lock<std::mutex>& lock);
   // The part of the file holding byte `offset`.
   std::uint32_t part_of(std::uint64_t offset) const;
-  std::uint32_t page_of(const void* address) const {
-    return static_cast<std::uint32_t>(std::size_t(static_cast<const std::byte*>(address) - base_) >> page_shift_);
+  std::uint64_t offset_of(const void* address) const {
+    return std::uint64_t(static_cast<const std::byte*>(address) - base_);
   }
+  std::uint32_t page_of(const void* address) const { return static_cast<std::uint32_t>(offset_of(address) >> page_shift_); }
   // Evicts the `count` least recently used pages (at most kMaxEvictionGroup) in one go.
   void evict_tail_locked(std::size_t count);
   // A full pool evicts an eighth of itself, up to 8 pages, at a time: a shootdown per group,
