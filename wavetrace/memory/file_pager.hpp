@@ -3,9 +3,8 @@
 // resident, in a pool of page slots (a memfd), filled on demand by reads that bypass the OS
 // page cache (O_DIRECT) and evicted least recently used, a few at a time (one TLB flush for
 // the group). Pages come in two ways: a probe reports a read (touch, which also keeps the
-// LRU order), or traversal reads a page
-// no probe announced, which faults (SIGSEGV on the reserved range) and is loaded by the
-// signal handler before the read is retried. Either way the bytes a reader sees are the
+// LRU order), or traversal reads a page no probe announced, which faults (SIGSEGV on the
+// reserved range) and is loaded by the signal handler before the read is retried. Either way the bytes a reader sees are the
 // file's; an eviction racing a reader only costs that reader another fault.
 #pragma once
 

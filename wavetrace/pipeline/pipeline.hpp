@@ -94,8 +94,8 @@ class OrderedHandOff {
 
   // For the next stage's look-ahead (Stage::look_ahead_batches): waits for the oldest batch
   // this reader has not seen among the first `depth` in the queue (the next to be popped is
-  // the first), hands it to `copy` (under the lock: a queued batch is no one's to change) and returns
-  // true; returns false once closed.
+  // the first), hands it to `copy` under the lock (a queued batch is no one's to change) and
+  // returns true; returns false once closed.
   bool next_ahead(std::size_t depth, const std::function<void(const Batch&)>& copy);
   void close();  // the graph is done: a waiting reader returns
 

@@ -29,9 +29,8 @@ class Stage {
   virtual void process(Batch* batch, StageOutput& out) const = 0;
 
   // Reading ahead: a stage that takes a buffering stage's batches in their order (the
-  // pipeline's ordered hand-off) may look at the batches queued for it, up to
-  // look_ahead_batches() places past the next one it takes, on a thread of its own, while
-  // the batches before them are processed. A trace whose world is paged from disk reads
+  // pipeline's ordered hand-off) may look at the first look_ahead_batches() batches queued
+  // for it, on a thread of its own, while the batches before them are processed. A trace whose world is paged from disk reads
   // their pages then, so that its own reads find them loaded. `copy_ahead` runs while the
   // queued batch cannot change (copy what the look needs into `copy`); `look_ahead` then
   // runs on the copy. Neither may change what the stage computes. 0: no look-ahead.
