@@ -12,33 +12,41 @@
 
 namespace wavetrace {
 
+namespace {
+
+// Calls visit(kind, range) for each run of consecutive rays of one kind, in order.
+template <typename Visit>
+void for_each_run_of_one_kind(const RayBatch& rays, Visit&& visit) {
+  const auto count = static_cast<std::uint32_t>(rays.count);
+  for (std::uint32_t begin = 0, end = 0; begin < count; begin = end) {
+    end = begin + 1;
+    while (end < count && rays.kind[end] == rays.kind[begin]) ++end;
+    visit(rays.kind[begin], RayRange{begin, end});
+  }
+}
+
+}  // namespace
+
 void TraceStage::process(Batch* batch, StageOutput& out) const {
-  const RayBatch& rays = batch->rays;
   std::optional<RecordingProbe> probe;
   if (instruments_.observers != nullptr) {
     probe.emplace(*instruments_.observers, std::size_t(ObservedStage::trace),
                   std::size_t(tbb::this_task_arena::current_thread_index()));
     probe->count_ray_windows();
   }
-  std::uint32_t begin = 0;
-  const auto count = static_cast<std::uint32_t>(rays.count);
-  while (begin < count) {
-    const RayKind kind = rays.kind[begin];
-    std::uint32_t end = begin + 1;
-    while (end < count && rays.kind[end] == kind) ++end;
+  for_each_run_of_one_kind(batch->rays, [&](RayKind kind, RayRange run) {
     if (instruments_.times == nullptr) {
-      trace_run(*batch, {begin, end}, probe ? &*probe : nullptr);
-    } else {
-      const auto start = std::chrono::steady_clock::now();
-      trace_run(*batch, {begin, end}, probe ? &*probe : nullptr);
-      const auto nanoseconds = static_cast<std::uint64_t>(
-          std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count());
-      const bool shadow = kind == RayKind::shadow;
-      (shadow ? instruments_.times->any_rays : instruments_.times->closest_rays).fetch_add(end - begin);
-      (shadow ? instruments_.times->any_nanoseconds : instruments_.times->closest_nanoseconds).fetch_add(nanoseconds);
+      trace_run(*batch, run, probe ? &*probe : nullptr);
+      return;
     }
-    begin = end;
-  }
+    const auto start = std::chrono::steady_clock::now();
+    trace_run(*batch, run, probe ? &*probe : nullptr);
+    const auto nanoseconds = static_cast<std::uint64_t>(
+        std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count());
+    const bool shadow = kind == RayKind::shadow;
+    (shadow ? instruments_.times->any_rays : instruments_.times->closest_rays).fetch_add(run.size());
+    (shadow ? instruments_.times->any_nanoseconds : instruments_.times->closest_nanoseconds).fetch_add(nanoseconds);
+  });
   out.emit(batch);
 }
 
@@ -58,17 +66,13 @@ void TraceStage::copy_ahead(const Batch& upcoming, Batch& copy) const {
 
 void TraceStage::look_ahead(Batch& copy) const {
   RecordingProbe probe(look_ahead_observers_, kLookAheadClient, 0);
-  const RayBatch& rays = copy.rays;
-  const auto count = static_cast<std::uint32_t>(rays.count);
-  for (std::uint32_t begin = 0, end = 0; begin < count; begin = end) {
-    end = begin + 1;
-    while (end < count && rays.kind[end] == rays.kind[begin]) ++end;
-    if (rays.kind[begin] == RayKind::shadow) {
-      accelerator_.intersect_any_probed(rays, copy.hits, {begin, end}, probe);
+  for_each_run_of_one_kind(copy.rays, [&](RayKind kind, RayRange run) {
+    if (kind == RayKind::shadow) {
+      accelerator_.intersect_any_probed(copy.rays, copy.hits, run, probe);
     } else {
-      accelerator_.intersect_closest_probed(rays, copy.hits, {begin, end}, probe);
+      accelerator_.intersect_closest_probed(copy.rays, copy.hits, run, probe);
     }
-  }
+  });
 }
 
 void TraceStage::trace_run(Batch& batch, RayRange range, RecordingProbe* probe) const {
