@@ -4,8 +4,9 @@
 // page cache (O_DIRECT) and evicted least recently used, a few at a time (one TLB flush for
 // the group). Pages come in two ways: a probe reports a read (touch, which also keeps the
 // LRU order), or traversal reads a page no probe announced, which faults (SIGSEGV on the
-// reserved range) and is loaded by the signal handler before the read is retried. Either way the bytes a reader sees are the
-// file's; an eviction racing a reader only costs that reader another fault.
+// reserved range) and is loaded by the signal handler before the read is retried. Either
+// way the bytes a reader sees are the file's; an eviction racing a reader only costs that
+// reader another fault.
 #pragma once
 
 #include <cstddef>
@@ -126,7 +127,9 @@ class FilePager {
   std::uint64_t offset_of(const void* address) const {
     return std::uint64_t(static_cast<const std::byte*>(address) - base_);
   }
-  std::uint32_t page_of(const void* address) const { return static_cast<std::uint32_t>(offset_of(address) >> page_shift_); }
+  std::uint32_t page_of(const void* address) const {
+    return static_cast<std::uint32_t>(offset_of(address) >> page_shift_);
+  }
   // Evicts the `count` least recently used pages (at most kMaxEvictionGroup) in one go.
   void evict_tail_locked(std::size_t count);
   // A full pool evicts an eighth of itself, up to 8 pages, at a time: a shootdown per group,
@@ -181,7 +184,8 @@ class FilePager {
   int self_pidfd_ = -1;  // this process, for process_madvise; -1 once the kernel refused it
   std::vector<DiskCounters> clients_;
   std::size_t prefetch_client_ = ~std::size_t{0};
-  std::unique_ptr<std::atomic<std::uint8_t>[]> prefetched_;  // per page: loaded by the prefetcher, not yet read by another
+  // Per page: loaded by the prefetcher and not yet read by another client.
+  std::unique_ptr<std::atomic<std::uint8_t>[]> prefetched_;
   std::atomic<std::uint64_t> prefetch_hits_{0};
   std::vector<std::string> part_names_ = {"other"};
   std::vector<FilePart> parts_;                  // sorted by offset
