@@ -9,10 +9,12 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "wavetrace/accel/chunked/chunked_accelerator.hpp"
 #include "wavetrace/accel/registry.hpp"
 #include "app/command_options.hpp"
 #include "app/commands.hpp"
 #include "wavetrace/memory/process_memory.hpp"
+#include "wavetrace/memory/section_writer.hpp"
 #include "wavetrace/scene/lights.hpp"
 #include "wavetrace/setup/accelerator_spec.hpp"
 #include "wavetrace/setup/render_setup.hpp"
@@ -36,6 +38,19 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+// Before a build of hours stops for want of disk at its end: the structure's size by its
+// type's measured bytes per triangle (registry.cpp) against the free space where it goes.
+void check_world_file_space(const std::string& out, double estimated_bytes) {
+  const std::filesystem::path directory = std::filesystem::absolute(out).parent_path();
+  std::error_code error;
+  const std::filesystem::space_info space = std::filesystem::space(directory, error);
+  if (error) throw ConfigError(fmt::format("--out {}: {}: {}", out, directory.string(), error.message()));
+  if (estimated_bytes > double(space.available)) {
+    throw ConfigError(fmt::format("--out {}: the world needs about {:.2f} GB and {} has {:.2f} GB free", out,
+                                  estimated_bytes * 1e-9, directory.string(), double(space.available) * 1e-9));
+  }
+}
+
 int run_build(const BuildArguments& args) {
   Config config;
   if (!args.config_file.empty()) config.load_file(args.config_file);
@@ -47,21 +62,31 @@ int run_build(const BuildArguments& args) {
   RenderPlan plan = plan_render(config);
   if (is_world_file(plan.scene.source)) throw ConfigError(fmt::format("{} is already a world", plan.scene.source));
   const bool with_proxy = args.proxy || plan.needs_proxy();
+  // A world that builds in chunks is written chunk by chunk as it is built and never held
+  // whole, so that it may be larger than memory; not with a proxy, whose quality is measured
+  // by tracing the built world (and which is simplified from the whole mesh in memory).
+  const auto streams_to_file = [&](const std::string& type) {
+    return !with_proxy && saves_structure(type) && builds_in_chunks(type);
+  };
 
   // As render does: an accelerator holding its own geometry is built from a streamed scene
   // (never whole) unless the proxy, simplified from the whole mesh, is wanted.
   const auto load_start = std::chrono::steady_clock::now();
-  SceneForWorld loaded = load_scene_for_world(plan, with_proxy);
+  SceneForWorld loaded = load_scene_for_world(plan, with_proxy, streams_to_file(plan.accelerator.type));
   Scene& scene = loaded.scene;
   plan.accelerator = loaded.accelerator.options;
   const std::string& type = plan.accelerator.type;
+  check_world_file_space(args.out, double(scene.triangle_count) * estimated_bytes_per_triangle(plan.accelerator));
   if (const std::string line = resolution_summary(loaded.accelerator); !line.empty()) fmt::print("{}\n", line);
   // The world records what was built, not what chose it.
   record_built_accelerator(config, plan);
   WorldBuildInfo info;
   info.scene_seconds = seconds_since(load_start);
   const auto build_start = std::chrono::steady_clock::now();
-  const std::unique_ptr<Accelerator> accelerator = build_world_accelerator(scene, plan.accelerator);
+  SectionWriter out(args.out);
+  const ChunkStream stream{out, kWorldAcceleratorPrefix};
+  const std::unique_ptr<Accelerator> accelerator =
+      build_world_accelerator(scene, plan.accelerator, streams_to_file(type) ? &stream : nullptr);
   const LightSampler lights = represented_lights(scene, *accelerator);
   std::unique_ptr<Proxy> proxy;
   if (with_proxy) proxy = std::make_unique<Proxy>(scene.mesh, plan.proxy, *accelerator);
@@ -72,14 +97,17 @@ int run_build(const BuildArguments& args) {
 
   const auto save_start = std::chrono::steady_clock::now();
   info.peak_rss_bytes = read_resident_memory().peak_bytes;
-  save_world(args.out, scene, lights, *accelerator, type, proxy.get(), config, info);
+  save_world(out, scene, lights, *accelerator, type, proxy.get(), config, info);
   const double save_seconds = seconds_since(save_start);
   const std::uintmax_t file_bytes = std::filesystem::file_size(args.out);
   const std::size_t peak = read_resident_memory().peak_bytes;
 
   const double triangles = double(std::max<std::size_t>(scene.triangle_count, 1));
   fmt::print("{}: {} triangles; {} ({})\n", scene.name, scene.triangle_count, type,
-             saves_structure(type) ? "saved in place" : "rebuilt from the saved geometry when loaded");
+             !saves_structure(type)                ? "rebuilt from the saved geometry when loaded"
+             : streams_to_file(type) && scene.triangle_count > plan.accelerator.chunk_triangles
+                 ? "saved in place, each chunk as it was built"
+                 : "saved in place");
   fmt::print("scene {:.2f} s, build {:.2f} s, save {:.2f} s; peak resident {:.2f} GB\n", info.scene_seconds,
              info.build_seconds, save_seconds, double(peak) * 1e-9);
   fmt::print("wrote {}: {:.3f} GB, {:.2f} bytes/triangle (in memory: {:.2f}){}\n", args.out, double(file_bytes) * 1e-9,

@@ -269,6 +269,59 @@ TEST(WorldFile, TracesLookAheadReadsPagesAheadAndChangesNoPixel) {
   fs::remove(path);
 }
 
+// A chunked world written chunk by chunk as it is built (ChunkStream) holds the same
+// sections as one saved after its build, all but the build's own timings and peaks, and
+// renders the fresh build's image; built so, it refuses to trace (its chunks are freed).
+class StreamedWorld : public ::testing::TestWithParam<std::vector<std::string>> {};
+
+TEST_P(StreamedWorld, IsTheSameFileSectionBySectionAndRendersTheFreshImage) {
+  const std::string saved_after = temp_path("saved_after.wtw"), streamed = temp_path("streamed.wtw");
+  const std::vector<float> fresh = build_and_save(GetParam(), saved_after);
+  const Config config = small_render(GetParam());
+  const RenderPlan plan = plan_render(config);
+  const Scene& scene = room();
+  const LightSampler lights(scene);
+  {
+    SectionWriter out(streamed);
+    const ChunkStream stream{out, kWorldAcceleratorPrefix};
+    const auto accelerator = build_world_accelerator(scene, plan.accelerator, &stream);
+    RayBatch rays(8);
+    HitBatch hits(8);
+    EXPECT_THROW(accelerator->intersect_closest(rays, hits, RayRange{0, 8}), std::logic_error);
+    // Chunk 0 stays (represented_point, build notes); the others went to the file.
+    const auto built_in_memory = build_world_accelerator(scene, plan.accelerator);
+    EXPECT_EQ(accelerator->memory().total(), built_in_memory->memory().total());
+    EXPECT_LT(accelerator->memory_spans().size() * 2, built_in_memory->memory_spans().size());
+    SectionWriter elsewhere(temp_path("elsewhere.wtw"));
+    EXPECT_THROW(accelerator->save(elsewhere, kWorldAcceleratorPrefix), std::logic_error);
+    save_world(out, scene, lights, *accelerator, plan.accelerator.type, nullptr, config, {});
+  }
+  const auto a = SectionFile::open(saved_after), b = SectionFile::open(streamed);
+  ASSERT_EQ(a->sections().size(), b->sections().size());
+  std::size_t chunk_sections = 0;
+  for (std::size_t s = 0; s < a->sections().size(); ++s) {
+    const std::string& name = a->sections()[s].name;
+    ASSERT_EQ(name, b->sections()[s].name);
+    // The build's seconds and peaks (raystrips' statistics hold its stages' seconds).
+    if (name.ends_with("common") || name.ends_with("raystrips.state") || name == "build.notes") continue;
+    const auto left = a->bytes(name), right = b->bytes(name);
+    EXPECT_TRUE(std::ranges::equal(left, right)) << name;
+    chunk_sections += name.starts_with("accel/chunk.");
+  }
+  EXPECT_GT(chunk_sections, 10u);
+  EXPECT_TRUE(render_loaded(GetParam(), streamed) == fresh);
+  EXPECT_FALSE(fs::exists(temp_path("elsewhere.wtw")));  // never finished: removed
+  fs::remove(saved_after);
+  fs::remove(streamed);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    ChunkedAccelerators, StreamedWorld,
+    ::testing::Values(std::vector<std::string>{"accel.type=hmq", "build.chunk_triangles=4096"},
+                      std::vector<std::string>{"accel.type=hmq", "accel.hmq.width=8", "build.chunk_triangles=4096"},
+                      std::vector<std::string>{"accel.type=raystrips", "build.chunk_triangles=4096"},
+                      std::vector<std::string>{"accel.type=bvh", "build.chunk_triangles=4096"}));
+
 TEST(WorldFile, SavedProxyOrdersRaysAsTheFreshOneDoes) {
   const std::string path = temp_path("proxy.wtw");
   const std::vector<std::string> settings = {"accel.type=hmq", "reorder.heuristic=hph"};
@@ -497,6 +550,12 @@ TEST(WorldFileCli, BuildRenderAndInfo) {
                                                 "--set memory.budget=10% --out " + temp_path("y.exr"));
   EXPECT_EQ(not_world.exit_code, 1);
   EXPECT_NE(not_world.output.find("is not one"), std::string::npos) << not_world.output;
+  const auto chunked = testing::run_wavetrace("build builtin:room:20k --accel hmq --set build.chunk_triangles=4096 --out " +
+                                              world);
+  ASSERT_EQ(chunked.exit_code, 0) << chunked.output;
+  EXPECT_NE(chunked.output.find("saved in place, each chunk as it was built"), std::string::npos) << chunked.output;
+  const auto chunked_render = testing::run_wavetrace("render " + world + " --size 32x24 --out " + temp_path("c.exr"));
+  EXPECT_EQ(chunked_render.exit_code, 0) << chunked_render.output;
   // A pool smaller than one page could hold nothing: refused, not rounded up.
   const auto built_again = testing::run_wavetrace("build builtin:room:20k --accel hmq --out " + world);
   ASSERT_EQ(built_again.exit_code, 0) << built_again.output;

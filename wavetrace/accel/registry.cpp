@@ -135,7 +135,7 @@ double estimated_bytes_per_triangle(const AcceleratorOptions& options) {
 double estimated_build_bytes_per_triangle(std::string_view type) { return accelerator_type(type).build_bytes_per_triangle; }
 
 std::unique_ptr<Accelerator> make_world_accelerator(const TriangleSource& source, const TriangleMesh* whole,
-                                                    const AcceleratorOptions& options) {
+                                                    const AcceleratorOptions& options, const ChunkStream* stream) {
   checked_uint32(source.triangle_count(), "triangles of a scene, which hits name by 32-bit ids");
   const AcceleratorType& type = accelerator_type(options.type);
   AcceleratorOptions chunk_options = options;
@@ -143,7 +143,7 @@ std::unique_ptr<Accelerator> make_world_accelerator(const TriangleSource& source
   if (type.builds_in_chunks && source.triangle_count() > options.chunk_triangles) {
     return make_chunked_accelerator(
         source, options.chunk_triangles,
-        [&](const TriangleMesh& chunk) { return type.make(chunk, chunk_options); }, !type.holds_own_geometry);
+        [&](const TriangleMesh& chunk) { return type.make(chunk, chunk_options); }, !type.holds_own_geometry, stream);
   }
   if (whole != nullptr) return type.make(*whole, chunk_options);
   if (!type.holds_own_geometry) {

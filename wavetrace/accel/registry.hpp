@@ -10,6 +10,7 @@
 
 #include "wavetrace/accel/accelerator.hpp"
 #include "wavetrace/accel/bvh/bvh_accelerator.hpp"
+#include "wavetrace/accel/chunked/chunked_accelerator.hpp"
 #include "wavetrace/accel/embree/embree_accelerator.hpp"
 #include "wavetrace/accel/grid/array_grid.hpp"
 #include "wavetrace/accel/grid/hashed_grid.hpp"
@@ -103,8 +104,10 @@ double estimated_build_bytes_per_triangle(std::string_view type);
 // The world's accelerator over a scene's triangles: chunked (make_chunked_accelerator) when
 // the type builds in chunks and the source has more than options.chunk_triangles, else one
 // build over `whole` (a mesh the caller keeps alive), or over the source extracted whole
-// when `whole` is null.
+// when `whole` is null. A chunked world saves each chunk to `stream` as it is built
+// (ChunkStream); a world built whole ignores it.
 std::unique_ptr<Accelerator> make_world_accelerator(const TriangleSource& source, const TriangleMesh* whole,
-                                                    const AcceleratorOptions& options);
+                                                    const AcceleratorOptions& options,
+                                                    const ChunkStream* stream = nullptr);
 
 }  // namespace wavetrace

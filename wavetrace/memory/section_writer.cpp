@@ -33,7 +33,9 @@ SectionWriter::SectionWriter(std::string path) : path_(std::move(path)) {
 }
 
 SectionWriter::~SectionWriter() {
-  if (fd_ >= 0) ::close(fd_);
+  if (fd_ < 0) return;
+  ::close(fd_);
+  ::unlink(path_.c_str());
 }
 
 void SectionWriter::write_at(std::uint64_t offset, const void* data, std::size_t bytes) {
@@ -53,9 +55,7 @@ void SectionWriter::add(std::string_view name, std::span<const std::byte> bytes,
   if (name.empty() || name.size() >= kNameBytes) {
     throw std::invalid_argument(fmt::format("section name '{}': must be 1 to {} bytes", name, kNameBytes - 1));
   }
-  for (const TableEntry& entry : table_) {
-    if (name == entry.name) throw std::invalid_argument(fmt::format("section '{}' added twice", name));
-  }
+  if (!names_.emplace(name).second) throw std::invalid_argument(fmt::format("section '{}' added twice", name));
   TableEntry entry{};
   std::memcpy(entry.name, name.data(), name.size());
   entry.offset = position_;

@@ -1,6 +1,9 @@
 // Writes a section file (section_file_format.hpp) front to back: each section's bytes go
 // to the file as they are added, with their checksum, so a saved world never needs a
-// second copy of itself in memory; the table and header are written by finish().
+// second copy of itself in memory (a chunked world is written chunk by chunk while it is
+// built, ChunkStream); the table and header are written by finish(). A writer destroyed
+// before finish() (an error during the build or save) removes its file: a world of tens of
+// gigabytes left half written would only fill the disk.
 #pragma once
 
 #include <cstddef>
@@ -9,6 +12,7 @@
 #include <string>
 #include <string_view>
 #include <type_traits>
+#include <unordered_set>
 #include <vector>
 
 #include "wavetrace/memory/section_file_format.hpp"
@@ -24,6 +28,7 @@ class SectionWriter {
   SectionWriter& operator=(const SectionWriter&) = delete;
 
   // Adds a section; names are unique and at most 63 bytes (std::invalid_argument otherwise).
+  // Any order: the table is sorted by name when finished.
   void add(std::string_view name, std::span<const std::byte> bytes, std::uint32_t element_bytes = 1);
   template <typename T>
   void add_array(std::string_view name, std::span<const T> items) {
@@ -46,6 +51,7 @@ class SectionWriter {
   int fd_ = -1;
   std::uint64_t position_ = 0;
   std::vector<section_file::TableEntry> table_;
+  std::unordered_set<std::string> names_;  // a world of 3G triangles has over 4,000 sections
 };
 
 }  // namespace wavetrace

@@ -105,6 +105,11 @@ bool is_world_file(const std::string& path) { return path.size() > 4 && path.com
 void save_world(const std::string& path, const Scene& scene, const LightSampler& lights, const Accelerator& accelerator,
                 const std::string& type, const Proxy* proxy, const Config& settings, const WorldBuildInfo& info) {
   SectionWriter out(path);
+  save_world(out, scene, lights, accelerator, type, proxy, settings, info);
+}
+
+void save_world(SectionWriter& out, const Scene& scene, const LightSampler& lights, const Accelerator& accelerator,
+                const std::string& type, const Proxy* proxy, const Config& settings, const WorldBuildInfo& info) {
   out.add_value("world.kind", saved_kind("world", kWorldFileVersion));
   out.add("scene.name", text_bytes(scene.name));
   SavedSceneInfo scene_info{};
@@ -137,12 +142,12 @@ void save_world(const std::string& path, const Scene& scene, const LightSampler&
   out.add_value("build.info", info);
 
   if (saves_structure(type)) {
-    accelerator.save(out, "accel/");
+    accelerator.save(out, kWorldAcceleratorPrefix);
   } else {
     if (scene.mesh.triangles.empty()) {
       throw std::logic_error(fmt::format("saving a '{}' world needs the scene's mesh, which is rebuilt from", type));
     }
-    out.add_value("accel/kind", saved_kind(type, 0));
+    out.add_value(std::string(kWorldAcceleratorPrefix) + "kind", saved_kind(type, 0));
     add_mesh(out, "geometry.", scene.mesh);
     out.add_array("geometry.materials", std::span<const std::uint32_t>(scene.mesh.material_of_triangle));
   }
@@ -206,11 +211,11 @@ std::unique_ptr<LoadedWorld> load_world(const std::string& path, const std::opti
   world.build = file.value<WorldBuildInfo>("build.info");
 
   if (saves_structure(world.type)) {
-    SectionLoader accel(world.file, "accel/");
+    SectionLoader accel(world.file, kWorldAcceleratorPrefix);
     world.accelerator = load_accelerator(accel);
   } else {
     // Embree and the grids cannot be written: rebuilt, with the settings they were built with.
-    SectionLoader accel(world.file, "accel/");
+    SectionLoader accel(world.file, kWorldAcceleratorPrefix);
     accel.expect_kind(world.type, 0);
     scene.mesh = read_mesh(file, "geometry.");
     const auto material_of_triangle = file.array<std::uint32_t>("geometry.materials");

@@ -30,6 +30,7 @@
 #include "wavetrace/accel/accelerator.hpp"
 #include "wavetrace/accel/proxy/proxy.hpp"
 #include "wavetrace/memory/section_file.hpp"
+#include "wavetrace/memory/section_writer.hpp"
 #include "wavetrace/scene/lights.hpp"
 #include "wavetrace/scene/scene.hpp"
 #include "wavetrace/setup/config.hpp"
@@ -51,6 +52,12 @@ struct WorldBuildInfo {
 // saved in place when its type saves_structure, else the scene's mesh (which must then be
 // present) is saved for a rebuild at load. Throws std::runtime_error naming the file.
 void save_world(const std::string& path, const Scene& scene, const LightSampler& lights, const Accelerator& accelerator,
+                const std::string& type, const Proxy* proxy, const Config& settings, const WorldBuildInfo& info);
+// The same into a writer opened before the build, which may hold the accelerator's chunks
+// already (ChunkStream under "accel/", the prefix the world's accelerator is saved under);
+// finishes it.
+inline constexpr const char* kWorldAcceleratorPrefix = "accel/";
+void save_world(SectionWriter& out, const Scene& scene, const LightSampler& lights, const Accelerator& accelerator,
                 const std::string& type, const Proxy* proxy, const Config& settings, const WorldBuildInfo& info);
 
 // Held by pointer: a rebuilt Embree refers to `scene.mesh` where it lies.

@@ -11,13 +11,14 @@
 
 namespace wavetrace {
 
-std::unique_ptr<Accelerator> build_world_accelerator(const Scene& scene, const AcceleratorOptions& options) {
-  if (scene.streamed()) return make_world_accelerator(*scene.stream, nullptr, options);
+std::unique_ptr<Accelerator> build_world_accelerator(const Scene& scene, const AcceleratorOptions& options,
+                                                    const ChunkStream* stream) {
+  if (scene.streamed()) return make_world_accelerator(*scene.stream, nullptr, options, stream);
   const MeshTriangleSource source(scene.mesh);
-  return make_world_accelerator(source, &scene.mesh, options);
+  return make_world_accelerator(source, &scene.mesh, options, stream);
 }
 
-void check_scene_fits(const RenderPlan& plan) {
+void check_scene_fits(const RenderPlan& plan, bool structure_to_file) {
   const std::string& source = plan.scene.source;
   // accel.type = auto chooses by its own budget.
   if (!is_builtin_scene(source) || plan.scene.subdivide > 0 || plan.accel_goal.automatic) return;
@@ -31,11 +32,11 @@ void check_scene_fits(const RenderPlan& plan) {
   // temporaries, bounded by a chunk where the type builds in chunks.
   const double structure = estimated_bytes_per_triangle(plan.accelerator);
   const double mesh = plan.scene.streamed ? 0.0 : kWholeMeshBytesPerTriangle;
-  const double build_triangles = builds_in_chunks(plan.accelerator.type)
-                                     ? std::min(triangles, double(plan.accelerator.chunk_triangles))
-                                     : triangles;
-  const double needed =
-      triangles * (structure + mesh) + build_triangles * estimated_build_bytes_per_triangle(plan.accelerator.type);
+  const bool chunked = builds_in_chunks(plan.accelerator.type);
+  const double build_triangles = chunked ? std::min(triangles, double(plan.accelerator.chunk_triangles)) : triangles;
+  const double held_triangles = chunked && structure_to_file ? build_triangles : triangles;
+  const double needed = held_triangles * structure + triangles * mesh +
+                        build_triangles * estimated_build_bytes_per_triangle(plan.accelerator.type);
   if (needed > double(available)) {
     throw SceneError(fmt::format(
         "{}: about {:.1f} GB needed to build '{}' ({:.0f} bytes/triangle{} plus build temporaries) but {:.1f} GB "
@@ -45,12 +46,12 @@ void check_scene_fits(const RenderPlan& plan) {
   }
 }
 
-SceneForWorld load_scene_for_world(const RenderPlan& plan, bool keep_mesh) {
+SceneForWorld load_scene_for_world(const RenderPlan& plan, bool keep_mesh, bool structure_to_file) {
   SceneRequest request = plan.scene;
   request.streamed = (plan.accel_goal.automatic || holds_own_geometry(plan.accelerator.type)) && !keep_mesh;
   RenderPlan checked = plan;
   checked.scene = request;
-  check_scene_fits(checked);
+  check_scene_fits(checked, structure_to_file);
   Scene scene = load_scene(request);
   const Camera camera = resolve_camera(plan.camera, scene);
   const MeshTriangleSource whole(scene.mesh);

@@ -34,7 +34,8 @@ struct Chunk {
   std::size_t count = 0;
   Bounds3 bounds;
   std::unique_ptr<const TriangleMesh> mesh;  // kept only when the sub-accelerator reads it
-  std::unique_ptr<Accelerator> accelerator;
+  std::unique_ptr<Accelerator> accelerator;  // null once streamed to a file (ChunkStream)
+  MemoryReport memory;                       // the sub-accelerator's, kept when it is freed
 };
 
 // A chunk a ray enters, and where.
@@ -101,11 +102,15 @@ class ChunkedAccelerator final : public Accelerator {
     chunks_.resize(saved.size());
     for (std::size_t c = 0; c < saved.size(); ++c) {
       SectionLoader chunk_in(in.file(), in.prefix() + fmt::format("chunk.{}/", c));
-      chunks_[c] = Chunk{saved[c].first, saved[c].count, saved[c].bounds, nullptr, load_chunk(chunk_in)};
+      chunks_[c] = Chunk{saved[c].first, saved[c].count, saved[c].bounds, nullptr, load_chunk(chunk_in), {}};
+      chunks_[c].memory = chunks_[c].accelerator->memory();
     }
   }
 
   void save(SectionWriter& out, const std::string& prefix) const override {
+    if (streamed_to_ != nullptr && (streamed_to_ != &out || streamed_prefix_ != prefix)) {
+      throw std::logic_error("a world streamed to a file while it was built is saved to that file only");
+    }
     out.add_value(prefix + "kind", saved_kind(kChunkedKind, kChunkedSavedVersion));
     LargeArray<SavedChunk> saved;
     for (const Chunk& chunk : chunks_) saved.push_back({chunk.first, chunk.count, chunk.bounds});
@@ -114,13 +119,14 @@ class ChunkedAccelerator final : public Accelerator {
     saver.array("chunked.top", top_);
     std::size_t triangles = this->triangles();
     archive_common_state(saver, triangles, build_);
+    if (streamed_to_ != nullptr) return;  // the chunks are in the file already
     for (std::size_t c = 0; c < chunks_.size(); ++c) {
       chunks_[c].accelerator->save(out, prefix + fmt::format("chunk.{}/", c));
     }
   }
 
   ChunkedAccelerator(const TriangleSource& source, std::size_t chunk_triangles, const ChunkBuilder& build_chunk,
-                     bool keeps_mesh) {
+                     bool keeps_mesh, const ChunkStream* stream) {
     if (chunk_triangles < kMinChunkTriangles || chunk_triangles > kMaxChunkTriangles) {
       throw std::invalid_argument(fmt::format("build.chunk_triangles = {}: must be in [{}, {}]", chunk_triangles,
                                               kMinChunkTriangles, kMaxChunkTriangles));
@@ -142,7 +148,7 @@ class ChunkedAccelerator final : public Accelerator {
       }
       tbb::parallel_for(wave_begin, wave_end, [&](std::size_t c) {
         const TriangleMesh& mesh = *meshes[c - wave_begin];
-        chunks_[c] = Chunk{ranges[c].first, ranges[c].count, mesh.bounds(), nullptr, build_chunk(mesh)};
+        chunks_[c] = Chunk{ranges[c].first, ranges[c].count, mesh.bounds(), nullptr, build_chunk(mesh), {}};
       });
       // The wave's builds held their meshes, their temporaries and every chunk finished before.
       std::size_t wave_bytes = 0;
@@ -151,10 +157,20 @@ class ChunkedAccelerator final : public Accelerator {
       }
       build_.peak_bytes = std::max(build_.peak_bytes, finished_bytes + wave_bytes);
       for (std::size_t c = wave_begin; c < wave_end; ++c) {
-        finished_bytes += chunks_[c].accelerator->memory().total();
+        Chunk& chunk = chunks_[c];
+        chunk.memory = chunk.accelerator->memory();
+        if (stream != nullptr) {
+          // Written in chunk order, so a chunk's sections lie together in the file.
+          chunk.accelerator->save(stream->out, stream->prefix + fmt::format("chunk.{}/", c));
+          if (c != 0) {
+            chunk.accelerator.reset();
+            continue;
+          }
+        }
+        finished_bytes += chunk.memory.total();
         if (keeps_mesh) {
-          chunks_[c].mesh = std::move(meshes[c - wave_begin]);
-          finished_bytes += chunks_[c].mesh->bytes();
+          chunk.mesh = std::move(meshes[c - wave_begin]);
+          finished_bytes += chunk.mesh->bytes();
         }
       }
       // The wave's meshes and temporaries go back to the OS before the next wave: glibc keeps
@@ -165,6 +181,10 @@ class ChunkedAccelerator final : public Accelerator {
       meshes.clear();
       malloc_trim(0);
       wave_begin = wave_end;
+    }
+    if (stream != nullptr) {
+      streamed_to_ = &stream->out;
+      streamed_prefix_ = stream->prefix;
     }
     build_top();
     build_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -208,7 +228,7 @@ class ChunkedAccelerator final : public Accelerator {
     report.hierarchy = top_.size() * sizeof(BvhNode);
     report.other = chunks_.size() * sizeof(Chunk);
     for (const Chunk& chunk : chunks_) {
-      const MemoryReport part = chunk.accelerator->memory();
+      const MemoryReport& part = chunk.memory;
       report.hierarchy += part.hierarchy;
       report.geometry += part.geometry;
       report.other += part.other;
@@ -234,6 +254,7 @@ class ChunkedAccelerator final : public Accelerator {
 
   std::optional<TriangleMesh> represented_mesh(const TriangleMesh& source) const override {
     if (source.triangle_count() != triangles()) throw std::invalid_argument("represented_mesh: not the mesh of this world");
+    if (streamed_to_ != nullptr) throw std::logic_error(kStreamedIsNotTraced);
     TriangleMesh result = source;
     bool moved = false;
     const MeshTriangleSource ranges(source);
@@ -255,6 +276,7 @@ class ChunkedAccelerator final : public Accelerator {
   std::vector<std::span<const std::byte>> memory_spans() const override {
     std::vector<std::span<const std::byte>> spans = {top_.bytes()};
     for (const Chunk& chunk : chunks_) {
+      if (!chunk.accelerator) continue;  // streamed to a file
       for (const auto& span : chunk.accelerator->memory_spans()) spans.push_back(span);
     }
     return spans;
@@ -303,6 +325,7 @@ class ChunkedAccelerator final : public Accelerator {
 
   template <bool kAnyHit, typename Probe, typename Query>
   void trace(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe, Query&& query) const {
+    if (streamed_to_ != nullptr) throw std::logic_error(kStreamedIsNotTraced);
     thread_local RoundScratch scratch;
     const std::uint32_t n = range.size();
     if (n == 0) return;
@@ -380,9 +403,14 @@ class ChunkedAccelerator final : public Accelerator {
     }
   }
 
+  static constexpr const char* kStreamedIsNotTraced =
+      "a world streamed to a file while it was built is for saving: load the file to trace it";
+
   std::vector<Chunk> chunks_;
   StoredArray<BvhNode> top_;
   BuildReport build_;
+  const SectionWriter* streamed_to_ = nullptr;  // set when every chunk went to this writer as it was built
+  std::string streamed_prefix_;
 };
 
 }  // namespace
@@ -408,8 +436,9 @@ std::unique_ptr<Accelerator> load_chunked_accelerator(SectionLoader& in, const C
 }
 
 std::unique_ptr<Accelerator> make_chunked_accelerator(const TriangleSource& source, std::size_t chunk_triangles,
-                                                      const ChunkBuilder& build_chunk, bool keeps_mesh) {
-  return std::make_unique<ChunkedAccelerator>(source, chunk_triangles, build_chunk, keeps_mesh);
+                                                      const ChunkBuilder& build_chunk, bool keeps_mesh,
+                                                      const ChunkStream* stream) {
+  return std::make_unique<ChunkedAccelerator>(source, chunk_triangles, build_chunk, keeps_mesh, stream);
 }
 
 }  // namespace wavetrace

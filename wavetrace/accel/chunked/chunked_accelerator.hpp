@@ -10,6 +10,7 @@
 #include <functional>
 #include <memory>
 #include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -37,12 +38,25 @@ std::vector<ChunkRange> plan_chunks(std::span<const std::size_t> object_starts, 
 // Builds a chunk's sub-accelerator from the chunk's own mesh (triangles numbered from 0).
 using ChunkBuilder = std::function<std::unique_ptr<Accelerator>(const TriangleMesh&)>;
 
+class SectionWriter;
+
+// Where a build saves its chunks as they are built, so that a world larger than memory is
+// never held whole: each chunk's sections go to `out` under `prefix` + "chunk.N/" once its
+// wave is built, and the chunk's structure is freed (all but chunk 0's, which answers
+// represented_point and build_notes). The world built so is for saving, to the same writer
+// under the same prefix, and nothing else: tracing it throws std::logic_error.
+struct ChunkStream {
+  SectionWriter& out;
+  std::string prefix;
+};
+
 // `keeps_mesh`: the sub-accelerators read their chunk's mesh in place (bvh), so the world
 // keeps each chunk's mesh; otherwise (hmq, raystrips) a chunk's mesh is freed once built.
 // Primitive ids in hits are the source's; throws std::invalid_argument for chunk_triangles
 // outside [kMinChunkTriangles, kMaxChunkTriangles].
 std::unique_ptr<Accelerator> make_chunked_accelerator(const TriangleSource& source, std::size_t chunk_triangles,
-                                                      const ChunkBuilder& build_chunk, bool keeps_mesh);
+                                                      const ChunkBuilder& build_chunk, bool keeps_mesh,
+                                                      const ChunkStream* stream = nullptr);
 
 // A chunked world saved under the loader's prefix (format in chunked_accelerator.cpp), each
 // chunk's accelerator loaded by `load_chunk` from its own prefix.
