@@ -38,8 +38,9 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-// Before a build of hours stops for want of disk at its end: the structure's size by its
-// type's measured bytes per triangle (registry.cpp) against the free space where it goes.
+// Before a build of hours stops for want of disk at its end: the file's size by its type's
+// measured bytes per triangle (registry.cpp; the mesh's, for a type rebuilt from it when
+// loaded) against the free space where it goes.
 void check_world_file_space(const std::string& out, double estimated_bytes) {
   const std::filesystem::path directory = std::filesystem::absolute(out).parent_path();
   std::error_code error;
@@ -76,7 +77,9 @@ int run_build(const BuildArguments& args) {
   Scene& scene = loaded.scene;
   plan.accelerator = loaded.accelerator.options;
   const std::string& type = plan.accelerator.type;
-  check_world_file_space(args.out, double(scene.triangle_count) * estimated_bytes_per_triangle(plan.accelerator));
+  check_world_file_space(args.out, double(scene.triangle_count) * (saves_structure(type)
+                                                                       ? estimated_bytes_per_triangle(plan.accelerator)
+                                                                       : kWholeMeshBytesPerTriangle));
   if (const std::string line = resolution_summary(loaded.accelerator); !line.empty()) fmt::print("{}\n", line);
   // The world records what was built, not what chose it.
   record_built_accelerator(config, plan);

@@ -2,6 +2,7 @@
 // eviction, faults counted by part, and a file cut short while it is paged.
 #include <gtest/gtest.h>
 
+#include <cctype>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -66,6 +67,36 @@ TEST(FilePager, AFullPoolEvictsAGroupOfTheLeastRecentlyUsedPages) {
   EXPECT_EQ(word(pager, 4, 9), 4009u);
   EXPECT_EQ(pager.total().faults, 20u);
   for (std::size_t page = 0; page < 32; ++page) EXPECT_EQ(word(pager, page, 100), page * 1000 + 100) << page;
+}
+
+// Resident kilobytes of this process's mappings of the page pool whose permissions start
+// with `permissions` ("" for all of them).
+std::size_t pool_resident_kb(const std::string& permissions) {
+  std::ifstream smaps("/proc/self/smaps");
+  std::size_t kb = 0;
+  bool pool = false;
+  for (std::string line; std::getline(smaps, line);) {
+    if (!line.empty() && std::isxdigit(static_cast<unsigned char>(line[0])) && line.find('-') < line.find(' ')) {
+      pool = line.find("wavetrace-page-pool") != std::string::npos &&
+             line.compare(line.find(' ') + 1, permissions.size(), permissions) == 0;
+    } else if (pool && line.starts_with("Rss:")) {
+      kb += std::stoul(line.substr(4));
+    }
+  }
+  return kb;
+}
+
+// A page read into the pool is mapped once, at its place: through a writable view of the
+// pool as well, it counted twice in the process's resident memory (a 12 GB pool read 24 GB).
+TEST(FilePager, ResidentMemoryCountsAPagedPageOnce) {
+  constexpr std::size_t kFilePages = 256, kSlots = 64;
+  const std::string path = numbered_file("pager_resident.bin", kFilePages);
+  FilePager pager(path, kFilePages * kPage, kPage, kSlots * kPage, 1);
+  for (std::size_t pass = 0; pass < 2; ++pass) {
+    for (std::size_t page = 0; page < kFilePages; ++page) ASSERT_EQ(word(pager, page, 3), page * 1000 + 3);
+  }
+  EXPECT_EQ(pool_resident_kb(""), kSlots * kPage / 1024);  // every mapping of the pool together
+  std::filesystem::remove(path);
 }
 
 TEST(FilePager, CountsFaultsByPartOfTheFile) {

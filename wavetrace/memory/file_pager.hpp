@@ -158,9 +158,6 @@ class FilePager {
   int direct_fd_ = -1;  // the file, O_DIRECT
   int pool_fd_ = -1;    // the memfd of page slots
   std::byte* base_ = nullptr;
-  // The whole pool mapped writable once: reads land in their slot directly (O_DIRECT into
-  // the memfd's pages), then the slot is mapped read-only at the page's address.
-  std::byte* pool_view_ = nullptr;
 
   mutable std::mutex mutex_;
   std::condition_variable loaded_;  // a page finished loading (or failed to)
