@@ -285,7 +285,8 @@ std::string FilePager::load(std::uint32_t page, std::uint64_t address_offset, st
     // Into the slot by a write to the memfd, not through a writable mapping of the pool: a
     // page mapped there and at its address counted twice in the process's resident memory
     // (VmRSS, VmHWM, what the OOM killer weighs: a 12 GB pool showed 24 GB), and unmapping
-    // it from such a view after each read cost 27% of a paged render's time in more faults.
+    // the view's pages a group at a time cost 27% of a paged render's time; this copy, no
+    // time we could measure (docs/memory.md).
     for (std::size_t done = 0; done < page_bytes_ && error.empty();) {
       const ssize_t put = ::pwrite(pool_fd_, into + done, page_bytes_ - done, off_t(std::size_t(slot) * page_bytes_ + done));
       if (put < 0 && errno == EINTR) continue;
