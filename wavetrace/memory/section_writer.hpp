@@ -51,7 +51,7 @@ class SectionWriter {
   int fd_ = -1;
   std::uint64_t position_ = 0;
   std::vector<section_file::TableEntry> table_;
-  std::unordered_set<std::string> names_;  // a world of 3G triangles has over 4,000 sections
+  std::unordered_set<std::string> names_;  // builtin:room:3G's world has 3,630 sections
 };
 
 }  // namespace wavetrace
