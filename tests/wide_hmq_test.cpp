@@ -3,7 +3,10 @@
 // memory, the collapse, and bad options.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <span>
 #include <string>
 
 #include "wavetrace/accel/hmq/hmq_accelerator.hpp"
@@ -119,6 +122,68 @@ TEST(WideHmq, FewerBytesThanBinaryHmqAndFullNodes) {
   EXPECT_LE(children, 8.0) << notes;
 }
 
+// Levels below the root of each node of a wide tree, by walking it from the root.
+std::vector<std::uint32_t> node_levels(std::span<const QuantizedWideNode> nodes) {
+  std::vector<std::uint32_t> level(nodes.size(), 0), pending = {0};
+  while (!pending.empty()) {
+    const std::uint32_t n = pending.back();
+    pending.pop_back();
+    for (int slot = 0, inner = 0; slot < QuantizedWideNode::kWidth; ++slot) {
+      if (nodes[n].meta[slot] != QuantizedWideNode::kInnerMeta) continue;
+      const std::uint32_t child = nodes[n].child_base + inner++;
+      level[child] = level[n] + 1;
+      pending.push_back(child);
+    }
+  }
+  return level;
+}
+
+// The node order changes where nodes lie, never what a ray meets: the same hits bit for bit,
+// the same leaf bytes; breadth first lays levels in order, van Emde Boas the top half of the
+// levels before anything below them.
+TEST(WideHmq, NodeLayoutsMoveNodesAndChangeNoHit) {
+  const Scene scene = make_builtin_scene("builtin:room:60k");
+  HmqOptions options = hmq_options(8, 8, 16);
+  const auto depth_first = make_hmq_accelerator(scene.mesh, options);
+  const RaySet rays = make_ray_set(RaySetKind::diffuse, scene, *depth_first, 20000);
+  const auto expected = trace_ray_set(*depth_first, rays, false);
+  const auto nodes_of = [](const Accelerator& accel) {
+    const std::span<const std::byte> bytes = accel.memory_spans()[0];
+    return std::span(reinterpret_cast<const QuantizedWideNode*>(bytes.data()), bytes.size() / sizeof(QuantizedWideNode));
+  };
+  const std::span<const QuantizedWideNode> reference = nodes_of(*depth_first);
+  ASSERT_GT(reference.size(), 200u);
+  for (const NodeLayout layout : {NodeLayout::breadth_first, NodeLayout::van_emde_boas}) {
+    options.layout = layout;
+    const auto moved = make_hmq_accelerator(scene.mesh, options);
+    const std::span<const QuantizedWideNode> nodes = nodes_of(*moved);
+    ASSERT_EQ(nodes.size(), reference.size());
+    EXPECT_NE(std::memcmp(nodes.data(), reference.data(), nodes.size_bytes()), 0) << to_string(layout);
+    const auto leaves = moved->memory_spans()[1], reference_leaves = depth_first->memory_spans()[1];
+    ASSERT_EQ(leaves.size(), reference_leaves.size());
+    EXPECT_EQ(std::memcmp(leaves.data(), reference_leaves.data(), leaves.size()), 0) << to_string(layout);
+    const auto hits = trace_ray_set(*moved, rays, false);
+    for (std::size_t b = 0; b < rays.batches.size(); ++b) {
+      for (std::size_t i = 0; i < rays.batches[b]->count; ++i) {
+        ASSERT_EQ(hits[b]->t[i], expected[b]->t[i]) << to_string(layout);
+        ASSERT_EQ(hits[b]->primitive[i], expected[b]->primitive[i]) << to_string(layout);
+        ASSERT_EQ(hits[b]->u[i], expected[b]->u[i]) << to_string(layout);
+        ASSERT_EQ(hits[b]->v[i], expected[b]->v[i]) << to_string(layout);
+      }
+    }
+    const std::vector<std::uint32_t> level = node_levels(nodes);
+    const std::uint32_t height = *std::max_element(level.begin(), level.end()) + 1;
+    ASSERT_GE(height, 4u);
+    if (layout == NodeLayout::breadth_first) {
+      EXPECT_TRUE(std::is_sorted(level.begin(), level.end()));
+    } else {
+      const std::uint32_t top = height / 2;
+      const auto top_nodes = std::size_t(std::count_if(level.begin(), level.end(), [&](std::uint32_t l) { return l < top; }));
+      for (std::size_t n = 0; n < nodes.size(); ++n) EXPECT_EQ(level[n] < top, n < top_nodes) << n;
+    }
+  }
+}
+
 TEST(WideHmq, DecodedChildOfAFullStepIsTheFrame) {
   QuantizedWideNode node{};
   Bounds3 frame;
@@ -145,6 +210,10 @@ TEST(WideHmq, BadWidthIsAClearError) {
   // A float top share for the layout that has none is refused, not ignored.
   EXPECT_THROW(parse_accelerator_spec("hmq:width=8:top_fraction=0.1", Config{}), ConfigError);
   EXPECT_NO_THROW(parse_accelerator_spec("hmq:width=8:leaf_size=12", Config{}));
+  // So is a node order for the binary layout, whose nodes sit in blocks.
+  EXPECT_THROW(parse_accelerator_spec("hmq:layout=veb", Config{}), ConfigError);
+  EXPECT_THROW(parse_accelerator_spec("hmq:width=8:layout=spiral", Config{}), ConfigError);
+  EXPECT_EQ(parse_accelerator_spec("hmq:width=8:layout=veb", Config{}).options.hmq.layout, NodeLayout::van_emde_boas);
 }
 
 }  // namespace

@@ -84,6 +84,29 @@ std::string open_error(const std::string& path) {
   return "(no error)";
 }
 
+// A writer works beside the path and renames at finish(): a failed save keeps the world that
+// was there, and a process with that world mapped keeps reading it while it is replaced.
+TEST(SectionFile, AWriterReplacesTheFileOnlyWhenItFinishes) {
+  const std::string path = temp_path("replaced.bin");
+  const auto write = [&](std::uint64_t value, bool finish) {
+    SectionWriter out(path);
+    EXPECT_NE(out.partial_path(), path);
+    out.add_value("a/value", value);
+    EXPECT_TRUE(fs::exists(out.partial_path()));
+    if (finish) out.finish();
+    return out.partial_path();
+  };
+  write(1, true);
+  const auto mapped = SectionFile::open(path);
+  const std::string unfinished = write(2, false);
+  EXPECT_FALSE(fs::exists(unfinished));
+  EXPECT_EQ(SectionFile::open(path)->value<std::uint64_t>("a/value"), 1u);
+  const std::string finished = write(3, true);
+  EXPECT_FALSE(fs::exists(finished));
+  EXPECT_EQ(SectionFile::open(path)->value<std::uint64_t>("a/value"), 3u);
+  EXPECT_EQ(mapped->value<std::uint64_t>("a/value"), 1u);
+}
+
 TEST(SectionFile, ArraysComeBackInPlaceAndChecked) {
   const std::string path = temp_path("sections.bin");
   const std::vector<std::uint32_t> numbers = {1, 2, 3, 5, 8, 13};

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <set>
 #include <stdexcept>
+#include <utility>
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -23,9 +24,12 @@ std::uint64_t align_up_u64(std::uint64_t value, std::uint64_t alignment) { retur
 
 }  // namespace
 
-SectionWriter::SectionWriter(std::string path) : path_(std::move(path)) {
-  fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd_ < 0) throw std::runtime_error(fmt::format("{}: cannot create: {}", path_, std::strerror(errno)));
+SectionWriter::SectionWriter(std::string path)
+    : path_(std::move(path)), partial_path_(fmt::format("{}.{}.partial", path_, ::getpid())) {
+  fd_ = ::open(partial_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd_ < 0) {
+    throw std::runtime_error(fmt::format("{}: cannot create (as {}): {}", path_, partial_path_, std::strerror(errno)));
+  }
   // The header stays zero until finish(): a file cut short by a crash reads as "not a world".
   const Header zero{};
   write_at(0, &zero, sizeof(zero));
@@ -35,7 +39,7 @@ SectionWriter::SectionWriter(std::string path) : path_(std::move(path)) {
 SectionWriter::~SectionWriter() {
   if (fd_ < 0) return;
   ::close(fd_);
-  ::unlink(path_.c_str());
+  ::unlink(partial_path_.c_str());
 }
 
 void SectionWriter::write_at(std::uint64_t offset, const void* data, std::size_t bytes) {
@@ -84,8 +88,16 @@ void SectionWriter::finish() {
     throw std::runtime_error(fmt::format("{}: cannot set its size: {}", path_, std::strerror(errno)));
   }
   write_at(0, &header, sizeof(header));
-  if (::close(fd_) != 0) throw std::runtime_error(fmt::format("{}: close failed: {}", path_, std::strerror(errno)));
-  fd_ = -1;
+  const int fd = std::exchange(fd_, -1);
+  const auto fail = [&](std::string_view what, int error) {
+    ::unlink(partial_path_.c_str());
+    throw std::runtime_error(fmt::format("{}: {} failed: {}", path_, what, std::strerror(error)));
+  };
+  if (::close(fd) != 0) fail("close", errno);
+  if (::rename(partial_path_.c_str(), path_.c_str()) != 0) {
+    const int error = errno;
+    fail(fmt::format("rename from {}", partial_path_), error);
+  }
 }
 
 }  // namespace wavetrace

@@ -1,9 +1,12 @@
 // Writes a section file (section_file_format.hpp) front to back: each section's bytes go
 // to the file as they are added, with their checksum, so a saved world never needs a
 // second copy of itself in memory (a chunked world is written chunk by chunk while it is
-// built, ChunkStream); the table and header are written by finish(). A writer destroyed
-// before finish() (an error during the build or save) removes its file: a world of tens of
-// gigabytes left half written would only fill the disk.
+// built, ChunkStream); the table and header are written by finish(). The bytes go to a
+// temporary file beside `path`, renamed over it by finish(): a build that fails keeps the
+// world that was at `path` before, and a process that has that world mapped keeps reading
+// it (truncating it in place would fault its pages). A writer destroyed before finish() (an
+// error during the build or save) removes its temporary file: a world of tens of gigabytes
+// left half written would only fill the disk.
 #pragma once
 
 #include <cstddef>
@@ -21,7 +24,8 @@ namespace wavetrace {
 
 class SectionWriter {
  public:
-  // Creates (or truncates) `path`; throws std::runtime_error naming it when it cannot.
+  // Creates the temporary file beside `path` ("PATH.PID.partial"); throws std::runtime_error
+  // naming `path` when it cannot.
   explicit SectionWriter(std::string path);
   ~SectionWriter();
   SectionWriter(const SectionWriter&) = delete;
@@ -40,14 +44,17 @@ class SectionWriter {
     add_array(name, std::span<const T>(&value, 1));
   }
 
-  // Writes the table and header and closes the file; until then the file is not valid
-  // (its header is zero), so an interrupted save is refused when read.
+  // Writes the table and header, closes the file and renames it to `path`; until then the
+  // file is not valid (its header is zero), so an interrupted save is refused when read.
   void finish();
+
+  // Where the bytes are written until finish() (for tests and error messages).
+  const std::string& partial_path() const { return partial_path_; }
 
  private:
   void write_at(std::uint64_t offset, const void* data, std::size_t bytes);
 
-  std::string path_;
+  std::string path_, partial_path_;
   int fd_ = -1;
   std::uint64_t position_ = 0;
   std::vector<section_file::TableEntry> table_;

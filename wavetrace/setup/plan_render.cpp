@@ -100,6 +100,11 @@ void check_accelerator_options(const Config& config, const AcceleratorOptions& o
                                   "quantizes every node",
                                   options.hmq.top_fraction));
   }
+  if (options.hmq.width == 2 && (config.given("accel.hmq.layout") || options.hmq.layout != HmqOptions{}.layout)) {
+    throw ConfigError(fmt::format("accel.hmq.layout = {} orders the 8-wide nodes (width 8): the binary layout "
+                                  "keeps its blocks",
+                                  to_string(options.hmq.layout)));
+  }
 }
 
 void check_memory_plan(const Config& config, const MemoryPlan& plan) {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <limits>
 #include <stdexcept>
 #include <vector>
@@ -171,13 +172,94 @@ class Encoder {
   std::uint64_t weights_ = 0;
 };
 
+// A node's inner children, nodes first .. first + count - 1: the unit every layout moves.
+struct SiblingGroup {
+  std::uint32_t first, count;
+};
+
+std::uint32_t inner_children(const QuantizedWideNode& node) {
+  std::uint32_t count = 0;
+  for (const std::uint8_t meta : node.meta) count += meta == QuantizedWideNode::kInnerMeta;
+  return count;
+}
+
+class GroupOrder {
+ public:
+  explicit GroupOrder(const LargeArray<QuantizedWideNode>& nodes) : nodes_(nodes), height_(nodes.size(), 1) {
+    // Children come after their parent in the encoder's order: one pass backwards gives heights.
+    for (std::size_t n = nodes.size(); n-- > 0;) {
+      for (std::uint32_t c = 0, inner = inner_children(nodes[n]); c < inner; ++c) {
+        height_[n] = std::max(height_[n], height_[nodes[n].child_base + c] + 1);
+      }
+    }
+    order_.reserve(nodes.size());
+  }
+
+  std::vector<std::uint32_t> breadth_first() {
+    std::deque<SiblingGroup> queue = {{0, 1}};
+    while (!queue.empty()) {
+      const SiblingGroup group = queue.front();
+      queue.pop_front();
+      emit(group, [&](SiblingGroup child) { queue.push_back(child); });
+    }
+    return std::move(order_);
+  }
+
+  std::vector<std::uint32_t> van_emde_boas() {
+    std::vector<SiblingGroup> below;
+    van_emde_boas({0, 1}, height_[0], below);
+    return std::move(order_);
+  }
+
+ private:
+  template <typename Child>
+  void emit(SiblingGroup group, Child&& child) {
+    for (std::uint32_t n = group.first; n < group.first + group.count; ++n) {
+      order_.push_back(n);
+      if (const std::uint32_t inner = inner_children(nodes_[n]); inner != 0) child({nodes_[n].child_base, inner});
+    }
+  }
+
+  // Lays out the `levels` top levels of the subtree at `group`; the groups just below them go
+  // to `frontier` for the caller to lay out next. Recursion depth is O(log levels).
+  void van_emde_boas(SiblingGroup group, std::uint32_t levels, std::vector<SiblingGroup>& frontier) {
+    if (levels == 1) return emit(group, [&](SiblingGroup child) { frontier.push_back(child); });
+    const std::uint32_t top = levels / 2;
+    std::vector<SiblingGroup> middle;
+    van_emde_boas(group, top, middle);
+    for (const SiblingGroup subtree : middle) van_emde_boas(subtree, levels - top, frontier);
+  }
+
+  const LargeArray<QuantizedWideNode>& nodes_;
+  std::vector<std::uint32_t> height_;
+  std::vector<std::uint32_t> order_;
+};
+
 }  // namespace
 
-QuantizedWideTree build_quantized_wide_tree(const BuildTree& tree, const EncodeWideLeaf& encode_leaf) {
+void reorder_wide_nodes(LargeArray<QuantizedWideNode>& nodes, NodeLayout layout) {
+  if (layout == NodeLayout::depth_first || nodes.empty()) return;
+  GroupOrder groups(nodes);
+  const std::vector<std::uint32_t> order =
+      layout == NodeLayout::breadth_first ? groups.breadth_first() : groups.van_emde_boas();
+  if (order.size() != nodes.size()) throw std::logic_error("reorder_wide_nodes: a node is not reached from the root");
+  std::vector<std::uint32_t> position_of(nodes.size());
+  for (std::uint32_t i = 0; i < order.size(); ++i) position_of[order[i]] = i;
+  LargeArray<QuantizedWideNode> reordered(nodes.size());
+  for (std::uint32_t i = 0; i < order.size(); ++i) {
+    reordered[i] = nodes[order[i]];
+    if (inner_children(reordered[i]) != 0) reordered[i].child_base = position_of[reordered[i].child_base];
+  }
+  nodes = std::move(reordered);
+}
+
+QuantizedWideTree build_quantized_wide_tree(const BuildTree& tree, const EncodeWideLeaf& encode_leaf,
+                                            NodeLayout layout) {
   QuantizedWideTree out;
   out.root_frame = tree.nodes[0].bounds;
   out.nodes.resize(1);
   Encoder(tree, encode_leaf, out).encode(0, 0, out.root_frame);
+  reorder_wide_nodes(out.nodes, layout);
   return out;
 }
 

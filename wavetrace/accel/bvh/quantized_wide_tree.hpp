@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <functional>
 
+#include "wavetrace/accel/bvh/node_layout.hpp"
 #include "wavetrace/accel/bvh/quantized_wide_node.hpp"
 #include "wavetrace/accel/bvh/sah_builder.hpp"
 #include "wavetrace/memory/cache_aligned_allocator.hpp"
@@ -24,6 +25,18 @@ struct QuantizedWideTree {
 };
 
 // Throws std::length_error when the leaf weights sum to 2^31 or more (the references' range).
-QuantizedWideTree build_quantized_wide_tree(const BuildTree& tree, const EncodeWideLeaf& encode_leaf);
+// `layout` orders the nodes in the array (the leaves keep the depth-first order the encoder
+// calls them in): a node's inner children stay consecutive whatever the order, so the unit
+// ordered is a group of siblings (see reorder_wide_nodes).
+QuantizedWideTree build_quantized_wide_tree(const BuildTree& tree, const EncodeWideLeaf& encode_leaf,
+                                            NodeLayout layout = NodeLayout::depth_first);
+
+// Reorders a tree laid out depth first (every child after its parent, as the encoder leaves
+// it) into `layout`, with child_base rewritten: depth_first is the identity; breadth_first
+// lays sibling groups level by level; van_emde_boas lays the top half of the group levels
+// recursively, then each subtree below them recursively (cache-oblivious, as Yoon and
+// Lindstrom 2006 lay out BVHs for out-of-core walks), so that a ray's path from a chunk's root
+// crosses few pages of any size and a page near the root holds only nodes near the root.
+void reorder_wide_nodes(LargeArray<QuantizedWideNode>& nodes, NodeLayout layout);
 
 }  // namespace wavetrace

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <optional>
 
+#include "wavetrace/accel/bvh/node_layout.hpp"
 #include "wavetrace/scene/triangle_mesh.hpp"
 
 namespace wavetrace {
@@ -21,6 +22,9 @@ struct HmqOptions {
   // 2: the paper's binary tree of 4-byte nodes in blocks; 8: 64-byte nodes of eight children
   // quantized to 8 bits per plane, tested in AVX2 lanes (accel/bvh/quantized_wide_node.hpp). Same leaves.
   std::uint32_t width = 2;
+  // The 8-wide nodes' order in the array and so in a world file (width 8 only; the binary
+  // layout keeps its blocks): what a paged render reads per ray depends on it.
+  NodeLayout layout = NodeLayout::depth_first;
   std::uint32_t bins = 16;       // SAH bins
   // The box the global grid spans: the whole scene's when a chunk is built, so that every
   // chunk snaps to the same grid and shared vertices decode alike; unset: the mesh's box.

@@ -74,7 +74,7 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
       parts.geometry += record - identity;
       parts.hierarchy += leaves.size() - at - record;
       return static_cast<std::uint32_t>((leaves.size() - at) / kUnit);
-    });
+    }, options.layout);
     leaves.resize(leaves.size() + 8, std::byte{0});  // read slack for unaligned 8-byte stream loads
     parts.hierarchy += 8 + tree.nodes.size() * sizeof(QuantizedWideNode);
     const std::size_t encode_peak = tree.nodes.capacity() * sizeof(QuantizedWideNode) + leaves.capacity();
