@@ -12,6 +12,9 @@
 #include "wavetrace/accel/hmq/hmq_accelerator.hpp"
 #include "wavetrace/accel/bvh/quantized_wide_node.hpp"
 #include "wavetrace/accel/registry.hpp"
+#include "wavetrace/accel/section_archive.hpp"
+#include "wavetrace/memory/section_file.hpp"
+#include "wavetrace/memory/section_writer.hpp"
 #include "accel_agreement.hpp"
 #include "wavetrace/bench/accel_bench.hpp"
 #include "wavetrace/bench/leak_bench.hpp"
@@ -138,12 +141,15 @@ std::vector<std::uint32_t> node_levels(std::span<const QuantizedWideNode> nodes)
   return level;
 }
 
-// The node order changes where nodes lie, never what a ray meets: the same hits bit for bit,
-// the same leaf bytes; breadth first lays levels in order, van Emde Boas the top half of the
-// levels before anything below them.
+// The node order and the leaves' place change where bytes lie, never what a ray meets: the
+// same hits bit for bit, saved and loaded too; apart, the same leaf bytes, breadth first lays
+// levels in order and van Emde Boas the top half of the levels before anything below them;
+// together, one array a few percent larger than the two.
 TEST(WideHmq, NodeLayoutsMoveNodesAndChangeNoHit) {
   const Scene scene = make_builtin_scene("builtin:room:60k");
   HmqOptions options = hmq_options(8, 8, 16);
+  EXPECT_EQ(options.layout, NodeLayout::van_emde_boas);  // the default
+  options.layout = NodeLayout::depth_first;
   const auto depth_first = make_hmq_accelerator(scene.mesh, options);
   const RaySet rays = make_ray_set(RaySetKind::diffuse, scene, *depth_first, 20000);
   const auto expected = trace_ray_set(*depth_first, rays, false);
@@ -153,6 +159,42 @@ TEST(WideHmq, NodeLayoutsMoveNodesAndChangeNoHit) {
   };
   const std::span<const QuantizedWideNode> reference = nodes_of(*depth_first);
   ASSERT_GT(reference.size(), 200u);
+  const auto same_hits = [&](const Accelerator& moved, const std::string& label) {
+    const auto hits = trace_ray_set(moved, rays, false);
+    for (std::size_t b = 0; b < rays.batches.size(); ++b) {
+      for (std::size_t i = 0; i < rays.batches[b]->count; ++i) {
+        ASSERT_EQ(hits[b]->t[i], expected[b]->t[i]) << label;
+        ASSERT_EQ(hits[b]->primitive[i], expected[b]->primitive[i]) << label;
+        ASSERT_EQ(hits[b]->u[i], expected[b]->u[i]) << label;
+        ASSERT_EQ(hits[b]->v[i], expected[b]->v[i]) << label;
+      }
+    }
+  };
+  for (const NodeLayout layout : {NodeLayout::depth_first, NodeLayout::van_emde_boas}) {
+    options.layout = layout;
+    options.leaves_beside_nodes = true;
+    const auto together = make_hmq_accelerator(scene.mesh, options);
+    const std::string label = to_string(layout) + " together";
+    ASSERT_EQ(together->memory_spans().size(), 1u) << label;
+    EXPECT_EQ(together->memory().total(), together->memory_spans()[0].size()) << label;
+    EXPECT_GT(together->memory().total(), depth_first->memory().total()) << label;
+    EXPECT_LT(together->memory().total(), depth_first->memory().total() * 1.05) << label;
+    const auto counts = [](const std::string& notes) { return notes.substr(0, notes.find("; bytes/tri")); };
+    EXPECT_EQ(counts(together->build_notes()), counts(depth_first->build_notes())) << label;
+    same_hits(*together, label);
+    const std::string path = testing::write_temp_file("wide_hmq_together.wtw", "");
+    {
+      SectionWriter out(path);
+      together->save(out, "world/");
+      out.finish();
+    }
+    SectionLoader in(SectionFile::open(path), "world/");
+    const auto loaded = load_accelerator(in);
+    EXPECT_EQ(loaded->memory().total(), together->memory().total()) << label;
+    EXPECT_EQ(loaded->build_notes(), together->build_notes()) << label;
+    same_hits(*loaded, label + " loaded");
+  }
+  options.leaves_beside_nodes = false;
   for (const NodeLayout layout : {NodeLayout::breadth_first, NodeLayout::van_emde_boas}) {
     options.layout = layout;
     const auto moved = make_hmq_accelerator(scene.mesh, options);
@@ -162,15 +204,7 @@ TEST(WideHmq, NodeLayoutsMoveNodesAndChangeNoHit) {
     const auto leaves = moved->memory_spans()[1], reference_leaves = depth_first->memory_spans()[1];
     ASSERT_EQ(leaves.size(), reference_leaves.size());
     EXPECT_EQ(std::memcmp(leaves.data(), reference_leaves.data(), leaves.size()), 0) << to_string(layout);
-    const auto hits = trace_ray_set(*moved, rays, false);
-    for (std::size_t b = 0; b < rays.batches.size(); ++b) {
-      for (std::size_t i = 0; i < rays.batches[b]->count; ++i) {
-        ASSERT_EQ(hits[b]->t[i], expected[b]->t[i]) << to_string(layout);
-        ASSERT_EQ(hits[b]->primitive[i], expected[b]->primitive[i]) << to_string(layout);
-        ASSERT_EQ(hits[b]->u[i], expected[b]->u[i]) << to_string(layout);
-        ASSERT_EQ(hits[b]->v[i], expected[b]->v[i]) << to_string(layout);
-      }
-    }
+    same_hits(*moved, to_string(layout));
     const std::vector<std::uint32_t> level = node_levels(nodes);
     const std::uint32_t height = *std::max_element(level.begin(), level.end()) + 1;
     ASSERT_GE(height, 4u);
@@ -214,6 +248,8 @@ TEST(WideHmq, BadWidthIsAClearError) {
   EXPECT_THROW(parse_accelerator_spec("hmq:layout=veb", Config{}), ConfigError);
   EXPECT_THROW(parse_accelerator_spec("hmq:width=8:layout=spiral", Config{}), ConfigError);
   EXPECT_EQ(parse_accelerator_spec("hmq:width=8:layout=veb", Config{}).options.hmq.layout, NodeLayout::van_emde_boas);
+  EXPECT_THROW(parse_accelerator_spec("hmq:leaves_beside_nodes=true", Config{}), ConfigError);
+  EXPECT_TRUE(parse_accelerator_spec("hmq:width=8:leaves_beside_nodes=true", Config{}).options.hmq.leaves_beside_nodes);
 }
 
 }  // namespace

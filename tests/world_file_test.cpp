@@ -495,6 +495,9 @@ INSTANTIATE_TEST_SUITE_P(
         CraftedCase{"WideHmqChildAndLeafPastTheirArrays", {"accel.type=hmq", "accel.hmq.width=8"}, "hmq8.nodes",
                     point_wide_node_past_its_arrays,
                     "node 0"},
+        CraftedCase{"WideHmqTogetherChildBeforeItsParent",
+                    {"accel.type=hmq", "accel.hmq.width=8", "accel.hmq.leaves_beside_nodes=true"}, "hmq8.tree",
+                    point_wide_node_past_its_arrays, "node at unit 0 names child 0"},
         CraftedCase{"LeafOfMoreStripsThanFollowIt", {"accel.type=raystrips"}, "raystrips.nodes",
                     [](char* d) {
                       for (char* node = d;; node += 32) {  // the first leaf: count with bit 31

@@ -87,6 +87,7 @@ class SectionLoader {
   [[noreturn]] void fail(std::string_view name, const std::string& problem) const {
     file_->fail(named(name), problem);
   }
+  bool has(std::string_view name) const { return file_->has(named(name)); }
   const std::shared_ptr<const SectionFile>& file() const { return file_; }
   const std::string& prefix() const { return prefix_; }
 

@@ -299,11 +299,18 @@ const std::vector<ConfigKey>& config_schema() {
       {"accel.hmq.width", T::integer, std::int64_t{2}, 2, 8, {},
        "2: the paper's binary 4-byte nodes in blocks; 8: 64-byte nodes of 8 children, 8-bit planes, AVX2",
        integer<&P::accelerator, &A::hmq, &HmqOptions::width>, recorded_integer<&P::accelerator, &A::hmq, &HmqOptions::width>},
-      {"accel.hmq.layout", T::text, std::string("depth_first"), 0, 0, {"depth_first", "breadth_first", "veb"},
-       "order of the 8-wide nodes in memory and in a world file (width 8 only); veb: cache-oblivious",
+      {"accel.hmq.layout", T::text, std::string("veb"), 0, 0, {"depth_first", "breadth_first", "veb"},
+       "order of the 8-wide nodes in memory and in a world file (width 8 only); veb: cache-oblivious (van Emde Boas)",
        choice<parse_node_layout, &P::accelerator, &A::hmq, &HmqOptions::layout>,
        [](const RenderPlan& plan) -> Recorded {
          return plan.accelerator.hmq.width == 8 ? Recorded(to_string(plan.accelerator.hmq.layout)) : std::nullopt;
+       }},
+      {"accel.hmq.leaves_beside_nodes", T::boolean, false, 0, 0, {},
+       "width 8: each group of sibling nodes followed by its nodes' leaf records in one array, so a paged walk "
+       "reads a leaf from its parent's page",
+       boolean<&P::accelerator, &A::hmq, &HmqOptions::leaves_beside_nodes>,
+       [](const RenderPlan& plan) -> Recorded {
+         return plan.accelerator.hmq.width == 8 ? Recorded(plan.accelerator.hmq.leaves_beside_nodes) : std::nullopt;
        }},
       {"accel.bvh.width", T::integer, std::int64_t{2}, 2, 8, {}, "2: binary 32-byte nodes; 8: AVX2 8-wide nodes",
        integer<&P::accelerator, &A::bvh, &BvhOptions::width>, recorded_integer<&P::accelerator, &A::bvh, &BvhOptions::width>},

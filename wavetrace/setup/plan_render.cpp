@@ -105,6 +105,10 @@ void check_accelerator_options(const Config& config, const AcceleratorOptions& o
                                   "keeps its blocks",
                                   to_string(options.hmq.layout)));
   }
+  if (options.hmq.width == 2 && options.hmq.leaves_beside_nodes) {
+    throw ConfigError("accel.hmq.leaves_beside_nodes = true places the 8-wide nodes' leaves (width 8): the binary "
+                      "layout keeps its blocks");
+  }
 }
 
 void check_memory_plan(const Config& config, const MemoryPlan& plan) {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <deque>
 #include <limits>
 #include <stdexcept>
@@ -251,6 +252,55 @@ void reorder_wide_nodes(LargeArray<QuantizedWideNode>& nodes, NodeLayout layout)
     if (inner_children(reordered[i]) != 0) reordered[i].child_base = position_of[reordered[i].child_base];
   }
   nodes = std::move(reordered);
+}
+
+InterleavedWideTree interleave_leaf_records(std::span<const QuantizedWideNode> nodes, std::span<const std::byte> records,
+                                            std::size_t unit_bytes, std::size_t slack_bytes) {
+  constexpr std::size_t kUnitBytes = sizeof(QuantizedWideNode);
+  std::vector<bool> group_start(nodes.size() + 1, false);
+  group_start[0] = group_start[nodes.size()] = true;
+  for (const QuantizedWideNode& node : nodes) {
+    if (inner_children(node) != 0) group_start[node.child_base] = true;
+  }
+  const auto leaf_weight = [](const QuantizedWideNode& node) {
+    std::size_t weight = 0;
+    for (const std::uint8_t meta : node.meta) weight += meta != QuantizedWideNode::kInnerMeta ? meta : 0;
+    return weight;
+  };
+  // Where each node and each node's records go, then the bytes.
+  std::vector<std::uint32_t> unit_of(nodes.size());
+  std::vector<std::size_t> records_at(nodes.size());
+  std::size_t cursor = 0, used = 0;
+  for (std::size_t first = 0; first < nodes.size();) {
+    std::size_t end = first + 1;
+    while (!group_start[end]) ++end;
+    cursor = (cursor + kUnitBytes - 1) / kUnitBytes * kUnitBytes;
+    for (std::size_t n = first; n < end; ++n, cursor += kUnitBytes) unit_of[n] = checked_uint32(cursor / kUnitBytes, "interleaved wide tree units");
+    for (std::size_t n = first; n < end; ++n) {
+      records_at[n] = cursor;
+      cursor += leaf_weight(nodes[n]) * unit_bytes;
+    }
+    used += (end - first) * kUnitBytes;
+    first = end;
+  }
+  if (cursor / unit_bytes >= (std::uint64_t{1} << 31)) {
+    throw std::length_error("interleaved wide tree: the leaf references pass 2^31; build in smaller chunks (build.chunk_triangles)");
+  }
+  InterleavedWideTree out;
+  out.units.resize((cursor + slack_bytes + kUnitBytes - 1) / kUnitBytes);
+  std::byte* bytes = reinterpret_cast<std::byte*>(out.units.data());
+  std::memset(bytes, 0, out.units.size() * kUnitBytes);
+  for (std::size_t n = 0; n < nodes.size(); ++n) {
+    QuantizedWideNode node = nodes[n];
+    const std::size_t record_bytes = leaf_weight(node) * unit_bytes;
+    if (record_bytes != 0) std::memcpy(bytes + records_at[n], records.data() + std::size_t(node.leaf_base) * unit_bytes, record_bytes);
+    used += record_bytes;
+    node.leaf_base = static_cast<std::uint32_t>(records_at[n] / unit_bytes);
+    if (inner_children(node) != 0) node.child_base = unit_of[node.child_base];
+    std::memcpy(bytes + std::size_t(unit_of[n]) * kUnitBytes, &node, kUnitBytes);
+  }
+  out.padding_bytes = out.units.size() * kUnitBytes - used;
+  return out;
 }
 
 QuantizedWideTree build_quantized_wide_tree(const BuildTree& tree, const EncodeWideLeaf& encode_leaf,

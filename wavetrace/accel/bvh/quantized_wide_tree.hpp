@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <span>
 
 #include "wavetrace/accel/bvh/node_layout.hpp"
 #include "wavetrace/accel/bvh/quantized_wide_node.hpp"
@@ -38,5 +39,20 @@ QuantizedWideTree build_quantized_wide_tree(const BuildTree& tree, const EncodeW
 // Lindstrom 2006 lay out BVHs for out-of-core walks), so that a ray's path from a chunk's root
 // crosses few pages of any size and a page near the root holds only nodes near the root.
 void reorder_wide_nodes(LargeArray<QuantizedWideNode>& nodes, NodeLayout layout);
+
+// One array holding the nodes and the owner's leaf records side by side, in 64-byte units:
+// each group of sibling nodes (in the nodes' order, 64-byte aligned) is followed by the leaf
+// records of its nodes, so a leaf lies beside the node that names it and a paged walk's last
+// steps read one page, not a node page and a leaf page. child_base counts 64-byte units of
+// the array, leaf_base `unit_bytes` units from its start (records are multiples of
+// unit_bytes; `records` are the encoder's, a node's leaves consecutive from leaf_base).
+// `slack_bytes` zero bytes follow the last record (read slack); the array is zero-padded to
+// whole units. Throws std::length_error when a leaf reference would pass 2^31 units.
+struct InterleavedWideTree {
+  LargeArray<QuantizedWideNode> units;
+  std::size_t padding_bytes = 0;  // the zeros that align each group of nodes and the end
+};
+InterleavedWideTree interleave_leaf_records(std::span<const QuantizedWideNode> nodes, std::span<const std::byte> records,
+                                            std::size_t unit_bytes, std::size_t slack_bytes);
 
 }  // namespace wavetrace

@@ -16,6 +16,7 @@
 #include <limits>
 #include <span>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -107,6 +108,49 @@ void check_tree(std::span<const QuantizedWideNode> nodes, const SectionLoader& i
       }
     }
   }
+}
+
+// A quantized 8-wide tree whose array also holds leaf records (interleave_leaf_records in
+// quantized_wide_tree.hpp): only what the root reaches is a node, so the check walks from the
+// root, each node reached once and after its parent. Returns the number of nodes.
+template <typename CheckLeaf>
+std::size_t check_tree_from_root(std::span<const QuantizedWideNode> units, const SectionLoader& in,
+                                 std::string_view section, CheckLeaf&& check_leaf) {
+  if (units.empty()) in.fail(section, "is empty");
+  std::vector<bool> reached(units.size(), false);
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> pending = {{0, 0}};  // unit, depth
+  reached[0] = true;
+  std::size_t nodes = 0;
+  while (!pending.empty()) {
+    const auto [i, depth] = pending.back();
+    pending.pop_back();
+    ++nodes;
+    const QuantizedWideNode& node = units[i];
+    std::uint64_t inner = 0, weight = 0;
+    for (int k = 0; k < QuantizedWideNode::kWidth; ++k) {
+      const std::uint8_t meta = node.meta[k];
+      if (meta == 0) continue;
+      if (meta == QuantizedWideNode::kInnerMeta) {
+        const std::uint64_t child = std::uint64_t(node.child_base) + inner++;
+        if (child <= i || child >= units.size() || reached[child]) {
+          in.fail(section, fmt::format("node at unit {} names child {}, which does not lie after it among the {} units "
+                                       "or is named twice",
+                                       i, child, units.size()));
+        }
+        if (depth + 1 >= kMaxTreeDepth) in.fail(section, fmt::format("is deeper than {} levels", kMaxTreeDepth));
+        reached[child] = true;
+        pending.emplace_back(child, depth + 1);
+      } else {
+        const std::uint64_t reference = node.leaf_base + weight;
+        if (reference >= (std::uint64_t{1} << 31)) {
+          in.fail(section, fmt::format("node at unit {} has a leaf reference past 2^31", i));
+        }
+        check_leaf(static_cast<std::uint32_t>(reference), meta);
+        weight += meta;
+      }
+    }
+  }
+  return nodes;
 }
 
 // A leaf's triangle slots [first, first + count) within `slots`, and (checked once for the

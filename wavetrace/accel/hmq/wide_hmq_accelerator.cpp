@@ -30,6 +30,7 @@ using namespace hmq;
 // Leaf records start 2-byte aligned; a reference counts 2-byte units (at most 254 a record:
 // 508 bytes, above the largest, 472: 14 triangles, 42 vertices of 3 x 25 bits, 32-bit id deltas).
 constexpr std::size_t kUnit = 2;
+constexpr std::size_t kSlackBytes = 8;  // read slack after the last record for unaligned 8-byte stream loads
 
 // What an hmq:width=8 world saves besides its arrays, `PREFIX` + "hmq8.state" (112 bytes):
 //   offset  size  field
@@ -41,8 +42,17 @@ constexpr std::size_t kUnit = 2;
 //       96     8  other bytes of the leaf records (triangle ids and corners)
 //      104     4  children of all nodes (leaves and inner nodes below the root), uint32
 //      108     4  leaves, uint32
-// Arrays: "hmq8.nodes" (QuantizedWideNode, node 0 the root) and "hmq8.leaves" (bytes, 8 of
-// slack), each record's leaf reference its offset in 2-byte units.
+// Arrays, either apart (the default):
+//   "hmq8.nodes"  QuantizedWideNode[], node 0 the root, child_base a node index;
+//   "hmq8.leaves" bytes, the leaf records, a leaf reference its offset in 2-byte units, 8
+//                 bytes of slack at the end;
+// or together (accel.hmq.leaves_beside_nodes), one array instead of the two:
+//   "hmq8.tree"   64-byte units (element size 64): the root node at unit 0; each group of
+//                 sibling nodes 64-byte aligned, followed by the leaf records of its nodes;
+//                 child_base a unit index, a leaf reference the record's offset from the
+//                 array's start in 2-byte units; zeros pad each group's start and the end
+//                 (at least 8 bytes of slack after the last record). Units no node names
+//                 are records or padding.
 struct WideHmqSavedState {
   GlobalGrid grid;
   Bounds3 root;
@@ -75,13 +85,23 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
       parts.hierarchy += leaves.size() - at - record;
       return static_cast<std::uint32_t>((leaves.size() - at) / kUnit);
     }, options.layout);
-    leaves.resize(leaves.size() + 8, std::byte{0});  // read slack for unaligned 8-byte stream loads
-    parts.hierarchy += 8 + tree.nodes.size() * sizeof(QuantizedWideNode);
-    const std::size_t encode_peak = tree.nodes.capacity() * sizeof(QuantizedWideNode) + leaves.capacity();
+    std::size_t encode_peak = tree.nodes.capacity() * sizeof(QuantizedWideNode) + leaves.capacity();
     root_ = tree.root_frame;
     children_ = tree.children;
-    nodes_ = StoredArray<QuantizedWideNode>(std::move(tree.nodes));
-    leaves_ = StoredArray<std::byte>(LargeArray<std::byte>(leaves.begin(), leaves.end()));
+    node_count_ = tree.nodes.size();
+    parts.hierarchy += node_count_ * sizeof(QuantizedWideNode);
+    if (options.leaves_beside_nodes) {
+      InterleavedWideTree together = interleave_leaf_records(tree.nodes, leaves, kUnit, kSlackBytes);
+      encode_peak += together.units.size() * sizeof(QuantizedWideNode);
+      parts.hierarchy += together.padding_bytes;
+      nodes_ = StoredArray<QuantizedWideNode>(std::move(together.units));
+      leaves_beside_ = true;
+    } else {
+      leaves.resize(leaves.size() + kSlackBytes, std::byte{0});
+      parts.hierarchy += kSlackBytes;
+      nodes_ = StoredArray<QuantizedWideNode>(std::move(tree.nodes));
+      leaves_ = StoredArray<std::byte>(LargeArray<std::byte>(leaves.begin(), leaves.end()));
+    }
     parts_ = parts;
     triangles_ = mesh.triangle_count();
     leaf_count_ = 0;
@@ -107,8 +127,13 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
                             static_cast<std::uint32_t>(self.children_),
                             static_cast<std::uint32_t>(self.leaf_count_)};
     a.value("hmq8.state", state);
-    a.array("hmq8.nodes", self.nodes_);
-    a.array("hmq8.leaves", self.leaves_);
+    if constexpr (Archive::kLoading) self.leaves_beside_ = a.has("hmq8.tree");
+    if (self.leaves_beside_) {
+      a.array("hmq8.tree", self.nodes_);
+    } else {
+      a.array("hmq8.nodes", self.nodes_);
+      a.array("hmq8.leaves", self.leaves_);
+    }
     archive_common_state(a, self.triangles_, self.build_);
     if constexpr (Archive::kLoading) {
       self.grid_ = state.grid;
@@ -116,12 +141,20 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
       self.parts_ = {state.hierarchy_bytes, state.geometry_bytes, state.other_bytes};
       self.children_ = state.children;
       self.leaf_count_ = state.leaves;
-      if (self.nodes_.empty() || self.leaves_.size() < 8) a.fail("hmq8.nodes", "is empty: no hmq8 structure was saved");
-      const std::span<const std::byte> leaves(self.leaves_.data(), self.leaves_.size());
-      check_tree(std::span<const QuantizedWideNode>(self.nodes_.data(), self.nodes_.size()), a, "hmq8.nodes",
-                 [&](std::uint32_t units, std::uint8_t) {
-                   check_leaf_record(leaves, std::uint64_t(units) * kUnit, self.triangles_, a, "hmq8.leaves");
-                 });
+      const std::span<const QuantizedWideNode> nodes(self.nodes_.data(), self.nodes_.size());
+      if (self.leaves_beside_) {
+        const std::span<const std::byte> leaves = self.nodes_.bytes();
+        self.node_count_ = check_tree_from_root(nodes, a, "hmq8.tree", [&](std::uint32_t units, std::uint8_t) {
+          check_leaf_record(leaves, std::uint64_t(units) * kUnit, self.triangles_, a, "hmq8.tree");
+        });
+      } else {
+        if (self.nodes_.empty() || self.leaves_.size() < kSlackBytes) a.fail("hmq8.nodes", "is empty: no hmq8 structure was saved");
+        const std::span<const std::byte> leaves(self.leaves_.data(), self.leaves_.size());
+        check_tree(nodes, a, "hmq8.nodes", [&](std::uint32_t units, std::uint8_t) {
+          check_leaf_record(leaves, std::uint64_t(units) * kUnit, self.triangles_, a, "hmq8.leaves");
+        });
+        self.node_count_ = self.nodes_.size();
+      }
     }
   }
 
@@ -140,7 +173,7 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
   void intersect_coherent(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
     NullProbe probe;
     QuantizedWidePacketStack stack;
-    const std::byte* leaves = leaves_.data();
+    const std::byte* leaves = leaf_records();
     for (std::uint32_t begin = range.begin; begin < range.end; begin += kWidePacketRays) {
       const std::uint32_t end = std::min<std::uint32_t>(begin + kWidePacketRays, range.end);
       SingleRay packet[kWidePacketRays];
@@ -183,13 +216,16 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
     return fmt::format(
         "grid {}x{}x{} bits, vertex error <= {:.3g}; {} 8-wide nodes ({:.2f} children each) over {} leaves ({:.1f} "
         "triangles each); bytes/tri: nodes+padding {:.2f}, vertices+connectivity {:.2f}, ids+corners {:.2f}",
-        grid_.bits.x, grid_.bits.y, grid_.bits.z, grid_.max_vertex_error, nodes_.size(),
-        double(children_) / double(std::max<std::size_t>(1, nodes_.size())), leaf_count_,
+        grid_.bits.x, grid_.bits.y, grid_.bits.z, grid_.max_vertex_error, node_count_,
+        double(children_) / double(std::max<std::size_t>(1, node_count_)), leaf_count_,
         triangles / double(std::max<std::size_t>(1, leaf_count_)), double(parts_.hierarchy) / triangles,
         double(parts_.geometry) / triangles, double(parts_.other) / triangles);
   }
 
-  std::vector<std::span<const std::byte>> memory_spans() const override { return {nodes_.bytes(), leaves_.bytes()}; }
+  std::vector<std::span<const std::byte>> memory_spans() const override {
+    if (leaves_beside_) return {nodes_.bytes()};
+    return {nodes_.bytes(), leaves_.bytes()};
+  }
 
   std::optional<TriangleMesh> represented_mesh(const TriangleMesh& source) const override {
     return snapped_mesh(grid_, source);
@@ -200,7 +236,7 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
   template <bool kAnyHit, typename Probe>
   void traverse(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
     QuantizedWideStack stack;
-    const std::byte* leaves = leaves_.data();
+    const std::byte* leaves = leaf_records();
     for_each_ray(rays, hits, range, [&](const SingleRay& ray, std::uint32_t i) {
       float tmax = ray.tmax;
       LeafHit best;
@@ -213,12 +249,19 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
     });
   }
 
+  // Leaf references count 2-byte units from here: the records' own array, or the one array
+  // that holds nodes and records together.
+  const std::byte* leaf_records() const {
+    return leaves_beside_ ? reinterpret_cast<const std::byte*>(nodes_.data()) : leaves_.data();
+  }
+
   GlobalGrid grid_;
   Bounds3 root_;
-  StoredArray<QuantizedWideNode> nodes_;
-  StoredArray<std::byte> leaves_;
+  StoredArray<QuantizedWideNode> nodes_;  // with leaves_beside_, the nodes and the leaf records
+  StoredArray<std::byte> leaves_;         // empty with leaves_beside_
+  bool leaves_beside_ = false;
   PartBytes parts_;
-  std::size_t children_ = 0, leaf_count_ = 0, triangles_ = 0;
+  std::size_t children_ = 0, leaf_count_ = 0, triangles_ = 0, node_count_ = 0;
   BuildReport build_;
 };
 
