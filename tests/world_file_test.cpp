@@ -84,27 +84,36 @@ std::string open_error(const std::string& path) {
   return "(no error)";
 }
 
-// A writer works beside the path and renames at finish(): a failed save keeps the world that
-// was there, and a process with that world mapped keeps reading it while it is replaced.
+// A writer works in an unnamed file and renames at finish(): a failed save leaves no file and
+// keeps the world that was there, and a process with that world mapped keeps reading it
+// while it is replaced.
 TEST(SectionFile, AWriterReplacesTheFileOnlyWhenItFinishes) {
   const std::string path = temp_path("replaced.bin");
+  const auto others_beside = [&] {
+    std::size_t count = 0;
+    for (const auto& entry : fs::directory_iterator(fs::path(path).parent_path())) {
+      count += entry.path().filename().string().starts_with("replaced.bin.");
+    }
+    return count;
+  };
   const auto write = [&](std::uint64_t value, bool finish) {
     SectionWriter out(path);
-    EXPECT_NE(out.partial_path(), path);
+    EXPECT_TRUE(out.unnamed());  // the test directory's file system has O_TMPFILE
     out.add_value("a/value", value);
-    EXPECT_TRUE(fs::exists(out.partial_path()));
+    EXPECT_EQ(others_beside(), 0u);
     if (finish) out.finish();
-    return out.partial_path();
   };
   write(1, true);
   const auto mapped = SectionFile::open(path);
-  const std::string unfinished = write(2, false);
-  EXPECT_FALSE(fs::exists(unfinished));
+  write(2, false);
+  EXPECT_EQ(others_beside(), 0u);
   EXPECT_EQ(SectionFile::open(path)->value<std::uint64_t>("a/value"), 1u);
-  const std::string finished = write(3, true);
-  EXPECT_FALSE(fs::exists(finished));
+  write(3, true);
+  EXPECT_EQ(others_beside(), 0u);
   EXPECT_EQ(SectionFile::open(path)->value<std::uint64_t>("a/value"), 3u);
   EXPECT_EQ(mapped->value<std::uint64_t>("a/value"), 1u);
+  // A directory in the way is an error at once, not at the end of a build.
+  EXPECT_THROW(SectionWriter(fs::path(path).parent_path().string()), std::runtime_error);
 }
 
 TEST(SectionFile, ArraysComeBackInPlaceAndChecked) {

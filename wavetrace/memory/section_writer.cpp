@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 #include <set>
 #include <stdexcept>
 #include <utility>
@@ -26,10 +27,19 @@ std::uint64_t align_up_u64(std::uint64_t value, std::uint64_t alignment) { retur
 
 SectionWriter::SectionWriter(std::string path)
     : path_(std::move(path)), partial_path_(fmt::format("{}.{}.partial", path_, ::getpid())) {
-  fd_ = ::open(partial_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd_ < 0) {
-    throw std::runtime_error(fmt::format("{}: cannot create (as {}): {}", path_, partial_path_, std::strerror(errno)));
+  // Found now, not by the rename after a build of hours.
+  if (std::error_code error; std::filesystem::is_directory(path_, error)) {
+    throw std::runtime_error(fmt::format("{}: cannot create: it is a directory", path_));
   }
+  const std::filesystem::path parent = std::filesystem::path(path_).parent_path();
+  const std::string directory = parent.empty() ? std::string(".") : parent.string();
+  fd_ = ::open(directory.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0644);
+  unnamed_ = fd_ >= 0;
+  // EISDIR: a kernel without O_TMPFILE; EOPNOTSUPP: a file system without it.
+  if (fd_ < 0 && (errno == EOPNOTSUPP || errno == EISDIR)) {
+    fd_ = ::open(partial_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  }
+  if (fd_ < 0) throw std::runtime_error(fmt::format("{}: cannot create: {}", path_, std::strerror(errno)));
   // The header stays zero until finish(): a file cut short by a crash reads as "not a world".
   const Header zero{};
   write_at(0, &zero, sizeof(zero));
@@ -39,7 +49,7 @@ SectionWriter::SectionWriter(std::string path)
 SectionWriter::~SectionWriter() {
   if (fd_ < 0) return;
   ::close(fd_);
-  ::unlink(partial_path_.c_str());
+  if (!unnamed_) ::unlink(partial_path_.c_str());
 }
 
 void SectionWriter::write_at(std::uint64_t offset, const void* data, std::size_t bytes) {
@@ -88,15 +98,23 @@ void SectionWriter::finish() {
     throw std::runtime_error(fmt::format("{}: cannot set its size: {}", path_, std::strerror(errno)));
   }
   write_at(0, &header, sizeof(header));
-  const int fd = std::exchange(fd_, -1);
   const auto fail = [&](std::string_view what, int error) {
-    ::unlink(partial_path_.c_str());
     throw std::runtime_error(fmt::format("{}: {} failed: {}", path_, what, std::strerror(error)));
   };
-  if (::close(fd) != 0) fail("close", errno);
-  if (::rename(partial_path_.c_str(), path_.c_str()) != 0) {
+  if (unnamed_) {
+    ::unlink(partial_path_.c_str());  // what a crashed writer of the same process id left there
+    // The documented way to name an O_TMPFILE file without CAP_DAC_READ_SEARCH (open(2)).
+    const std::string self = fmt::format("/proc/self/fd/{}", fd_);
+    if (::linkat(AT_FDCWD, self.c_str(), AT_FDCWD, partial_path_.c_str(), AT_SYMLINK_FOLLOW) != 0) {
+      const int error = errno;
+      ::close(std::exchange(fd_, -1));
+      fail(fmt::format("naming the written file {}", partial_path_), error);
+    }
+  }
+  if (::close(std::exchange(fd_, -1)) != 0 || ::rename(partial_path_.c_str(), path_.c_str()) != 0) {
     const int error = errno;
-    fail(fmt::format("rename from {}", partial_path_), error);
+    ::unlink(partial_path_.c_str());
+    fail(fmt::format("closing and renaming {}", partial_path_), error);
   }
 }
 

@@ -1,12 +1,14 @@
 // Writes a section file (section_file_format.hpp) front to back: each section's bytes go
 // to the file as they are added, with their checksum, so a saved world never needs a
 // second copy of itself in memory (a chunked world is written chunk by chunk while it is
-// built, ChunkStream); the table and header are written by finish(). The bytes go to a
-// temporary file beside `path`, renamed over it by finish(): a build that fails keeps the
-// world that was at `path` before, and a process that has that world mapped keeps reading
-// it (truncating it in place would fault its pages). A writer destroyed before finish() (an
-// error during the build or save) removes its temporary file: a world of tens of gigabytes
-// left half written would only fill the disk.
+// built, ChunkStream); the table and header are written by finish(). The bytes go to an
+// unnamed file (O_TMPFILE) in `path`'s directory, given a name and renamed over `path` by
+// finish(): a build that fails keeps the world that was at `path` before, a process that has
+// that world mapped keeps reading it (truncating it in place would fault its pages), and a
+// build that ends any other way (an error, SIGINT, SIGTERM, SIGKILL, a crash) leaves nothing
+// behind: a world of tens of gigabytes left half written would only fill the disk. Where the
+// file system has no O_TMPFILE, the file is named "PATH.PID.partial" from the start and
+// removed by the destructor instead.
 #pragma once
 
 #include <cstddef>
@@ -24,8 +26,8 @@ namespace wavetrace {
 
 class SectionWriter {
  public:
-  // Creates the temporary file beside `path` ("PATH.PID.partial"); throws std::runtime_error
-  // naming `path` when it cannot.
+  // Creates the unnamed file in `path`'s directory; throws std::runtime_error naming `path`
+  // when it cannot.
   explicit SectionWriter(std::string path);
   ~SectionWriter();
   SectionWriter(const SectionWriter&) = delete;
@@ -44,18 +46,22 @@ class SectionWriter {
     add_array(name, std::span<const T>(&value, 1));
   }
 
-  // Writes the table and header, closes the file and renames it to `path`; until then the
-  // file is not valid (its header is zero), so an interrupted save is refused when read.
+  // Writes the table and header, links the file as "PATH.PID.partial" and renames that over
+  // `path`. Until then the file is not valid (its header is zero), so a named partial file
+  // left by a crash is refused when read.
   void finish();
 
-  // Where the bytes are written until finish() (for tests and error messages).
+  // The name the file has before it becomes `path`: from the start where the file system
+  // has no O_TMPFILE, only inside finish() otherwise.
   const std::string& partial_path() const { return partial_path_; }
+  bool unnamed() const { return unnamed_; }
 
  private:
   void write_at(std::uint64_t offset, const void* data, std::size_t bytes);
 
   std::string path_, partial_path_;
   int fd_ = -1;
+  bool unnamed_ = false;
   std::uint64_t position_ = 0;
   std::vector<section_file::TableEntry> table_;
   std::unordered_set<std::string> names_;  // builtin:room:3G's world has 3,630 sections
