@@ -24,9 +24,10 @@ mkdir -p "$build/fuzz-findings" "$build/fuzz-logs"
 make_world_seeds() {
   local seeds="$build/fuzz-seeds/world_file" accel
   mkdir -p "$seeds"
-  for accel in bvh bvh:width=8 hmq hmq:width=8 hmq:epsilon=0.01 raystrips raystrips:width=8 embree chunked proxy; do
+  for accel in bvh bvh:width=8 hmq hmq:width=8 hmq:epsilon=0.01 hmq8_together raystrips raystrips:width=8 embree chunked proxy; do
     local name=${accel//[:=]/_} scene=builtin:sphere:600 options=()
     case $accel in
+      hmq8_together) options=(--accel hmq:width=8:leaves_beside_nodes=true) ;;
       *:*) options=(--accel "${accel%%:*}" --set "accel.${accel%%:*}.${accel#*:}") ;;
       chunked) scene=builtin:sphere:2500 options=(--accel hmq --set build.chunk_triangles=1024) ;;
       proxy) options=(--accel bvh --proxy) ;;
