@@ -103,9 +103,11 @@ void SectionWriter::finish() {
   };
   if (unnamed_) {
     ::unlink(partial_path_.c_str());  // what a crashed writer of the same process id left there
-    // The documented way to name an O_TMPFILE file without CAP_DAC_READ_SEARCH (open(2)).
+    // The documented way to name an O_TMPFILE file without CAP_DAC_READ_SEARCH (open(2)); a
+    // process without /proc but with that capability (root) names it through the descriptor.
     const std::string self = fmt::format("/proc/self/fd/{}", fd_);
-    if (::linkat(AT_FDCWD, self.c_str(), AT_FDCWD, partial_path_.c_str(), AT_SYMLINK_FOLLOW) != 0) {
+    if (::linkat(AT_FDCWD, self.c_str(), AT_FDCWD, partial_path_.c_str(), AT_SYMLINK_FOLLOW) != 0 &&
+        ::linkat(fd_, "", AT_FDCWD, partial_path_.c_str(), AT_EMPTY_PATH) != 0) {
       const int error = errno;
       ::close(std::exchange(fd_, -1));
       fail(fmt::format("naming the written file {}", partial_path_), error);
