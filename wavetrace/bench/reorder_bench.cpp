@@ -177,8 +177,9 @@ std::string to_table(const ReorderBenchReport& report) {
   table += fmt::format("{:<11} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>8} {:>9} {:>10} {:>9} {:>11} {:>11} {:>9} {:>10}",
                        "heuristic", "render s", "trace s", "Mr/s/thr", "closest", "shadow", "approx s", "sort s",
                        "overhead", "faults", "sim I/O s", "misses", "vs first", "speedup", "identical");
-  table += disk ? fmt::format(" {:>11} {:>9} {:>9} {:>9} {:>9} {:>10} {:>10} {:>10} {:>10}\n", "disk faults", "disk MB",
-                              "read s", "wait s", "disk vs 1st", "rays/page", "pages/1k", "read ahead", "ahead hits")
+  table += disk ? fmt::format(" {:>11} {:>9} {:>9} {:>9} {:>11} {:>10} {:>10} {:>10} {:>10} {:>9}\n", "disk faults",
+                              "disk MB", "read s", "wait s", "disk vs 1st", "rays/page", "pages/1k", "read ahead",
+                              "ahead hits", "in flight")
                 : "\n";
   const ReorderBenchResult* first = report.results.empty() ? nullptr : &report.results.front();
   const auto optional = [](const auto& value, const char* format) {
@@ -197,12 +198,13 @@ std::string to_table(const ReorderBenchReport& report) {
                          ratio(first->page_faults, r.page_faults), first->render_seconds / r.render_seconds,
                          r.image_identical ? "yes" : "NO");
     if (disk) {
-      table += fmt::format(" {:>11} {:>9.1f} {:>9.2f} {:>9.2f} {:>11} {:>10.0f} {:>10}", optional(r.disk_faults, "{}"),
+      table += fmt::format(" {:>11} {:>9.1f} {:>9.2f} {:>9.2f} {:>11} {:>10.0f} {:>10} {:>10} {:>10} {:>9}",
+                           optional(r.disk_faults, "{}"),
                            double(r.disk_bytes_read.value_or(0)) * 1e-6, r.disk_read_seconds.value_or(0.0),
                            r.disk_wait_seconds.value_or(0.0), ratio(first->disk_faults, r.disk_faults),
                            double(r.rays_traced) / double(std::max<std::size_t>(report.page_count, 1)),
                            optional(r.disk_pages_per_1000_rays, "{:.1f}"), optional(r.disk_prefetched, "{}"),
-                           optional(r.disk_prefetch_hits, "{}"));
+                           optional(r.disk_prefetch_hits, "{}"), optional(r.disk_reads_in_flight_max, "{}"));
     }
     table += "\n";
   }
@@ -213,7 +215,7 @@ std::string to_table(const ReorderBenchReport& report) {
              "seconds (inside render s); wait s: trace's threads waiting for pages (their own reads included);\n"
              "rays/page: rays traced per page of the world file; pages/1k: distinct pages 1,000 consecutive traced rays touch;\n"
              "read ahead: of the faults, pages trace's look-ahead read before trace reached them (memory.look_ahead);\n"
-             "ahead hits: of those, pages trace read before they were evicted\n";
+             "ahead hits: of those, pages trace read before they were evicted; in flight: the most reads under way at once\n";
   }
   return table;
 }

@@ -23,6 +23,8 @@ struct MemoryPlan {
   std::size_t page_bytes = std::size_t{4} << 20;
   // Real paging: sorted batches queued for trace whose pages its look-ahead reads first (0: none).
   std::size_t look_ahead_batches = 0;
+  // Threads reading ahead, each on its own queued batch: reads in flight beside trace's own.
+  std::size_t look_ahead_threads = 1;
   bool simulate_beside_file = false;  // real paging: also count the reads in the simulated pager
   IoModel io = io_preset("disk");  // memory.io
   std::optional<CacheGeometry> cache;  // no cache simulation without one

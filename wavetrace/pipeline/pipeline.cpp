@@ -273,9 +273,11 @@ PipelineRun Pipeline::run(const std::function<void(const Progress&)>& on_progres
       readers_ahead.clear();  // joins
     };
     for (std::size_t i = 1; i < chain_.size(); ++i) {
-      const std::size_t depth = chain_[i]->look_ahead_batches();
-      if (hand_offs[i - 1] == nullptr || depth == 0) continue;
-      readers_ahead.emplace_back([&, stage = chain_[i], hand_off = hand_offs[i - 1].get(), depth] {
+      const Stage* stage = chain_[i];
+      const std::size_t depth = stage->look_ahead_batches();
+      OrderedHandOff* hand_off = hand_offs[i - 1].get();
+      if (hand_off == nullptr || depth == 0) continue;
+      const auto read_ahead = [&, stage, hand_off, depth] {
         Batch* copy = context.pool().acquire();
         try {
           while (hand_off->next_ahead(depth, [&](const Batch& upcoming) { stage->copy_ahead(upcoming, *copy); })) {
@@ -287,7 +289,8 @@ PipelineRun Pipeline::run(const std::function<void(const Progress&)>& on_progres
           look_ahead_error = std::current_exception();
         }
         context.pool().release(copy);
-      });
+      };
+      for (std::size_t reader = 0; reader < stage->look_ahead_threads(); ++reader) readers_ahead.emplace_back(read_ahead);
     }
     generate_node->try_put(tbb::flow::continue_msg());
     try {

@@ -336,6 +336,10 @@ const std::vector<ConfigKey>& config_schema() {
        "traces ahead (every 4th ray, hits thrown away) so that their pages are read before trace needs them; 0: none "
        "(on a disk that one read at a time already keeps busy it costs time: docs/measurements.md)",
        integer<&P::memory, &MemoryPlan::look_ahead_batches>},
+      {"memory.look_ahead_threads", T::integer, std::int64_t{1}, 1, 16, {},
+       "real paging with memory.look_ahead: threads reading ahead, each on the next queued batch none has seen, so "
+       "that this many reads are in flight beside trace's own (for a disk that serves reads in parallel)",
+       integer<&P::memory, &MemoryPlan::look_ahead_threads>},
       {"memory.simulate_beside_file", T::boolean, false, 0, 0, {},
        "real paging: also run the simulated pager over the same reads (a cross-check of the real faults; it costs "
        "render time, a lock per page change)",

@@ -30,11 +30,13 @@ class Stage {
 
   // Reading ahead: a stage that takes a buffering stage's batches in their order (the
   // pipeline's ordered hand-off) may look at the first look_ahead_batches() batches queued
-  // for it, on a thread of its own, while the batches before them are processed. A trace whose world is paged from disk reads
+  // for it, on look_ahead_threads() threads of their own (each on the next batch none has
+  // seen), while the batches before them are processed. A trace whose world is paged from disk reads
   // their pages then, so that its own reads find them loaded. `copy_ahead` runs while the
   // queued batch cannot change (copy what the look needs into `copy`); `look_ahead` then
   // runs on the copy. Neither may change what the stage computes. 0: no look-ahead.
   virtual std::size_t look_ahead_batches() const { return 0; }
+  virtual std::size_t look_ahead_threads() const { return 1; }
   virtual void copy_ahead(const Batch& /*upcoming*/, Batch& /*copy*/) const {}
   virtual void look_ahead(Batch& /*copy*/) const {}
 };

@@ -85,28 +85,39 @@ void check_tree(std::span<const WideBvhNode> nodes, const SectionLoader& in, std
   }
 }
 
+// The used slots of a quantized 8-wide node, `name` `index` in errors: inner children by their
+// place (child_base counts them), leaf children by reference and weight. Empty slots (meta 0)
+// are never entered.
+template <typename OnInner, typename OnLeaf>
+void for_each_used_slot(const QuantizedWideNode& node, std::uint64_t index, std::string_view name,
+                        const SectionLoader& in, std::string_view section, OnInner&& on_inner, OnLeaf&& on_leaf) {
+  std::uint64_t inner = 0, weight = 0;
+  for (int k = 0; k < QuantizedWideNode::kWidth; ++k) {
+    const std::uint8_t meta = node.meta[k];
+    if (meta == 0) continue;
+    if (meta == QuantizedWideNode::kInnerMeta) {
+      on_inner(std::uint64_t(node.child_base) + inner++);
+    } else {
+      const std::uint64_t reference = node.leaf_base + weight;
+      // The walk marks leaf references with bit 31 (kWideLeafReference).
+      if (reference >= (std::uint64_t{1} << 31)) {
+        in.fail(section, fmt::format("{} {} has a leaf reference past 2^31", name, index));
+      }
+      on_leaf(static_cast<std::uint32_t>(reference), meta);
+      weight += meta;
+    }
+  }
+}
+
 // A quantized 8-wide tree (quantized_wide_node.hpp); `check_leaf(reference, weight)` fails
-// for a leaf child naming what does not exist. Empty slots (meta 0) are never entered.
+// for a leaf child naming what does not exist.
 template <typename CheckLeaf>
 void check_tree(std::span<const QuantizedWideNode> nodes, const SectionLoader& in, std::string_view section,
                 CheckLeaf&& check_leaf) {
   TreeDepths depths(nodes.size(), in, section);
   for (std::size_t i = 0; i < nodes.size(); ++i) {
-    const QuantizedWideNode& node = nodes[i];
-    std::uint64_t inner = 0, weight = 0;
-    for (int k = 0; k < QuantizedWideNode::kWidth; ++k) {
-      const std::uint8_t meta = node.meta[k];
-      if (meta == 0) continue;
-      if (meta == QuantizedWideNode::kInnerMeta) {
-        depths.link(i, node.child_base + inner++);
-      } else {
-        const std::uint64_t reference = node.leaf_base + weight;
-        // The walk marks leaf references with bit 31 (kWideLeafReference).
-        if (reference >= (std::uint64_t{1} << 31)) in.fail(section, fmt::format("node {} has a leaf reference past 2^31", i));
-        check_leaf(static_cast<std::uint32_t>(reference), meta);
-        weight += meta;
-      }
-    }
+    for_each_used_slot(nodes[i], i, "node", in, section, [&](std::uint64_t child) { depths.link(i, child); },
+                       check_leaf);
   }
 }
 
@@ -125,30 +136,19 @@ std::size_t check_tree_from_root(std::span<const QuantizedWideNode> units, const
     const auto [i, depth] = pending.back();
     pending.pop_back();
     ++nodes;
-    const QuantizedWideNode& node = units[i];
-    std::uint64_t inner = 0, weight = 0;
-    for (int k = 0; k < QuantizedWideNode::kWidth; ++k) {
-      const std::uint8_t meta = node.meta[k];
-      if (meta == 0) continue;
-      if (meta == QuantizedWideNode::kInnerMeta) {
-        const std::uint64_t child = std::uint64_t(node.child_base) + inner++;
-        if (child <= i || child >= units.size() || reached[child]) {
-          in.fail(section, fmt::format("node at unit {} names child {}, which does not lie after it among the {} units "
-                                       "or is named twice",
-                                       i, child, units.size()));
-        }
-        if (depth + 1 >= kMaxTreeDepth) in.fail(section, fmt::format("is deeper than {} levels", kMaxTreeDepth));
-        reached[child] = true;
-        pending.emplace_back(child, depth + 1);
-      } else {
-        const std::uint64_t reference = node.leaf_base + weight;
-        if (reference >= (std::uint64_t{1} << 31)) {
-          in.fail(section, fmt::format("node at unit {} has a leaf reference past 2^31", i));
-        }
-        check_leaf(static_cast<std::uint32_t>(reference), meta);
-        weight += meta;
-      }
-    }
+    for_each_used_slot(
+        units[i], i, "node at unit", in, section,
+        [&](std::uint64_t child) {
+          if (child <= i || child >= units.size() || reached[child]) {
+            in.fail(section, fmt::format("node at unit {} names child {}, which does not lie after it among the {} "
+                                         "units or is named twice",
+                                         i, child, units.size()));
+          }
+          if (depth + 1 >= kMaxTreeDepth) in.fail(section, fmt::format("is deeper than {} levels", kMaxTreeDepth));
+          reached[child] = true;
+          pending.emplace_back(child, depth + 1);
+        },
+        check_leaf);
   }
   return nodes;
 }
