@@ -14,6 +14,7 @@
 #include "wavetrace/bench/ray_sets.hpp"
 #include "wavetrace/scene/builtin_scenes.hpp"
 #include "wavetrace/scene/load_scene.hpp"
+#include "accel_agreement.hpp"
 #include "test_support.hpp"
 
 namespace wavetrace {
@@ -164,6 +165,32 @@ INSTANTIATE_TEST_SUITE_P(Scenes, BvhAgreesWithEmbree,
                          [](const ::testing::TestParamInfo<std::string>& info) {
                            return std::string(info.index == 0 ? "sphere" : info.index == 1 ? "soup" : "bunny");
                          });
+
+// The tinybvh peer, where this build carries it (-DWAVETRACE_TINYBVH), answers what Embree
+// answers: the same hit or miss (its Moeller-Trumbore test is not watertight: 999 in 1000) and
+// the same distance where both hit the same triangle, for both of its layouts.
+TEST(TinyBvhPeer, AgreesWithEmbreeWhereBuiltIn) {
+  if (!tinybvh_built_in()) GTEST_SKIP() << "configured without -DWAVETRACE_TINYBVH";
+  const Scene scene = make_builtin_scene("builtin:sphere:100k");
+  for (const TinyBvhLayout layout : {TinyBvhLayout::bvh8, TinyBvhLayout::bvh2}) {
+    AcceleratorOptions options;
+    options.type = "tinybvh";
+    options.tinybvh.layout = layout;
+    const auto peer = make_accelerator(scene.mesh, options);
+    EXPECT_EQ(peer->name(), "tinybvh-" + to_string(layout));
+    EXPECT_GT(peer->memory().hierarchy, 0u);
+    for (const RaySetKind kind : {RaySetKind::primary, RaySetKind::random, RaySetKind::diffuse, RaySetKind::shadow}) {
+      const Agreement result = agreement(scene, *peer, kind, 20000);
+      EXPECT_GE(result.hit, 0.999) << to_string(kind) << " " << to_string(layout);
+    }
+    const auto reference = make_accelerator(scene.mesh, AcceleratorOptions{});
+    const testing::Agreement close =
+        testing::compare_on_rays(scene, *reference, *peer, RaySetKind::primary, 20000, 1e-4f, 1e-3f);
+    EXPECT_GT(close.same_primitive, close.rays / 5) << to_string(layout);  // the sphere fills 29% of the frame
+    EXPECT_LE(close.far_t, close.rays / 1000) << to_string(layout);
+    EXPECT_LE(close.far_uv, close.rays / 1000) << to_string(layout);
+  }
+}
 
 TEST(Bvh, AnyHitAgreesWithClosestHitOnOcclusion) {
   const Scene scene = make_builtin_scene("builtin:default:20000");

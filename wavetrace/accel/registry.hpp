@@ -16,6 +16,7 @@
 #include "wavetrace/accel/grid/hashed_grid.hpp"
 #include "wavetrace/accel/hmq/hmq_accelerator.hpp"
 #include "wavetrace/accel/raystrips/raystrips_accelerator.hpp"
+#include "wavetrace/accel/tinybvh/tinybvh_accelerator.hpp"
 #include "wavetrace/scene/triangle_mesh.hpp"
 #include "wavetrace/scene/triangle_source.hpp"
 
@@ -32,6 +33,7 @@ struct AcceleratorOptions {
   ArrayGridOptions arraygrid;
   RayStripsOptions raystrips;
   HmqOptions hmq;
+  TinyBvhOptions tinybvh;
   // Scenes of more triangles are built in chunks of at most this many (hmq, raystrips, bvh).
   std::size_t chunk_triangles = std::size_t{1} << 22;
   bool operator==(const AcceleratorOptions&) const = default;

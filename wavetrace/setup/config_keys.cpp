@@ -312,6 +312,10 @@ const std::vector<ConfigKey>& config_schema() {
        [](const RenderPlan& plan) -> Recorded {
          return plan.accelerator.hmq.width == 8 ? Recorded(plan.accelerator.hmq.leaves_beside_nodes) : std::nullopt;
        }},
+      {"accel.tinybvh.layout", T::text, std::string("bvh8"), 0, 0, {"bvh8", "bvh2"},
+       "the peer built in with -DWAVETRACE_TINYBVH (bench accel's comparison): BVH8_CPU, its 8-wide AVX2 walk, or "
+       "its binary BVH",
+       choice<parse_tinybvh_layout, &P::accelerator, &A::tinybvh, &TinyBvhOptions::layout>},
       {"accel.bvh.width", T::integer, std::int64_t{2}, 2, 8, {}, "2: binary 32-byte nodes; 8: AVX2 8-wide nodes",
        integer<&P::accelerator, &A::bvh, &BvhOptions::width>, recorded_integer<&P::accelerator, &A::bvh, &BvhOptions::width>},
 
