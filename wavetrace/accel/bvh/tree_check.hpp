@@ -133,7 +133,9 @@ std::size_t check_tree_from_root(std::span<const QuantizedWideNode> units, const
   reached[0] = true;
   std::size_t nodes = 0;
   while (!pending.empty()) {
-    const auto [i, depth] = pending.back();
+    // Named copies, not a structured binding: the lambda below captures them (clang 14 cannot).
+    const std::uint64_t i = pending.back().first;
+    const std::uint32_t depth = pending.back().second;
     pending.pop_back();
     ++nodes;
     for_each_used_slot(

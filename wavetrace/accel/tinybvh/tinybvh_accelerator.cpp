@@ -130,9 +130,6 @@ class TinyBvhAccelerator final : public Accelerator {
 }  // namespace
 
 bool tinybvh_built_in() { return true; }
-std::string tinybvh_version() {
-  return fmt::format("{}.{}.{}", TINY_BVH_VERSION_MAJOR, TINY_BVH_VERSION_MINOR, TINY_BVH_VERSION_SUB);
-}
 
 std::unique_ptr<Accelerator> make_tinybvh_accelerator(const TriangleMesh& mesh, const TinyBvhOptions& options) {
   return std::make_unique<TinyBvhAccelerator>(mesh, options);
@@ -141,7 +138,6 @@ std::unique_ptr<Accelerator> make_tinybvh_accelerator(const TriangleMesh& mesh, 
 #else
 
 bool tinybvh_built_in() { return false; }
-std::string tinybvh_version() { return {}; }
 
 std::unique_ptr<Accelerator> make_tinybvh_accelerator(const TriangleMesh&, const TinyBvhOptions&) {
   throw std::invalid_argument(

@@ -23,9 +23,8 @@ struct TinyBvhOptions {
 TinyBvhLayout parse_tinybvh_layout(const std::string& text);  // "bvh8" | "bvh2"
 std::string to_string(TinyBvhLayout layout);
 
-// Whether this build carries tinybvh (WAVETRACE_TINYBVH was given to CMake), and its version.
+// Whether this build carries tinybvh (WAVETRACE_TINYBVH was given to CMake).
 bool tinybvh_built_in();
-std::string tinybvh_version();
 
 // Builds tinybvh's structure over `mesh`, which must outlive the accelerator (hit surfaces
 // are read from it). Throws std::invalid_argument naming the CMake option when this build
