@@ -22,11 +22,11 @@ struct TriangleLanes {
   alignas(32) float corner[3][3][8];
 };
 
-// Per lane, what the scalar test computes before its final tmax comparison.
+// Per lane, what the scalar test computes before its final tmax comparison (on t, which the
+// caller makes against its tmax of the moment).
 struct WatertightLanes {
   alignas(32) float t[8], u[8], v[8];
-  alignas(32) float signed_t[8], abs_determinant[8];
-  unsigned candidates = 0;  // inside, det != 0, t in [tmin, tmax]
+  unsigned candidates = 0;  // inside, det != 0, t * |det| in [tmin, tmax * slack] * |det|
   unsigned on_edge = 0;     // an edge weight is exactly zero in float: redo with intersect_watertight
 };
 
@@ -69,15 +69,16 @@ struct WatertightLanes {
   // The scalar test rejects on `<` or `>`; a NaN compares false there and passes, so here too.
   const __m256 outside_interval =
       _mm256_or_ps(_mm256_cmp_ps(signed_t, _mm256_mul_ps(_mm256_set1_ps(tmin), abs_determinant), _CMP_LT_OQ),
-                   _mm256_cmp_ps(signed_t, _mm256_mul_ps(_mm256_set1_ps(tmax), abs_determinant), _CMP_GT_OQ));
+                   _mm256_cmp_ps(signed_t,
+                                 _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(tmax), abs_determinant),
+                                               _mm256_set1_ps(kDistancePrecheckSlack)),
+                                 _CMP_GT_OQ));
   const __m256 rejected = _mm256_or_ps(_mm256_or_ps(_mm256_and_ps(any_negative, any_positive), outside_interval),
                                        _mm256_cmp_ps(determinant, zero, _CMP_EQ_OQ));
   const __m256 inverse = _mm256_div_ps(_mm256_set1_ps(1.0f), determinant);
   _mm256_store_ps(out.t, _mm256_mul_ps(scaled_t, inverse));
   _mm256_store_ps(out.u, _mm256_mul_ps(v, inverse));
   _mm256_store_ps(out.v, _mm256_mul_ps(w, inverse));
-  _mm256_store_ps(out.signed_t, signed_t);
-  _mm256_store_ps(out.abs_determinant, abs_determinant);
   out.on_edge = static_cast<unsigned>(_mm256_movemask_ps(on_edge)) & used;
   out.candidates = ~static_cast<unsigned>(_mm256_movemask_ps(rejected)) & used & ~out.on_edge;
 }

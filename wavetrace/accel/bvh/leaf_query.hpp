@@ -9,6 +9,7 @@
 
 #include "wavetrace/accel/bvh/indexed_face_set.hpp"
 #include "wavetrace/accel/ray_loop.hpp"
+#include "wavetrace/kernels/nearest_hit.hpp"
 #include "wavetrace/kernels/triangle_intersect.hpp"
 #include "wavetrace/memory/ray_batch.hpp"
 
@@ -44,7 +45,10 @@ class LeafQuery {
         for (int corner = 0; corner < 3; ++corner) probe.read(positions + tri[corner], sizeof(glm::vec3));
       }
       TriangleHit hit;
-      if (intersect_watertight(ray_, positions[tri.x], positions[tri.y], positions[tri.z], tmin, tmax, hit)) {
+      if (intersect_watertight(ray_, positions[tri.x], positions[tri.y], positions[tri.z], tmin, tmax, hit) &&
+          replaces_nearest(
+              hit.t, tmax, found(), [&] { return geometry_.input_id(triangle); },
+              [&] { return geometry_.input_id(found_); })) {
         tmax = hit.t;
         best_ = hit;
         found_ = triangle;

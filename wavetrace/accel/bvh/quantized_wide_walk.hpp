@@ -19,6 +19,7 @@
 #include "wavetrace/accel/bvh/sah_builder.hpp"
 #include "wavetrace/accel/ray_loop.hpp"
 #include "wavetrace/kernels/ray_box.hpp"
+#include "wavetrace/kernels/nearest_hit.hpp"
 
 namespace wavetrace {
 
@@ -101,7 +102,7 @@ inline constexpr std::array<SortStage, 6> kDescendingStages = [] {
 }
 
 // The robust slab test of one ray against the eight boxes: writes the entry distances to
-// `near` and returns the mask of the lanes entered within [tmin, tmax].
+// `near` and returns the mask of the lanes entered within [tmin, pruning_distance(tmax)].
 [[gnu::always_inline]] inline unsigned enter_children(const __m256 bound[6], const __m256 origin[3],
                                                       const __m256 inverse[3], float tmin, float tmax, __m256& near) {
   near = _mm256_set1_ps(tmin);
@@ -114,7 +115,7 @@ inline constexpr std::array<SortStage, 6> kDescendingStages = [] {
     near = _mm256_max_ps(_mm256_min_ps(t1, t0), near);
     far = _mm256_min_ps(_mm256_max_ps(t0, t1), far);
   }
-  far = _mm256_min_ps(_mm256_mul_ps(far, _mm256_set1_ps(kSlabFarScale)), _mm256_set1_ps(tmax));
+  far = _mm256_min_ps(_mm256_mul_ps(far, _mm256_set1_ps(kSlabFarScale)), _mm256_set1_ps(pruning_distance(tmax)));
   return static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(near, far, _CMP_LE_OQ)));
 }
 
@@ -187,7 +188,7 @@ template <typename Probe, typename VisitLeaf>
     } else if (visit_leaf(current & ~kWideLeafReference, frame)) {
       return;
     }
-    while (top > 0 && stack.distance[top - 1] > tmax) --top;
+    while (top > 0 && stack.distance[top - 1] > pruning_distance(tmax)) --top;
     if (top == 0) return;
     --top;
     current = stack.reference[top];
@@ -284,7 +285,7 @@ template <typename Probe, typename VisitLeaf>
       unsigned still = 0;
       for (unsigned bits = current.rays; bits != 0; bits &= bits - 1) {
         const int r = std::countr_zero(bits);
-        if (!(current.distance[r] > tmax[r])) still |= 1u << r;
+        if (!(current.distance[r] > pruning_distance(tmax[r]))) still |= 1u << r;
       }
       current.rays = still;
       if (still != 0) break;

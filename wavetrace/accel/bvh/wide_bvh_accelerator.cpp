@@ -22,6 +22,7 @@
 #include "wavetrace/kernels/ray_box.hpp"
 #include "wavetrace/accel/bvh/leaf_query.hpp"
 #include "wavetrace/memory/cache_aligned_allocator.hpp"
+#include "wavetrace/kernels/nearest_hit.hpp"
 
 namespace wavetrace {
 namespace {
@@ -199,7 +200,7 @@ class WideBvhAccelerator final : public ProbedAccelerator<WideBvhAccelerator> {
           alignas(32) float distance[kWidth];
           const WideBvhNode& node = nodes[current.child];
           probe.read(&node, sizeof node);
-          unsigned mask = intersect_children(node, box_ray, tmin, tmax, distance);
+          unsigned mask = intersect_children(node, box_ray, tmin, pruning_distance(tmax), distance);
           if (mask != 0 && (mask & (mask - 1)) == 0) {  // one child entered: no sorting
             const int k = std::countr_zero(mask);
             current = {node.child[k], node.count[k], distance[k]};
@@ -226,7 +227,7 @@ class WideBvhAccelerator final : public ProbedAccelerator<WideBvhAccelerator> {
           query.test_leaf<kAnyHit>(current.child, current.count, probe);
           if (kAnyHit && query.found()) break;
         }
-        while (top > 0 && stack[top - 1].distance > tmax) --top;
+        while (top > 0 && stack[top - 1].distance > pruning_distance(tmax)) --top;
         if (top == 0) break;
         current = stack[--top];
       }

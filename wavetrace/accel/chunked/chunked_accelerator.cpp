@@ -21,6 +21,7 @@
 #include "wavetrace/accel/bvh/node_layout.hpp"
 #include "wavetrace/accel/bvh/sah_builder.hpp"
 #include "wavetrace/accel/section_archive.hpp"
+#include "wavetrace/kernels/nearest_hit.hpp"
 #include "wavetrace/kernels/ray_box.hpp"
 #include "wavetrace/memory/process_memory.hpp"
 
@@ -352,7 +353,7 @@ class ChunkedAccelerator final : public Accelerator {
         scratch.due_chunk[r] = kNone;
         if (next == scratch.visit_begin[r + 1]) continue;
         const ChunkVisit& visit = scratch.visits[next];
-        if (visit.distance > scratch.nearest[r]) {
+        if (visit.distance > pruning_distance(scratch.nearest[r])) {
           next = scratch.visit_begin[r + 1];
           continue;
         }
@@ -393,7 +394,9 @@ class ChunkedAccelerator final : public Accelerator {
           if constexpr (kAnyHit) {
             hits.primitive[i] = first + sub_hits.primitive[slot];
             scratch.nearest[r] = -kInfinity;  // found: no further chunk is due
-          } else if (sub_hits.t[slot] < scratch.nearest[r]) {
+          } else if (replaces_nearest(
+                         sub_hits.t[slot], scratch.nearest[r], hits.is_hit(i),
+                         [&] { return first + sub_hits.primitive[slot]; }, [&] { return hits.primitive[i]; })) {
             hits.copy_hit(i, sub_hits, slot);
             hits.primitive[i] = first + sub_hits.primitive[slot];
             scratch.nearest[r] = sub_hits.t[slot];

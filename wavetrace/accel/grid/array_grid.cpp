@@ -19,6 +19,7 @@
 #include "wavetrace/kernels/ray_box.hpp"
 #include "wavetrace/kernels/triangle_intersect.hpp"
 #include "wavetrace/memory/cache_aligned_allocator.hpp"
+#include "wavetrace/kernels/nearest_hit.hpp"
 
 namespace wavetrace {
 namespace {
@@ -195,7 +196,8 @@ class ArrayGridAccelerator final : public ProbedAccelerator<ArrayGridAccelerator
       probe.read(&c, sizeof c);
       if (c.count > 0) {
         if (c.reference & 1u) {
-          if (traverse_grid<kAnyHit>(nodes_[c.reference >> 1], state, cell_enter, std::min(cell_leave, state.best),
+          if (traverse_grid<kAnyHit>(nodes_[c.reference >> 1], state, cell_enter,
+                                     std::min(cell_leave, pruning_distance(state.best)),
                                      probe)) {
             return true;
           }
@@ -209,7 +211,10 @@ class ArrayGridAccelerator final : public ProbedAccelerator<ArrayGridAccelerator
             }
             TriangleHit hit;
             if (intersect_watertight(state.ray, positions[tri.x], positions[tri.y], positions[tri.z], state.tmin,
-                                     state.best, hit)) {
+                                     state.best, hit) &&
+                replaces_nearest(
+                    hit.t, state.best, state.found_triangle != kInvalidPrimitive, [&] { return items_[k]; },
+                    [&] { return state.found_triangle; })) {
               state.best = hit.t;
               state.found = hit;
               state.found_triangle = items_[k];
@@ -218,7 +223,7 @@ class ArrayGridAccelerator final : public ProbedAccelerator<ArrayGridAccelerator
           }
         }
       }
-      if (walk.next_crossing[axis] >= state.best || walk.next_crossing[axis] > leave) return false;
+      if (walk.next_crossing[axis] > pruning_distance(state.best) || walk.next_crossing[axis] > leave) return false;
       cell_enter = walk.next_crossing[axis];
       if (!walk.advance(axis, node.cells)) return false;
     }

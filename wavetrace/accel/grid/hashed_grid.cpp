@@ -21,6 +21,7 @@
 #include "wavetrace/kernels/ray_box.hpp"
 #include "wavetrace/kernels/triangle_intersect.hpp"
 #include "wavetrace/memory/cache_aligned_allocator.hpp"
+#include "wavetrace/kernels/nearest_hit.hpp"
 
 namespace wavetrace {
 namespace {
@@ -271,7 +272,7 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
             const float t = walk.face_crossing(axis, walk.step[axis] > 0 ? upper[axis] + 1 : lower[axis]);
             if (t < exit) exit = t, exit_axis = axis;
           }
-          if (exit >= best || exit > far) break;
+          if (exit > pruning_distance(best) || exit > far) break;
           glm::ivec3 next = glm::clamp(glm::ivec3(cell_of(origin + direction * exit)), lower, upper);
           next[exit_axis] = walk.step[exit_axis] > 0 ? upper[exit_axis] + 1 : lower[exit_axis] - 1;
           if (next[exit_axis] < 0 || next[exit_axis] >= int(cells_[exit_axis])) break;
@@ -293,7 +294,10 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
               for (int corner = 0; corner < 3; ++corner) probe.read(positions + tri[corner], sizeof(glm::vec3));
             }
             TriangleHit hit;
-            if (intersect_watertight(ray, positions[tri.x], positions[tri.y], positions[tri.z], tmin, best, hit)) {
+            if (intersect_watertight(ray, positions[tri.x], positions[tri.y], positions[tri.z], tmin, best, hit) &&
+                replaces_nearest(
+                    hit.t, best, found_triangle != kInvalidPrimitive, [&] { return items_[k]; },
+                    [&] { return found_triangle; })) {
               best = hit.t;
               found = hit;
               found_triangle = items_[k];
@@ -304,7 +308,7 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
         }
         // Leave the cell: done once the nearest hit lies before the next cell begins.
         const int axis = walk.exit_axis();
-        if (walk.next_crossing[axis] >= best || walk.next_crossing[axis] > far) break;
+        if (walk.next_crossing[axis] > pruning_distance(best) || walk.next_crossing[axis] > far) break;
         if (!walk.advance(axis, cells_)) break;
       }
       if (found_triangle != kInvalidPrimitive) {

@@ -31,6 +31,7 @@
 #include "wavetrace/kernels/ray_box.hpp"
 #include "wavetrace/kernels/triangle_intersect.hpp"
 #include "wavetrace/memory/cache_aligned_allocator.hpp"
+#include "wavetrace/kernels/nearest_hit.hpp"
 
 namespace wavetrace {
 namespace {
@@ -360,14 +361,15 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
       std::uint32_t hit = 0;
       if (count == 2) {
         const std::uint32_t words[2] = {slot_word(block, slot, probe), slot_word(block, slot + 1, probe)};
-        const ChildPair children = decode_and_intersect_children(parent, words[0], words[1], box_ray, tmin, tmax);
+        const ChildPair children =
+            decode_and_intersect_children(parent, words[0], words[1], box_ray, tmin, pruning_distance(tmax));
         for (int k = 0; k < 2; ++k) {
           if (children.distance[k] != kInfinity) pair[hit++] = {block, words[k], children.distance[k], children.box[k]};
         }
       } else {  // a top leaf with one root
         const std::uint32_t word = slot_word(block, slot, probe);
         const Box box = decode_child_box(parent, word);
-        const float distance = intersect_box(box_ray, box.lower, box.upper, tmin, tmax);
+        const float distance = intersect_box(box_ray, box.lower, box.upper, tmin, pruning_distance(tmax));
         if (distance != kInfinity) pair[hit++] = {block, word, distance, box};
       }
       if (hit == 0) return false;
@@ -400,7 +402,7 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
         }
         if (have) continue;
       }
-      while (top > 0 && stack[top - 1].distance > tmax) --top;
+      while (top > 0 && stack[top - 1].distance > pruning_distance(tmax)) --top;
       if (top == 0) return;
       current = stack[--top];
       have = true;

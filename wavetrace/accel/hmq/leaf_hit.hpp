@@ -15,6 +15,7 @@
 #include "wavetrace/accel/hmq/global_grid.hpp"
 #include "wavetrace/accel/hmq/hmq_format.hpp"
 #include "wavetrace/accel/hmq/leaf_codec.hpp"
+#include "wavetrace/kernels/nearest_hit.hpp"
 #include "wavetrace/kernels/triangle_intersect.hpp"
 #include "wavetrace/kernels/watertight_lanes.hpp"
 #include "wavetrace/memory/ray_batch.hpp"
@@ -31,6 +32,12 @@ struct LeafHit {
   std::uint32_t triangle = 0;
   glm::vec3 corner[3];  // the strip triangle's decoded corners, for the hit's point and normal
   bool found = false;
+
+  std::uint32_t triangle_id() const {
+    std::uint32_t delta[kMaxLeafTriangles];
+    read_stream(ids, header.id_bits, triangle + 1, delta);
+    return header.id_base + delta[triangle];
+  }
 };
 
 // A leaf decoded once, with its triangles' corners gathered into lanes (eight triangles a
@@ -73,21 +80,28 @@ template <typename Probe>
 #endif
 }
 
-// Tests a prepared leaf's triangles against one ray; a hit nearer than `tmax` shrinks it and
-// replaces `best` (with kAnyHit, the first one ends the test).
+// Tests a prepared leaf's triangles against one ray; a hit that replaces `best` by the
+// nearest-hit rule (nearest_hit.hpp) shrinks `tmax` to it (with kAnyHit, the first hit ends
+// the test).
 template <bool kAnyHit>
 [[gnu::always_inline]] inline void test_leaf_triangles(const LeafTriangles& leaf, const WatertightRay& sheared,
                                                        float tmin, float& tmax, LeafHit& best) {
   const DecodedLeaf& decoded = leaf.decoded;
   const std::uint32_t triangles = decoded.layout->triangles;
+  // False when the hit loses to `best`; else it becomes `best`.
   auto accept = [&](std::uint32_t k, const TriangleHit& hit) {
+    if (!replaces_nearest(
+            hit.t, tmax, best.found, [&] { return decoded.triangle_id(k); }, [&] { return best.triangle_id(); })) {
+      return false;
+    }
     tmax = hit.t;
     best = {hit.t, hit.u, hit.v, decoded.header, decoded.ids, decoded.corners, k,
             {leaf.corner(k, 0), leaf.corner(k, 1), leaf.corner(k, 2)}, true};
+    return true;
   };
 #if WAVETRACE_AVX2
   // Candidates of each pass are taken in triangle order against the shrinking tmax, exactly
-  // as the scalar loop takes them (same hit, same ties).
+  // as the scalar loop takes them (same hits, same t).
   for (std::uint32_t base = 0; base < triangles; base += 8) {
     const std::uint32_t count = std::min<std::uint32_t>(8, triangles - base);
     WatertightLanes result;
@@ -101,18 +115,18 @@ template <bool kAnyHit>
           continue;
         }
       } else {
-        if (result.signed_t[lane] > tmax * result.abs_determinant[lane]) continue;
+        if (result.t[lane] > tmax) continue;
         hit = {result.t[lane], result.u[lane], result.v[lane]};
       }
-      accept(k, hit);
+      if (!accept(k, hit)) continue;
       if constexpr (kAnyHit) return;
     }
   }
 #else
   for (std::uint32_t k = 0; k < triangles; ++k) {
     TriangleHit hit;
-    if (intersect_watertight(sheared, leaf.corner(k, 0), leaf.corner(k, 1), leaf.corner(k, 2), tmin, tmax, hit)) {
-      accept(k, hit);
+    if (intersect_watertight(sheared, leaf.corner(k, 0), leaf.corner(k, 1), leaf.corner(k, 2), tmin, tmax, hit) &&
+        accept(k, hit)) {
       if constexpr (kAnyHit) return;
     }
   }

@@ -31,6 +31,7 @@
 #include "wavetrace/accel/raystrips/strip_traversal.hpp"
 #include "wavetrace/kernels/checked_narrowing.hpp"
 #include "wavetrace/memory/cache_aligned_allocator.hpp"
+#include "wavetrace/kernels/nearest_hit.hpp"
 
 namespace wavetrace {
 namespace {
@@ -463,7 +464,7 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
       StripRay ray(single);
       walk_bvh(nodes_.data(), ray.box, ray.tmin, ray.tmax, probe, [&](const BvhNode& leaf) {
         float near, far;
-        if (!clip_to_box(ray.box, leaf.lower, leaf.upper, ray.tmin, ray.tmax, near, far)) return false;
+        if (!clip_to_box(ray.box, leaf.lower, leaf.upper, ray.tmin, pruning_distance(ray.tmax), near, far)) return false;
         const std::byte* strip_data = strip_bytes_.data() + std::size_t(leaf.first) * 4;
         return trace_strips<kAnyHit>(ray, Bounds3{leaf.lower, leaf.upper}, strip_data, leaf.triangle_count(), near, far,
                                      positions, probe);
@@ -482,7 +483,7 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
       StripRay ray(single);
       walk_quantized_wide(wide_nodes_.data(), root_, single, ray.tmax, probe, stack, [&](std::uint32_t leaf, const Bounds3& box) {
         float near, far;
-        if (!clip_to_box(ray.box, box.lower, box.upper, ray.tmin, ray.tmax, near, far)) return false;
+        if (!clip_to_box(ray.box, box.lower, box.upper, ray.tmin, pruning_distance(ray.tmax), near, far)) return false;
         probe.read(leaf_words + leaf, 2 * sizeof(std::uint32_t));
         const std::byte* strip_data = strip_bytes_.data() + std::size_t(leaf_words[leaf]) * 4;
         const std::byte* end = strip_bytes_.data() + std::size_t(leaf_words[leaf + 1]) * 4;

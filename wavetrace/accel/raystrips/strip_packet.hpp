@@ -46,7 +46,7 @@ struct PacketTraversal {
         lanes.inverse[axis][r] = ray.box.inverse_direction[axis];
       }
       lanes.tmin[r] = ray.tmin;
-      lanes.tmax[r] = ray.tmax;
+      lanes.tmax[r] = pruning_distance(ray.tmax);
       alive |= 1u << r;
     }
     struct Pending {
@@ -102,7 +102,7 @@ struct PacketTraversal {
   // The packet's rays, one lane each (dead lanes: zeros, never in a mask).
   struct Packet {
     Lanes origin[3], inverse[3];
-    Lanes tmin, tmax;  // tmax follows each ray's nearest hit
+    Lanes tmin, tmax;  // tmax: pruning_distance of each ray's nearest hit (nodes beyond it are pruned)
   };
 
   static std::uint32_t bits_of(LaneMask mask) {
@@ -153,7 +153,7 @@ struct PacketTraversal {
           StripRay& ray = *packet[r];
           ray.traverse_subtree<false>(strip, frame, positions, current.node, current.first, current.leaves, current.dmin[r],
                                       current.dmax[r], run_triangles, probe);
-          lanes.tmax[r] = ray.tmax;
+          lanes.tmax[r] = pruning_distance(ray.tmax);
         }
       } else if (current.leaves >= 2 &&
                  std::min(2 * (current.first + current.leaves), triangles) - 2 * current.first > run_triangles) {
@@ -204,7 +204,7 @@ struct PacketTraversal {
         for (std::uint32_t ray_bits = current.mask; ray_bits != 0; ray_bits &= ray_bits - 1) {
           const int r = std::countr_zero(ray_bits);
           packet[r]->test_run<false>(strip, positions, begin, end, probe);
-          lanes.tmax[r] = packet[r]->tmax;
+          lanes.tmax[r] = pruning_distance(packet[r]->tmax);
         }
       }
       // Pop the next subtree that some ray can still improve on.

@@ -23,6 +23,7 @@
 
 #include "wavetrace/accel/ray_loop.hpp"
 #include "wavetrace/accel/raystrips/ray_strip_format.hpp"
+#include "wavetrace/kernels/nearest_hit.hpp"
 #include "wavetrace/kernels/ray_box.hpp"
 #include "wavetrace/kernels/triangle_intersect.hpp"
 
@@ -81,7 +82,7 @@ class StripRay {
     Pending stack[18];  // 65535 triangles: 16 levels of nodes
     std::uint32_t top = 0;
     const std::uint32_t triangles = strip.triangles();
-    dmax = std::min(dmax, tmax);
+    dmax = std::min(dmax, pruning_distance(tmax));
     while (true) {
       // Descend while the span holds more triangles than one run tests.
       while (leaves >= 2 && std::min(2 * (first + leaves), triangles) - 2 * first > run_triangles) {
@@ -120,12 +121,12 @@ class StripRay {
       test_run<kAnyHit>(strip, positions, 2 * first, std::min(2 * (first + leaves), triangles), probe);
       if (kAnyHit && found()) return;
     pop:
-      while (top > 0 && stack[top - 1].dmin > tmax) --top;
+      while (top > 0 && stack[top - 1].dmin > pruning_distance(tmax)) --top;
       if (top == 0) return;
       --top;
       node = stack[top].node, first = stack[top].first, leaves = stack[top].leaves;
       dmin = stack[top].dmin;
-      dmax = std::min(stack[top].dmax, tmax);
+      dmax = std::min(stack[top].dmax, pruning_distance(tmax));
     }
   }
 
@@ -196,12 +197,16 @@ class StripRay {
     const Lanes abs_determinant = flip ? -determinant : determinant;
     const Lanes signed_t = flip ? -scaled_t : scaled_t;
     const LaneMask accepted = ~(negative & positive) & (determinant != 0.0f) & (signed_t >= tmin * abs_determinant) &
-                              (signed_t <= tmax * abs_determinant);
+                              (signed_t <= tmax * abs_determinant * kDistancePrecheckSlack);
     for (std::uint32_t j = 0; j < count; ++j) {
       if (!accepted[j]) continue;
       const float inverse = 1.0f / determinant[j];
       const float t = scaled_t[j] * inverse;
-      if (t > tmax) continue;
+      if (!replaces_nearest(
+              t, tmax, found(), [&] { return strip.triangle(first + j); },
+              [&] { return ray_strip::StripView(hit.strip).triangle(hit.triangle); })) {
+        continue;
+      }
       tmax = t;
       hit.strip = strip.data();
       hit.triangle = first + j;
