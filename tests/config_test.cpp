@@ -127,6 +127,10 @@ TEST(Config, KeysThatOverrideEachOtherAreAConflictWhenBothAreGiven) {
   plan_with({"accel.hmq.width=8"});
   expect_config_error([&] { plan_with({"accel.hmq.width=8", "accel.hmq.top_fraction=0.05"}); },
                       "applies to the binary layout");
+  // Keys that do nothing without another: an error naming both.
+  plan_with({"memory.look_ahead=2", "memory.look_ahead_threads=2"});
+  expect_config_error([&] { plan_with({"memory.look_ahead_threads=2"}); },
+                      "memory.look_ahead_threads = 2 reads ahead of trace only with memory.look_ahead, which is 0");
   // The same keys from a file count as given too.
   expect_config_error(
       [&] {

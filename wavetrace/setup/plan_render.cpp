@@ -118,6 +118,11 @@ void check_memory_plan(const Config& config, const MemoryPlan& plan) {
   if (plan.file_backing && !plan.budget) {
     throw ConfigError("memory.backing = file pages a world file under memory.budget: set one (for example 20%)");
   }
+  if (config.given("memory.look_ahead_threads") && plan.look_ahead_batches == 0) {
+    throw ConfigError(fmt::format("memory.look_ahead_threads = {} reads ahead of trace only with memory.look_ahead, "
+                                  "which is 0: set memory.look_ahead (for example 4)",
+                                  plan.look_ahead_threads));
+  }
   if (!plan.cache) return;
   if (plan.cache->name == "custom" && !(config.has("memory.cache_bytes") && config.has("memory.cache_ways"))) {
     throw ConfigError("memory.cache = 'custom' needs memory.cache_bytes and memory.cache_ways");
