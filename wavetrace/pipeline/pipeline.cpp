@@ -274,7 +274,8 @@ PipelineRun Pipeline::run(const std::function<void(const Progress&)>& on_progres
     };
     for (std::size_t i = 1; i < chain_.size(); ++i) {
       const Stage* stage = chain_[i];
-      const std::size_t depth = stage->look_ahead_batches();
+      const LookAhead plan = stage->look_ahead_plan();
+      const std::size_t depth = plan.batches;
       OrderedHandOff* hand_off = hand_offs[i - 1].get();
       if (hand_off == nullptr || depth == 0) continue;
       const auto read_ahead = [&, stage, hand_off, depth] {
@@ -290,7 +291,7 @@ PipelineRun Pipeline::run(const std::function<void(const Progress&)>& on_progres
         }
         context.pool().release(copy);
       };
-      for (std::size_t reader = 0; reader < stage->look_ahead_threads(); ++reader) readers_ahead.emplace_back(read_ahead);
+      for (std::size_t reader = 0; reader < plan.threads; ++reader) readers_ahead.emplace_back(read_ahead);
     }
     generate_node->try_put(tbb::flow::continue_msg());
     try {

@@ -27,7 +27,7 @@ StageChain::StageChain(const RenderPlan& plan, const World& world, Film& film, c
     if (name == "trace") {
       owned_.push_back(std::make_unique<TraceStage>(world.accelerator, world.scene.material_runs,
                                                     TraceInstruments{&hit_rates_, observers, &trace_times_},
-                                                    plan.memory.look_ahead_batches, plan.memory.look_ahead_threads));
+                                                    LookAhead{plan.memory.look_ahead_batches, plan.memory.look_ahead_threads}));
     }
     if (name == "shade") owned_.push_back(std::make_unique<ShadeStage>(world, film, rules));
     if (name == "spawn") {

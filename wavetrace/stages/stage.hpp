@@ -21,6 +21,12 @@ class StageOutput {
   virtual void release(Batch* batch) = 0;    // rays in it are finished
 };
 
+// How far and on how many threads a stage reads ahead of itself (Stage::look_ahead_plan).
+struct LookAhead {
+  std::size_t batches = 0;
+  std::size_t threads = 1;
+};
+
 class Stage {
  public:
   virtual ~Stage() = default;
@@ -29,14 +35,13 @@ class Stage {
   virtual void process(Batch* batch, StageOutput& out) const = 0;
 
   // Reading ahead: a stage that takes a buffering stage's batches in their order (the
-  // pipeline's ordered hand-off) may look at the first look_ahead_batches() batches queued
-  // for it, on look_ahead_threads() threads of their own (each on the next batch none has
-  // seen), while the batches before them are processed. A trace whose world is paged from disk reads
-  // their pages then, so that its own reads find them loaded. `copy_ahead` runs while the
-  // queued batch cannot change (copy what the look needs into `copy`); `look_ahead` then
-  // runs on the copy. Neither may change what the stage computes. 0: no look-ahead.
-  virtual std::size_t look_ahead_batches() const { return 0; }
-  virtual std::size_t look_ahead_threads() const { return 1; }
+  // pipeline's ordered hand-off) may look at the first `batches` batches queued for it, on
+  // `threads` threads of their own (each on the next batch none has seen), while the batches
+  // before them are processed. A trace whose world is paged from disk reads their pages then,
+  // so that its own reads find them loaded. `copy_ahead` runs while the queued batch cannot
+  // change (copy what the look needs into `copy`); `look_ahead` then runs on the copy.
+  // Neither may change what the stage computes. batches = 0: no look-ahead.
+  virtual LookAhead look_ahead_plan() const { return {}; }
   virtual void copy_ahead(const Batch& /*upcoming*/, Batch& /*copy*/) const {}
   virtual void look_ahead(Batch& /*copy*/) const {}
 };

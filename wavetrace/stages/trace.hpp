@@ -36,18 +36,17 @@ struct TraceInstruments {
 // material from `materials`, so that shade and spawn never read the mesh.
 class TraceStage final : public Stage {
  public:
-  // `look_ahead_batches`: with a world paged from a file (an observer with a file pager),
-  // the sorted batches queued for trace that its look-ahead reads the pages of, on
-  // `look_ahead_threads` threads; else unused.
+  // `look_ahead`: with a world paged from a file (an observer with a file pager), how many of
+  // the sorted batches queued for trace its look-ahead reads the pages of, on how many
+  // threads; else unused.
   TraceStage(const Accelerator& accelerator, const MaterialRuns& materials, const TraceInstruments& instruments = {},
-             std::size_t look_ahead_batches = 0, std::size_t look_ahead_threads = 1)
+             LookAhead look_ahead = {})
       : accelerator_(accelerator), materials_(materials), instruments_(instruments) {
     if (instruments_.observers != nullptr && !(instruments_.observers->any() && accelerator.probed())) {
       instruments_.observers = nullptr;
     }
     if (instruments_.observers != nullptr && instruments_.observers->file_pager != nullptr) {
-      look_ahead_batches_ = look_ahead_batches;
-      look_ahead_threads_ = look_ahead_threads;
+      look_ahead_ = look_ahead;
       look_ahead_observers_.file_pager = instruments_.observers->file_pager;
     }
   }
@@ -57,8 +56,7 @@ class TraceStage final : public Stage {
   // The look-ahead traces every kLookAheadStride-th ray of a queued batch on the copy, its
   // hits thrown away: its reads load the pages trace will read (the sorted neighbours of a
   // ray share its pages), counted to the pager's look-ahead client.
-  std::size_t look_ahead_batches() const override { return look_ahead_batches_; }
-  std::size_t look_ahead_threads() const override { return look_ahead_threads_; }
+  LookAhead look_ahead_plan() const override { return look_ahead_; }
   void copy_ahead(const Batch& upcoming, Batch& copy) const override;
   void look_ahead(Batch& copy) const override;
   static constexpr std::uint32_t kLookAheadStride = 4;
@@ -77,8 +75,7 @@ class TraceStage final : public Stage {
   const Accelerator& accelerator_;
   const MaterialRuns& materials_;
   TraceInstruments instruments_;
-  std::size_t look_ahead_batches_ = 0;
-  std::size_t look_ahead_threads_ = 1;
+  LookAhead look_ahead_;
   MemoryObservers look_ahead_observers_;  // the file pager alone: no simulated pager or cache counts the look
 };
 
