@@ -8,7 +8,6 @@
 
 #if WAVETRACE_AVX2 && WAVETRACE_FMA
 
-#include <array>
 #include <bit>
 #include <cstdint>
 #include <limits>
@@ -18,6 +17,7 @@
 #include "wavetrace/accel/bvh/quantized_wide_node.hpp"
 #include "wavetrace/accel/bvh/sah_builder.hpp"
 #include "wavetrace/accel/ray_loop.hpp"
+#include "wavetrace/kernels/lane_sort.hpp"
 #include "wavetrace/kernels/ray_box.hpp"
 #include "wavetrace/kernels/nearest_hit.hpp"
 
@@ -37,37 +37,6 @@ struct QuantizedWideStack {
 };
 
 namespace quantized_wide {
-
-// Bitonic network over eight int32 lanes, descending: per stage, lane i meets lane i ^ j
-// and keeps the larger or the smaller.
-struct SortStage {
-  int partner[8];
-  int take_max[8];
-};
-inline constexpr std::array<SortStage, 6> kDescendingStages = [] {
-  std::array<SortStage, 6> stages{};
-  int n = 0;
-  for (int k = 2; k <= 8; k *= 2) {
-    for (int j = k / 2; j >= 1; j /= 2, ++n) {
-      for (int i = 0; i < 8; ++i) {
-        stages[n].partner[i] = i ^ j;
-        const bool upper = (i & j) != 0, descending_block = (i & k) != 0;
-        stages[n].take_max[i] = (upper != descending_block) ? 0 : -1;
-      }
-    }
-  }
-  return stages;
-}();
-
-[[gnu::always_inline]] inline __m256i sort_descending(__m256i keys) {
-  for (const SortStage& stage : kDescendingStages) {
-    const __m256i other =
-        _mm256_permutevar8x32_epi32(keys, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(stage.partner)));
-    keys = _mm256_blendv_epi8(_mm256_min_epi32(keys, other), _mm256_max_epi32(keys, other),
-                              _mm256_loadu_si256(reinterpret_cast<const __m256i*>(stage.take_max)));
-  }
-  return keys;
-}
 
 // Each child's reference: inner children number from child_base in slot order, leaves from
 // leaf_base by the weights of the leaf slots before them (exclusive prefix sums over the meta
@@ -125,24 +94,6 @@ inline constexpr std::array<SortStage, 6> kDescendingStages = [] {
   return ~static_cast<unsigned>(_mm_movemask_epi8(_mm_cmpeq_epi8(meta, _mm_setzero_si128()))) & 0xffu;
 }
 
-// All bits of lane k set where bit k of `mask` is.
-[[gnu::always_inline]] inline __m256i lanes_of(unsigned mask) {
-  return _mm256_cmpgt_epi32(_mm256_and_si256(_mm256_set1_epi32(int(mask)), _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128)),
-                            _mm256_setzero_si256());
-}
-
-// The children in `entered`, farthest first (so the nearest ends on top of a stack): a key
-// is the entry distance's bits (>= 0, so they order as integers) with the lane in the low
-// three, lanes not entered -1, sorted descending.
-[[gnu::always_inline]] inline __m256i nearest_last(__m256 near, unsigned entered) {
-  const __m256i keys = _mm256_blendv_epi8(
-      _mm256_set1_epi32(-1),
-      _mm256_or_si256(_mm256_and_si256(_mm256_castps_si256(near), _mm256_set1_epi32(~7)),
-                      _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)),
-      lanes_of(entered));
-  return _mm256_and_si256(sort_descending(keys), _mm256_set1_epi32(7));
-}
-
 }  // namespace quantized_wide
 
 // `visit_leaf(reference, box)` handles a leaf (its reference without the leaf bit, its
@@ -178,7 +129,7 @@ template <typename Probe, typename VisitLeaf>
         continue;
       }
       if (entered_mask != 0) {  // nearest first, by sorting
-        const __m256i order = nearest_last(near, entered_mask);
+        const __m256i order = lane_sort::nearest_last(near, entered_mask);
         _mm256_storeu_si256(reinterpret_cast<__m256i*>(stack.reference + top),
                             _mm256_permutevar8x32_epi32(child_references(node), order));
         _mm256_storeu_ps(stack.distance + top, _mm256_permutevar8x32_ps(near, order));
@@ -251,7 +202,7 @@ template <typename Probe, typename VisitLeaf>
         __m256 entry;
         entered[r] = enter_children(bound, origin[r], inverse[r], rays_in[r].tmin, tmax[r], entry) & occupied;
         _mm256_store_ps(near[r], entry);
-        least = _mm256_blendv_ps(least, _mm256_min_ps(least, entry), _mm256_castsi256_ps(lanes_of(entered[r])));
+        least = _mm256_blendv_ps(least, _mm256_min_ps(least, entry), _mm256_castsi256_ps(lane_sort::lanes_of(entered[r])));
       }
       unsigned any = 0;
       for (int r = 0; r < kWidePacketRays; ++r) any |= entered[r];
@@ -259,7 +210,7 @@ template <typename Probe, typename VisitLeaf>
         alignas(32) std::int32_t order[8];
         alignas(32) std::uint32_t reference[8];
         alignas(32) float lanes[6][8];
-        _mm256_store_si256(reinterpret_cast<__m256i*>(order), nearest_last(least, any));
+        _mm256_store_si256(reinterpret_cast<__m256i*>(order), lane_sort::nearest_last(least, any));
         _mm256_store_si256(reinterpret_cast<__m256i*>(reference), child_references(node));
         for (int b = 0; b < 6; ++b) _mm256_store_ps(lanes[b], bound[b]);
         for (int n = 0, count = std::popcount(any); n < count; ++n) {  // farthest first: the nearest ends on top

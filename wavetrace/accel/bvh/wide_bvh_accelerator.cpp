@@ -19,6 +19,7 @@
 #include "wavetrace/accel/section_archive.hpp"
 #include "wavetrace/accel/bvh/indexed_face_set.hpp"
 #include "wavetrace/accel/bvh/wide_bvh_node.hpp"
+#include "wavetrace/kernels/lane_sort.hpp"
 #include "wavetrace/kernels/ray_box.hpp"
 #include "wavetrace/accel/bvh/leaf_query.hpp"
 #include "wavetrace/memory/cache_aligned_allocator.hpp"
@@ -40,6 +41,15 @@ struct WideRay {
   glm::vec3 origin;
   glm::vec3 inverse;
   int zero_axes;  // bit a set: direction[a] == 0, that slab is tested by comparison
+};
+
+// The traversal stack, one column per field so that the entered children are pushed with one
+// store per field. A level pushes at most eight and pops one; the stores write eight lanes.
+struct WideStack {
+  static constexpr std::size_t kEntries = kMaxTreeDepth * kWidth + kWidth;
+  alignas(32) std::uint32_t child[kEntries];
+  alignas(32) std::uint32_t count[kEntries];
+  alignas(32) float distance[kEntries];
 };
 
 // Entry distances of the ray into the node's eight child boxes; returns the mask of the
@@ -86,6 +96,38 @@ struct WideRay {
     if (distance[k] != kInfinity) mask |= 1u << k;
   }
   return mask;
+#endif
+}
+
+// Pushes the children in `mask` (their entry distances in `distance`) farthest first, so that
+// the nearest is on top: with AVX2 by the bitonic lane sort and one permute per column.
+[[gnu::always_inline]] inline void push_nearest_last(const WideBvhNode& node, unsigned mask, const float distance[kWidth],
+                                                     WideStack& stack, std::uint32_t& top) {
+  if (mask == 0) return;
+#if WAVETRACE_AVX2
+  const __m256 near = _mm256_load_ps(distance);
+  // The sort keys are the distances' bits, which order as integers only from +0 up: a -0
+  // (max_ps keeps its second operand on a tie with tmin = 0) would sort below the lanes not
+  // entered and be lost.
+  const __m256i order = lane_sort::nearest_last(_mm256_max_ps(near, _mm256_setzero_ps()), mask);
+  const __m256i children = _mm256_load_si256(reinterpret_cast<const __m256i*>(node.child));
+  const __m256i counts = _mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(node.count)));
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(stack.child + top), _mm256_permutevar8x32_epi32(children, order));
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(stack.count + top), _mm256_permutevar8x32_epi32(counts, order));
+  _mm256_storeu_ps(stack.distance + top, _mm256_permutevar8x32_ps(near, order));
+  top += static_cast<std::uint32_t>(std::popcount(mask));
+#else
+  const std::uint32_t first = top;
+  for (; mask != 0; mask &= mask - 1) {  // insertion by descending distance
+    const int k = std::countr_zero(mask);
+    std::uint32_t slot = top++;
+    for (; slot > first && stack.distance[slot - 1] < distance[k]; --slot) {
+      stack.child[slot] = stack.child[slot - 1];
+      stack.count[slot] = stack.count[slot - 1];
+      stack.distance[slot] = stack.distance[slot - 1];
+    }
+    stack.child[slot] = node.child[k], stack.count[slot] = node.count[k], stack.distance[slot] = distance[k];
+  }
 #endif
 }
 
@@ -177,13 +219,7 @@ class WideBvhAccelerator final : public ProbedAccelerator<WideBvhAccelerator> {
 
   template <bool kAnyHit, typename Probe>
   void traverse(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
-    struct StackEntry {
-      std::uint32_t child;
-      std::uint32_t count;
-      float distance;
-    };
-    // Each level pushes at most seven siblings.
-    StackEntry stack[kMaxTreeDepth * (kWidth - 1) + kWidth];
+    WideStack stack;
     const WideBvhNode* nodes = nodes_.data();
     for_each_ray(rays, hits, range, [&](const SingleRay& ray, std::uint32_t i) {
       const glm::vec3& direction = ray.direction;
@@ -194,42 +230,27 @@ class WideBvhAccelerator final : public ProbedAccelerator<WideBvhAccelerator> {
       float& tmax = query.tmax;
 
       std::uint32_t top = 0;
-      StackEntry current{0, 0, tmin};
+      std::uint32_t child = 0, count = 0;  // the root
       while (true) {
-        if (current.count == 0) {
+        if (count == 0) {
           alignas(32) float distance[kWidth];
-          const WideBvhNode& node = nodes[current.child];
+          const WideBvhNode& node = nodes[child];
           probe.read(&node, sizeof node);
-          unsigned mask = intersect_children(node, box_ray, tmin, pruning_distance(tmax), distance);
-          if (mask != 0 && (mask & (mask - 1)) == 0) {  // one child entered: no sorting
+          const unsigned mask = intersect_children(node, box_ray, tmin, pruning_distance(tmax), distance);
+          if (std::has_single_bit(mask)) {  // one child entered: nothing to order or stack
             const int k = std::countr_zero(mask);
-            current = {node.child[k], node.count[k], distance[k]};
+            child = node.child[k], count = node.count[k];
             continue;
           }
-          StackEntry entered[kWidth];
-          int entered_count = 0;
-          for (; mask != 0; mask &= mask - 1) {
-            const int k = std::countr_zero(mask);
-            // Insertion by descending distance: the nearest ends last, to be taken first.
-            int slot = entered_count++;
-            while (slot > 0 && entered[slot - 1].distance < distance[k]) {
-              entered[slot] = entered[slot - 1];
-              --slot;
-            }
-            entered[slot] = {node.child[k], node.count[k], distance[k]};
-          }
-          if (entered_count > 0) {
-            for (int k = 0; k + 1 < entered_count; ++k) stack[top++] = entered[k];
-            current = entered[entered_count - 1];
-            continue;
-          }
+          push_nearest_last(node, mask, distance, stack, top);
         } else {
-          query.test_leaf<kAnyHit>(current.child, current.count, probe);
+          query.test_leaf<kAnyHit>(child, count, probe);
           if (kAnyHit && query.found()) break;
         }
-        while (top > 0 && stack[top - 1].distance > pruning_distance(tmax)) --top;
+        while (top > 0 && stack.distance[top - 1] > pruning_distance(tmax)) --top;
         if (top == 0) break;
-        current = stack[--top];
+        --top;
+        child = stack.child[top], count = stack.count[top];
       }
       query.write<!kAnyHit>(hits, i, probe);
     });
