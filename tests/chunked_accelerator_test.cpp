@@ -16,6 +16,7 @@
 #include "wavetrace/setup/render_setup.hpp"
 #include "wavetrace/pipeline/tracing_arena.hpp"
 #include "accel_agreement.hpp"
+#include "accel_options.hpp"
 
 namespace wavetrace {
 namespace {
@@ -42,14 +43,7 @@ TEST(PlanChunks, ObjectsSplitEvenlyAndNeverShareAChunk) {
 
 // `type` is an accelerator name, optionally followed by settings: "hmq accel.hmq.width=8".
 AcceleratorOptions options_for(const std::string& type, std::size_t chunk_triangles) {
-  Config config;
-  std::istringstream words(type);
-  std::string name, setting;
-  words >> name;
-  config.set("accel.type=" + name);
-  while (words >> setting) config.set(setting);
-  config.set("build.chunk_triangles=" + std::to_string(chunk_triangles));
-  return accelerator_options(config);
+  return testing::options_for(type + " build.chunk_triangles=" + std::to_string(chunk_triangles));
 }
 
 class ChunkedWorld : public ::testing::TestWithParam<std::string> {};

@@ -7,7 +7,6 @@
 #include <cstring>
 #include <numeric>
 #include <random>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -17,8 +16,7 @@
 #include "wavetrace/bench/ray_sets.hpp"
 #include "wavetrace/kernels/nearest_hit.hpp"
 #include "wavetrace/scene/builtin_scenes.hpp"
-#include "wavetrace/setup/config.hpp"
-#include "wavetrace/setup/plan_render.hpp"
+#include "accel_options.hpp"
 
 namespace wavetrace {
 namespace {
@@ -47,17 +45,6 @@ Scene doubled(const std::string& name) {
   return scene;
 }
 
-// `type` is an accelerator name, optionally followed by settings: "hmq accel.hmq.width=8".
-AcceleratorOptions options_for(const std::string& type) {
-  Config config;
-  std::istringstream words(type);
-  std::string name, setting;
-  words >> name;
-  config.set("accel.type=" + name);
-  while (words >> setting) config.set(setting);
-  return accelerator_options(config);
-}
-
 bool same_bits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 class TiedHits : public ::testing::TestWithParam<std::string> {};
@@ -71,7 +58,7 @@ TEST_P(TiedHits, AreTheSameWhateverRaysArePacketedTogether) {
   AcceleratorOptions reference_options;
   reference_options.type = "embree";
   const auto reference = make_accelerator(scene.mesh, reference_options);
-  const auto accelerator = make_accelerator(scene.mesh, options_for(GetParam()));
+  const auto accelerator = make_accelerator(scene.mesh, testing::options_for(GetParam()));
   constexpr std::size_t kRays = 4096;
   const RaySet set = make_ray_set(RaySetKind::primary, scene, *reference, kRays, kRays);
   ASSERT_EQ(set.batches.size(), 1u);
