@@ -1,7 +1,12 @@
 // Ray-box and ray-triangle kernels on the cases that break naive code: hits exactly on
 // shared edges and vertices, axis-parallel and grazing rays, very different scales.
+#include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -9,6 +14,7 @@
 #include "wavetrace/kernels/random.hpp"
 #include "wavetrace/kernels/ray_box.hpp"
 #include "wavetrace/kernels/triangle_intersect.hpp"
+#include "wavetrace/kernels/watertight_lanes.hpp"
 
 namespace wavetrace {
 namespace {
@@ -132,6 +138,83 @@ TEST(Watertight, TrianglesOfVeryDifferentScales) {
     EXPECT_FALSE(watertight_hit(origin + glm::vec3(2.0f * scale, 0, 0), {0, 0, -1}, a, b, c)) << scale;
   }
 }
+
+#if WAVETRACE_AVX2
+// Each lane of the SIMD test against the scalar test on the same triangle: a candidate lane is
+// the scalar hit, bit for bit, once its t is checked against tmax; a rejected lane is a scalar
+// miss; a lane on an edge (left to the scalar test by the caller) is counted, so that the
+// lattice below is known to reach that case.
+template <int kLanes>
+void expect_lanes_match_scalar_test() {
+  // Triangles of a unit lattice in z = 0 (shared edges and vertices) and tilted random ones.
+  std::vector<std::array<glm::vec3, 3>> triangles;
+  for (int x = -2; x < 2; ++x) {
+    for (int y = -2; y < 2; ++y) {
+      const glm::vec3 p(float(x), float(y), 0.0f);
+      triangles.push_back({p, p + glm::vec3(1, 0, 0), p + glm::vec3(1, 1, 0)});
+      triangles.push_back({p, p + glm::vec3(1, 1, 0), p + glm::vec3(0, 1, 0)});
+    }
+  }
+  for (std::uint32_t i = 0; i < 32; ++i) {
+    std::array<glm::vec3, 3> t;
+    for (int c = 0; c < 3; ++c) {
+      const UnitPair p = unit_pair(random_bits(i, c, 7, RandomPurpose::benchmark));
+      const UnitPair q = unit_pair(random_bits(i, c, 8, RandomPurpose::benchmark));
+      t[c] = glm::vec3(4 * p.first - 2, 4 * p.second - 2, q.first - 0.5f);
+    }
+    triangles.push_back(t);
+  }
+  int hits = 0, on_edges = 0, lanes_compared = 0;
+  for (std::uint32_t r = 0; r < 4000; ++r) {
+    const UnitPair p = unit_pair(random_bits(r, 0, 2, RandomPurpose::benchmark));
+    const UnitPair q = unit_pair(random_bits(r, 0, 3, RandomPurpose::benchmark));
+    // Every fourth ray starts on the half-lattice and runs straight down: through edges and
+    // vertices exactly. The others run anywhere, some away from the triangles (both faces).
+    const bool on_lattice = r % 4 == 0;
+    const glm::vec3 origin = on_lattice ? glm::vec3(std::floor(8 * p.first - 4) * 0.5f, std::floor(8 * p.second - 4) * 0.5f, 2.0f)
+                                        : glm::vec3(4 * p.first - 2, 4 * p.second - 2, r % 3 == 0 ? -2.0f : 2.0f);
+    const glm::vec3 direction = on_lattice ? glm::vec3(0, 0, -1)
+                                           : glm::normalize(glm::vec3(q.first - 0.5f, q.second - 0.5f, origin.z > 0 ? -1.0f : 1.0f));
+    const WatertightRay ray = make_watertight_ray(origin, direction);
+    const float tmin = 0.0f, tmax = r % 5 == 0 ? 1.9f : kInf;  // some hits lie beyond a tmax
+    for (std::size_t base = 0; base < triangles.size(); base += kLanes) {
+      TriangleLanes<kLanes> lanes{};
+      const std::size_t count = std::min<std::size_t>(kLanes, triangles.size() - base);
+      for (std::size_t k = 0; k < count; ++k) {
+        for (int c = 0; c < 3; ++c) {
+          for (int axis = 0; axis < 3; ++axis) lanes.corner[c][axis][k] = triangles[base + k][c][axis];
+        }
+      }
+      WatertightLanes<kLanes> result;
+      intersect_watertight_lanes(ray, lanes, (1u << count) - 1, tmin, tmax, result);
+      EXPECT_EQ((result.candidates | result.on_edge) >> count, 0u);
+      for (std::size_t k = 0; k < count; ++k) {
+        const auto& t = triangles[base + k];
+        TriangleHit hit{};
+        const bool scalar = intersect_watertight(ray, t[0], t[1], t[2], tmin, tmax, hit);
+        if (result.on_edge >> k & 1u) {
+          ++on_edges;
+          continue;
+        }
+        ++lanes_compared;
+        const bool lane = (result.candidates >> k & 1u) && result.t[k] <= tmax;
+        ASSERT_EQ(lane, scalar) << "ray " << r << " triangle " << base + k;
+        if (!scalar) continue;
+        ++hits;
+        EXPECT_EQ(std::bit_cast<std::uint32_t>(result.t[k]), std::bit_cast<std::uint32_t>(hit.t));
+        EXPECT_EQ(std::bit_cast<std::uint32_t>(result.u[k]), std::bit_cast<std::uint32_t>(hit.u));
+        EXPECT_EQ(std::bit_cast<std::uint32_t>(result.v[k]), std::bit_cast<std::uint32_t>(hit.v));
+      }
+    }
+  }
+  EXPECT_GT(hits, 2000);
+  EXPECT_GT(on_edges, 500);
+  EXPECT_GT(lanes_compared, 100000);
+}
+
+TEST(TriangleTests, FourLaneWatertightTestIsTheScalarTestBitForBit) { expect_lanes_match_scalar_test<4>(); }
+TEST(TriangleTests, EightLaneWatertightTestIsTheScalarTestBitForBit) { expect_lanes_match_scalar_test<8>(); }
+#endif
 
 TEST(TriangleTests, MollerTrumboreAndPluckerAgreeAwayFromEdges) {
   const glm::vec3 a(-0.4f, -0.3f, 0.1f), b(0.7f, -0.2f, -0.2f), c(0.1f, 0.8f, 0.3f);

@@ -486,7 +486,8 @@ void point_wide_node_past_its_arrays(char* node) {
 }
 
 // Offsets from the formats' comments: BvhNode first at 24 (bvh_node.hpp), WideBvhNode child[0]
-// at 192 and count[0] at 224 (wide_bvh_node.hpp), QuantizedWideNode child_base at 48 and
+// at 192 and count[0] at 224 (wide_bvh_node.hpp), TriangleBlock slot[0] at 144
+// (triangle_block.hpp), QuantizedWideNode child_base at 48 and
 // leaf_base at 52 (quantized_wide_node.hpp), an HMQ block's node_slots at 0 (hmq_format.hpp),
 // a strip's triangle count at 0 (ray_strip_format.hpp).
 INSTANTIATE_TEST_SUITE_P(
@@ -500,6 +501,17 @@ INSTANTIATE_TEST_SUITE_P(
                       poke<std::uint8_t>(d + 224, 0);
                     },
                     "which does not lie after it"},
+        CraftedCase{"WideBvhLeafPastItsBlocks", {"accel.type=bvh", "accel.bvh.width=8"}, "bvh8.nodes",
+                    [](char* d) {
+                      for (char* node = d;; node += 256) {  // the first leaf lane: count != 0
+                        for (int lane = 0; lane < 8; ++lane) {
+                          if (d[224 + (node - d) + lane] != 0) return poke<std::uint32_t>(node + 192 + 4 * lane, 1u << 30);
+                        }
+                      }
+                    },
+                    "triangle blocks"},
+        CraftedCase{"TriangleBlockOfAMissingTriangle", {"accel.type=bvh", "accel.bvh.width=8"}, "bvh8.triangle_blocks",
+                    [](char* d) { poke<std::uint32_t>(d + 144, 1u << 30); }, "names a triangle that does not exist"},
         CraftedCase{"ChunkedTopChildBeforeItsParent", {"accel.type=bvh", "build.chunk_triangles=4096"}, "chunked.top",
                     [](char* d) { poke<std::uint32_t>(d + 24, 0); }, "does not lie after it"},
         CraftedCase{"HmqBlockWithoutNodes", {"accel.type=hmq"}, "hmq.blocks", [](char* d) { poke<std::uint8_t>(d, 0); },

@@ -1,88 +1,111 @@
-// The watertight test (triangle_intersect.hpp) for up to eight triangles at once, one per
-// AVX2 lane, with the scalar test's float operations in the scalar test's order, so every
-// lane's edge weights, determinant and distance are bit-identical to intersect_watertight's.
-// Lanes with an edge weight of exactly zero (where the scalar test redoes the edges in
-// double) are reported apart for the caller to redo with the scalar test.
+// The watertight test (triangle_intersect.hpp) for several triangles at once, one per SIMD
+// lane (4 with SSE, 8 with AVX2), with the scalar test's float operations in the scalar
+// test's order, so every lane's edge weights, determinant and distance are bit-identical to
+// intersect_watertight's. Lanes with an edge weight of exactly zero (where the scalar test
+// redoes the edges in double) are reported apart for the caller to redo with the scalar test.
+//
+// Written once for every width with the vector extensions GCC and Clang share (`a * b` on
+// __m256 is one vmulps), so the widths cannot drift apart; only loads, splats and the mask
+// extraction name the width.
 #pragma once
 
 #include "wavetrace/build_config.hpp"
 
-#if WAVETRACE_AVX2
-
 #include <cstdint>
 
-#include <immintrin.h>
-
 #include "wavetrace/kernels/triangle_intersect.hpp"
+
+#if WAVETRACE_AVX2
+#include <immintrin.h>
+#endif
 
 namespace wavetrace {
 
 // Corners in SoA: corner[c][axis][lane]; unused lanes may hold anything finite or not.
+template <int kLanes>
 struct TriangleLanes {
-  alignas(32) float corner[3][3][8];
+  alignas(4 * kLanes) float corner[3][3][kLanes];
 };
 
 // Per lane, what the scalar test computes before its final tmax comparison (on t, which the
 // caller makes against its tmax of the moment).
+template <int kLanes>
 struct WatertightLanes {
-  alignas(32) float t[8], u[8], v[8];
+  alignas(4 * kLanes) float t[kLanes], u[kLanes], v[kLanes];
   unsigned candidates = 0;  // inside, det != 0, t * |det| in [tmin, tmax * slack] * |det|
   unsigned on_edge = 0;     // an edge weight is exactly zero in float: redo with intersect_watertight
 };
 
-[[gnu::always_inline]] inline void intersect_watertight_lanes(const WatertightRay& ray, const TriangleLanes& lanes,
+#if WAVETRACE_AVX2
+
+namespace lanes {
+
+template <int kLanes> struct Vector;
+template <> struct Vector<4> {
+  using Float = __m128;
+  using Int = std::int32_t __attribute__((vector_size(16)));
+  static Float splat(float x) { return _mm_set1_ps(x); }
+  static Float load(const float* p) { return _mm_load_ps(p); }
+  static void store(float* p, Float x) { _mm_store_ps(p, x); }
+  template <typename Mask> static unsigned bits(Mask m) { return static_cast<unsigned>(_mm_movemask_ps(Float(m))); }
+};
+template <> struct Vector<8> {
+  using Float = __m256;
+  using Int = std::int32_t __attribute__((vector_size(32)));
+  static Float splat(float x) { return _mm256_set1_ps(x); }
+  static Float load(const float* p) { return _mm256_load_ps(p); }
+  static void store(float* p, Float x) { _mm256_store_ps(p, x); }
+  template <typename Mask> static unsigned bits(Mask m) { return static_cast<unsigned>(_mm256_movemask_ps(Float(m))); }
+};
+
+}  // namespace lanes
+
+template <int kLanes>
+[[gnu::always_inline]] inline void intersect_watertight_lanes(const WatertightRay& ray, const TriangleLanes<kLanes>& lanes,
                                                               unsigned used, float tmin, float tmax,
-                                                              WatertightLanes& out) {
+                                                              WatertightLanes<kLanes>& out) {
+  using V = lanes::Vector<kLanes>;
+  using Float = typename V::Float;
   const int axes[3] = {ray.kx, ray.ky, ray.kz};
-  __m256 relative[3][3];  // corner, permuted axis (x, y, z of the sheared frame before shearing)
+  Float relative[3][3];  // corner, permuted axis (x, y, z of the sheared frame before shearing)
   for (int c = 0; c < 3; ++c) {
-    for (int k = 0; k < 3; ++k) {
-      relative[c][k] = _mm256_sub_ps(_mm256_load_ps(lanes.corner[c][axes[k]]), _mm256_set1_ps(ray.origin[axes[k]]));
-    }
+    for (int k = 0; k < 3; ++k) relative[c][k] = V::load(lanes.corner[c][axes[k]]) - V::splat(ray.origin[axes[k]]);
   }
-  const __m256 shear_x = _mm256_set1_ps(ray.shear_x), shear_y = _mm256_set1_ps(ray.shear_y);
-  __m256 px[3], py[3];
+  const Float shear_x = V::splat(ray.shear_x), shear_y = V::splat(ray.shear_y);
+  Float px[3], py[3];
   for (int c = 0; c < 3; ++c) {
-    px[c] = _mm256_sub_ps(relative[c][0], _mm256_mul_ps(shear_x, relative[c][2]));
-    py[c] = _mm256_sub_ps(relative[c][1], _mm256_mul_ps(shear_y, relative[c][2]));
+    px[c] = relative[c][0] - shear_x * relative[c][2];
+    py[c] = relative[c][1] - shear_y * relative[c][2];
   }
   // a = corner 0, b = corner 1, c = corner 2, as in the scalar test.
-  const __m256 u = _mm256_sub_ps(_mm256_mul_ps(px[2], py[1]), _mm256_mul_ps(py[2], px[1]));
-  const __m256 v = _mm256_sub_ps(_mm256_mul_ps(px[0], py[2]), _mm256_mul_ps(py[0], px[2]));
-  const __m256 w = _mm256_sub_ps(_mm256_mul_ps(px[1], py[0]), _mm256_mul_ps(py[1], px[0]));
-  const __m256 zero = _mm256_setzero_ps();
-  const __m256 on_edge = _mm256_or_ps(_mm256_or_ps(_mm256_cmp_ps(u, zero, _CMP_EQ_OQ), _mm256_cmp_ps(v, zero, _CMP_EQ_OQ)),
-                                      _mm256_cmp_ps(w, zero, _CMP_EQ_OQ));
-  const __m256 any_negative = _mm256_or_ps(_mm256_or_ps(_mm256_cmp_ps(u, zero, _CMP_LT_OQ), _mm256_cmp_ps(v, zero, _CMP_LT_OQ)),
-                                           _mm256_cmp_ps(w, zero, _CMP_LT_OQ));
-  const __m256 any_positive = _mm256_or_ps(_mm256_or_ps(_mm256_cmp_ps(u, zero, _CMP_GT_OQ), _mm256_cmp_ps(v, zero, _CMP_GT_OQ)),
-                                           _mm256_cmp_ps(w, zero, _CMP_GT_OQ));
-  const __m256 determinant = _mm256_add_ps(_mm256_add_ps(u, v), w);
-  const __m256 shear_z = _mm256_set1_ps(ray.shear_z);
-  const __m256 scaled_t = _mm256_add_ps(
-      _mm256_add_ps(_mm256_mul_ps(u, _mm256_mul_ps(shear_z, relative[0][2])), _mm256_mul_ps(v, _mm256_mul_ps(shear_z, relative[1][2]))),
-      _mm256_mul_ps(w, _mm256_mul_ps(shear_z, relative[2][2])));
-  const __m256 sign_bit = _mm256_set1_ps(-0.0f);
-  const __m256 sign = _mm256_or_ps(_mm256_and_ps(determinant, sign_bit), _mm256_set1_ps(1.0f));
-  const __m256 abs_determinant = _mm256_andnot_ps(sign_bit, determinant);
-  const __m256 signed_t = _mm256_mul_ps(scaled_t, sign);
+  const Float u = px[2] * py[1] - py[2] * px[1];
+  const Float v = px[0] * py[2] - py[0] * px[2];
+  const Float w = px[1] * py[0] - py[1] * px[0];
+  const Float zero = V::splat(0.0f);
+  const auto on_edge = (u == zero) | (v == zero) | (w == zero);
+  const auto any_negative = (u < zero) | (v < zero) | (w < zero);
+  const auto any_positive = (u > zero) | (v > zero) | (w > zero);
+  const Float determinant = (u + v) + w;
+  const Float shear_z = V::splat(ray.shear_z);
+  const Float scaled_t = (u * (shear_z * relative[0][2]) + v * (shear_z * relative[1][2])) + w * (shear_z * relative[2][2]);
+  // |det| and t * sign(det) by the sign bit, which is what fabs and the multiplication by
+  // copysign(1, det) do to every value the comparisons below can tell apart.
+  using Int = typename V::Int;
+  const Int sign_bit = Int(determinant) & static_cast<int>(0x80000000u);
+  const Float abs_determinant = Float(Int(determinant) ^ sign_bit);
+  const Float signed_t = Float(Int(scaled_t) ^ sign_bit);
   // The scalar test rejects on `<` or `>`; a NaN compares false there and passes, so here too.
-  const __m256 outside_interval =
-      _mm256_or_ps(_mm256_cmp_ps(signed_t, _mm256_mul_ps(_mm256_set1_ps(tmin), abs_determinant), _CMP_LT_OQ),
-                   _mm256_cmp_ps(signed_t,
-                                 _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(tmax), abs_determinant),
-                                               _mm256_set1_ps(kDistancePrecheckSlack)),
-                                 _CMP_GT_OQ));
-  const __m256 rejected = _mm256_or_ps(_mm256_or_ps(_mm256_and_ps(any_negative, any_positive), outside_interval),
-                                       _mm256_cmp_ps(determinant, zero, _CMP_EQ_OQ));
-  const __m256 inverse = _mm256_div_ps(_mm256_set1_ps(1.0f), determinant);
-  _mm256_store_ps(out.t, _mm256_mul_ps(scaled_t, inverse));
-  _mm256_store_ps(out.u, _mm256_mul_ps(v, inverse));
-  _mm256_store_ps(out.v, _mm256_mul_ps(w, inverse));
-  out.on_edge = static_cast<unsigned>(_mm256_movemask_ps(on_edge)) & used;
-  out.candidates = ~static_cast<unsigned>(_mm256_movemask_ps(rejected)) & used & ~out.on_edge;
+  const auto outside_interval = (signed_t < V::splat(tmin) * abs_determinant) |
+                                (signed_t > (V::splat(tmax) * abs_determinant) * V::splat(kDistancePrecheckSlack));
+  const auto rejected = (any_negative & any_positive) | outside_interval | (determinant == zero);
+  const Float inverse = V::splat(1.0f) / determinant;
+  V::store(out.t, scaled_t * inverse);
+  V::store(out.u, v * inverse);
+  V::store(out.v, w * inverse);
+  out.on_edge = V::bits(on_edge) & used;
+  out.candidates = ~V::bits(rejected) & used & ~out.on_edge;
 }
 
-}  // namespace wavetrace
+#endif  // WAVETRACE_AVX2
 
-#endif
+}  // namespace wavetrace

@@ -24,10 +24,19 @@ class BvhAccelerator final : public ProbedAccelerator<BvhAccelerator> {
   friend class ProbedAccelerator<BvhAccelerator>;
 
  public:
-  explicit BvhAccelerator(SectionLoader& in) : geometry_(in) { load_bvh(in, geometry_, "bvh.nodes", nodes_, leaf_triangles_, build_); }
+  explicit BvhAccelerator(SectionLoader& in) : geometry_(in) {
+    load_bvh(in, "bvh.nodes", nodes_, "bvh.leaf_triangles", leaf_triangles_, build_, [&](const BvhNode& leaf) {
+      // Without leaf_triangles (triangle_order = leaf) a leaf's slots are the triangles themselves.
+      const std::size_t slots = leaf_triangles_.empty() ? geometry_.triangle_count() : leaf_triangles_.size();
+      check_leaf_slots(leaf.first, leaf.triangle_count(), slots, in, "bvh.nodes");
+    });
+    for (const std::uint32_t triangle : leaf_triangles_) {
+      if (triangle >= geometry_.triangle_count()) in.fail("bvh.leaf_triangles", "names a triangle that does not exist");
+    }
+  }
 
   void save(SectionWriter& out, const std::string& prefix) const override {
-    save_bvh(out, prefix, geometry_, "bvh.nodes", nodes_, leaf_triangles_, build_);
+    save_bvh(out, prefix, geometry_, "bvh.nodes", nodes_, "bvh.leaf_triangles", leaf_triangles_, build_);
   }
 
   BvhAccelerator(const TriangleMesh& mesh, const BvhOptions& options)

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cstdint>
 #include <span>
-#include <type_traits>
 
 #include "wavetrace/accel/accelerator.hpp"
 #include "wavetrace/accel/bvh/bvh_options.hpp"
@@ -13,6 +12,8 @@
 #include "wavetrace/accel/bvh/indexed_face_set.hpp"
 #include "wavetrace/accel/bvh/sah_builder.hpp"
 #include "wavetrace/accel/bvh/tree_check.hpp"
+#include "wavetrace/accel/bvh/triangle_block.hpp"
+#include "wavetrace/accel/bvh/wide_bvh_node.hpp"
 #include "wavetrace/accel/section_archive.hpp"
 
 namespace wavetrace {
@@ -23,6 +24,8 @@ inline BuildTree build_bvh_tree(const IndexedFaceSet& geometry, const BvhOptions
   SahOptions sah;
   sah.max_leaf_size = options.max_leaf_size;
   sah.bins = options.bins;
+  // The 8-wide tree's leaves are blocks of four (triangle_block.hpp).
+  sah.block_size = options.width == 8 ? TriangleBlock::kLanes : 1;
   BuildTree tree = build_sah_tree(bounds, sah);
   tree.peak_bytes += bounds.size() * sizeof(Bounds3);
   return tree;
@@ -36,49 +39,45 @@ inline void adopt_leaf_order(const BvhOptions& options, IndexedFaceSet& geometry
 }
 
 // What a saved bvh or bvh8 keeps besides its arrays: its indexed face set (faces.*,
-// indexed_face_set.hpp), and "common" (section_archive.hpp). Arrays: "bvh.nodes" (BvhNode,
-// bvh_node.hpp) or "bvh8.nodes" (WideBvhNode, wide_bvh_node.hpp), and "bvh.leaf_triangles"
-// (uint32 per leaf slot: a face-set slot; empty in leaf order, where slot = leaf position).
-inline constexpr std::uint32_t kBvhSavedVersion = 1;
-
+// indexed_face_set.hpp), and "common" (section_archive.hpp). The binary tree (kind "bvh",
+// version 1): "bvh.nodes" (BvhNode, bvh_node.hpp) and "bvh.leaf_triangles" (uint32 per leaf
+// slot: a face-set slot; empty in leaf order, where slot = leaf position). The 8-wide tree
+// (kind "bvh", version 2, told apart by its "bvh8.nodes"): "bvh8.nodes" (WideBvhNode,
+// wide_bvh_node.hpp; a leaf lane names its first triangle block) and "bvh8.triangle_blocks"
+// (TriangleBlock, triangle_block.hpp). Version 1 of the 8-wide tree kept leaf slots as the
+// binary tree does; such a world is refused with the advice to rebuild it.
 template <typename Node>
+inline constexpr std::uint32_t kBvhSavedVersion = 1;
+template <>
+inline constexpr std::uint32_t kBvhSavedVersion<WideBvhNode> = 2;
+
+template <typename Node, typename Leaf>
 void save_bvh(SectionWriter& out, const std::string& prefix, const IndexedFaceSet& geometry, std::string_view nodes_section,
-              const StoredArray<Node>& nodes, const StoredArray<std::uint32_t>& leaf_triangles, const BuildReport& build) {
-  out.add_value(prefix + "kind", saved_kind("bvh", kBvhSavedVersion));
+              const StoredArray<Node>& nodes, std::string_view leaves_section, const StoredArray<Leaf>& leaves,
+              const BuildReport& build) {
+  out.add_value(prefix + "kind", saved_kind("bvh", kBvhSavedVersion<Node>));
   SectionSaver saver(out, prefix);
   geometry.save(saver);
   saver.array(nodes_section, nodes);
-  saver.array("bvh.leaf_triangles", leaf_triangles);
+  saver.array(leaves_section, leaves);
   std::size_t triangles = geometry.triangle_count();
   BuildReport report = build;
   archive_common_state(saver, triangles, report);
 }
 
 // The face set is loaded by the accelerator's constructor (a member); this reads the rest
-// and checks every index a walk follows (tree_check.hpp).
-template <typename Node>
-void load_bvh(SectionLoader& in, const IndexedFaceSet& geometry, std::string_view nodes_section,
-              StoredArray<Node>& nodes, StoredArray<std::uint32_t>& leaf_triangles, BuildReport& build) {
-  in.expect_kind("bvh", kBvhSavedVersion);
+// and checks the tree (tree_check.hpp), each leaf by `check_leaf` (a BvhNode for the binary
+// tree, (first, count) for the 8-wide one). The caller checks the leaf array's own contents.
+template <typename Node, typename Leaf, typename CheckLeaf>
+void load_bvh(SectionLoader& in, std::string_view nodes_section, StoredArray<Node>& nodes, std::string_view leaves_section,
+              StoredArray<Leaf>& leaves, BuildReport& build, CheckLeaf&& check_leaf) {
+  in.expect_kind("bvh", kBvhSavedVersion<Node>);
   in.array(nodes_section, nodes);
-  in.array("bvh.leaf_triangles", leaf_triangles);
+  in.array(leaves_section, leaves);
   std::size_t triangles = 0;
   archive_common_state(in, triangles, build);
   if (nodes.empty()) in.fail(nodes_section, "is empty: no bvh was saved");
-  for (const std::uint32_t triangle : leaf_triangles) {
-    if (triangle >= geometry.triangle_count()) in.fail("bvh.leaf_triangles", "names a triangle that does not exist");
-  }
-  // Without leaf_triangles (triangle_order = leaf) a leaf's slots are the triangles themselves.
-  const std::size_t slots = leaf_triangles.empty() ? geometry.triangle_count() : leaf_triangles.size();
-  const auto check_slots = [&](std::uint64_t first, std::uint64_t count) {
-    check_leaf_slots(first, count, slots, in, nodes_section);
-  };
-  if constexpr (std::is_same_v<Node, BvhNode>) {
-    check_tree(std::span<const BvhNode>(nodes.data(), nodes.size()), in, nodes_section,
-               [&](const BvhNode& leaf) { check_slots(leaf.first, leaf.triangle_count()); });
-  } else {
-    check_tree(std::span<const Node>(nodes.data(), nodes.size()), in, nodes_section, check_slots);
-  }
+  check_tree(std::span<const Node>(nodes.data(), nodes.size()), in, nodes_section, check_leaf);
 }
 
 // Peak build memory: the larger of the tree build's and the face-set copy's working sets,

@@ -2,15 +2,19 @@
 // over an indexed face set, and writing the answer into the hit batch.
 #pragma once
 
+#include <algorithm>
+#include <bit>
 #include <cstdint>
 #include <limits>
 #include <span>
 #include <vector>
 
 #include "wavetrace/accel/bvh/indexed_face_set.hpp"
+#include "wavetrace/accel/bvh/triangle_block.hpp"
 #include "wavetrace/accel/ray_loop.hpp"
 #include "wavetrace/kernels/nearest_hit.hpp"
 #include "wavetrace/kernels/triangle_intersect.hpp"
+#include "wavetrace/kernels/watertight_lanes.hpp"
 #include "wavetrace/memory/ray_batch.hpp"
 
 namespace wavetrace {
@@ -46,14 +50,50 @@ class LeafQuery {
       }
       TriangleHit hit;
       if (intersect_watertight(ray_, positions[tri.x], positions[tri.y], positions[tri.z], tmin, tmax, hit) &&
-          replaces_nearest(
-              hit.t, tmax, found(), [&] { return geometry_.input_id(triangle); },
-              [&] { return geometry_.input_id(found_); })) {
-        tmax = hit.t;
-        best_ = hit;
-        found_ = triangle;
+          accept(triangle, hit)) {
         if constexpr (kAnyHit) return;
       }
+    }
+  }
+
+  // Tests a leaf of `count` triangles stored as consecutive blocks from `block`, one 4-lane
+  // pass a block; the same hits as test_leaf over the same triangles, bit for bit (the lanes
+  // compute what the scalar test does, and a candidate is then taken against the tmax of the
+  // moment, as the scalar loop takes it).
+  template <bool kAnyHit, typename Probe>
+  void test_blocks(const TriangleBlock* block, std::uint32_t count, Probe& probe) {
+    for (std::uint32_t base = 0; base < count; base += TriangleBlock::kLanes, ++block) {
+      probe.read(block, sizeof *block);
+      const std::uint32_t used = (1u << std::min(TriangleBlock::kLanes, count - base)) - 1;
+#if WAVETRACE_AVX2
+      WatertightLanes<TriangleBlock::kLanes> result;
+      intersect_watertight_lanes(ray_, block->corners, used, tmin, tmax, result);
+      for (unsigned pending = result.candidates | result.on_edge; pending != 0; pending &= pending - 1) {
+        const int lane = std::countr_zero(pending);
+        TriangleHit hit;
+        if (result.on_edge >> lane & 1u) {
+          if (!intersect_watertight(ray_, block->corner(lane, 0), block->corner(lane, 1), block->corner(lane, 2), tmin,
+                                    tmax, hit)) {
+            continue;
+          }
+        } else {
+          if (result.t[lane] > tmax) continue;
+          hit = {result.t[lane], result.u[lane], result.v[lane]};
+        }
+        if (accept(block->slot[lane], hit)) {
+          if constexpr (kAnyHit) return;
+        }
+      }
+#else
+      for (unsigned lane = 0; used >> lane & 1u; ++lane) {
+        TriangleHit hit;
+        if (intersect_watertight(ray_, block->corner(lane, 0), block->corner(lane, 1), block->corner(lane, 2), tmin, tmax,
+                                 hit) &&
+            accept(block->slot[lane], hit)) {
+          if constexpr (kAnyHit) return;
+        }
+      }
+#endif
     }
   }
 
@@ -73,6 +113,19 @@ class LeafQuery {
   }
 
  private:
+  // True when `hit` on face-set slot `triangle` becomes the nearest (nearest_hit.hpp).
+  bool accept(std::uint32_t triangle, const TriangleHit& hit) {
+    if (!replaces_nearest(
+            hit.t, tmax, found(), [&] { return geometry_.input_id(triangle); },
+            [&] { return geometry_.input_id(found_); })) {
+      return false;
+    }
+    tmax = hit.t;
+    best_ = hit;
+    found_ = triangle;
+    return true;
+  }
+
   const IndexedFaceSet& geometry_;
   const std::uint32_t* leaf_index_;
   WatertightRay ray_;

@@ -178,7 +178,7 @@ class Builder {
         accumulated.extend(row[i].bounds);
         count += row[i].count;
         if (count == 0 || right_count[i] == 0) continue;
-        const float cost = half_area(accumulated) * float(count) + right_area[i] * float(right_count[i]);
+        const float cost = half_area(accumulated) * blocks(count) + right_area[i] * blocks(right_count[i]);
         if (cost < best.cost) {
           best.axis = axis;
           best.bin = i;
@@ -191,6 +191,10 @@ class Builder {
       for (std::uint32_t i = 0; i < bins; ++i) (i <= best.bin ? best.left_bounds : best.right_bounds).extend(row[i].bounds);
     }
     return best;
+  }
+
+  float blocks(std::uint32_t count) const {
+    return float((count + options_.block_size - 1) / options_.block_size);
   }
 
   void make_leaf(std::uint32_t node, std::uint32_t first, std::uint32_t count, const Bounds3& bounds) {
@@ -210,7 +214,7 @@ class Builder {
       scale[axis] = extent > 0.0f ? float(options_.bins) * (1.0f - 1e-6f) / extent : 0.0f;
     }
     const Split split = depth < kFreeDepth ? best_split(bin_range(first, count, centroids, scale), centroids) : Split{};
-    const float leaf_cost = options_.intersection_cost * float(count);
+    const float leaf_cost = options_.intersection_cost * blocks(count);
     const float split_cost = options_.traversal_cost + options_.intersection_cost * split.cost / half_area(bounds);
     if (count <= options_.max_leaf_size && (split.axis < 0 || leaf_cost <= split_cost)) {
       // split.axis < 0 with few primitives: coincident centroids, a leaf is best.
@@ -272,6 +276,7 @@ std::uint32_t BuildTree::depth() const { return nodes.empty() ? 0 : subtree_dept
 
 BuildTree build_sah_tree(std::span<const Bounds3> primitive_bounds, const SahOptions& options) {
   if (primitive_bounds.empty()) throw std::invalid_argument("SAH builder: no primitives");
+  if (options.block_size < 1) throw std::invalid_argument("SAH builder: block size 0");
   if (options.max_leaf_size < 1 || options.max_leaf_size > 16) {
     throw std::invalid_argument(fmt::format("SAH builder: max leaf size {} is outside 1..16", options.max_leaf_size));
   }

@@ -1,6 +1,7 @@
 // The 8-wide BVH: the binary SAH tree collapsed (each node adopts the largest-area inner
 // child's children until it has eight), traversed one ray at a time with all eight child
-// boxes tested in one AVX2 pass, nearest child first.
+// boxes tested in one AVX2 pass, nearest child first; leaves are blocks of four triangles
+// tested in one 4-lane pass.
 #include "wavetrace/accel/bvh/wide_bvh_accelerator.hpp"
 #include "wavetrace/build_config.hpp"  // WAVETRACE_AVX2, WAVETRACE_FMA, WAVETRACE_BMI2
 
@@ -8,6 +9,8 @@
 #include <bit>
 #include <chrono>
 #include <limits>
+
+#include <fmt/format.h>
 
 #if WAVETRACE_AVX2
 #include <immintrin.h>
@@ -18,6 +21,7 @@
 #include "wavetrace/accel/ray_loop.hpp"
 #include "wavetrace/accel/section_archive.hpp"
 #include "wavetrace/accel/bvh/indexed_face_set.hpp"
+#include "wavetrace/accel/bvh/triangle_block.hpp"
 #include "wavetrace/accel/bvh/wide_bvh_node.hpp"
 #include "wavetrace/kernels/lane_sort.hpp"
 #include "wavetrace/kernels/ray_box.hpp"
@@ -136,43 +140,58 @@ class WideBvhAccelerator final : public ProbedAccelerator<WideBvhAccelerator> {
 
  public:
   explicit WideBvhAccelerator(SectionLoader& in) : geometry_(in) {
-    load_bvh(in, geometry_, "bvh8.nodes", nodes_, leaf_triangles_, build_);
+    load_bvh(in, "bvh8.nodes", nodes_, "bvh8.triangle_blocks", blocks_, build_, [&](std::uint64_t first, std::uint64_t count) {
+      if (count == 0 || first + TriangleBlock::blocks_for(count) > blocks_.size()) {
+        in.fail("bvh8.nodes", fmt::format("has a leaf of {} triangles in blocks from {} beyond its {} triangle blocks", count,
+                                          first, blocks_.size()));
+      }
+    });
+    for (const TriangleBlock& block : blocks_) {
+      for (const std::uint32_t slot : block.slot) {
+        if (slot >= geometry_.triangle_count()) in.fail("bvh8.triangle_blocks", "names a triangle that does not exist");
+      }
+    }
   }
 
   void save(SectionWriter& out, const std::string& prefix) const override {
-    save_bvh(out, prefix, geometry_, "bvh8.nodes", nodes_, leaf_triangles_, build_);
+    save_bvh(out, prefix, geometry_, "bvh8.nodes", nodes_, "bvh8.triangle_blocks", blocks_, build_);
   }
 
   WideBvhAccelerator(const TriangleMesh& mesh, const BvhOptions& options) : geometry_(mesh, options.triangle_order) {
     const auto start = std::chrono::steady_clock::now();
     const BuildTree tree = build_bvh_tree(geometry_, options);
-    build_leaf_triangles_.reserve(geometry_.triangle_count());
+    LargeArray<std::uint32_t> leaf_triangles;
+    leaf_triangles.reserve(geometry_.triangle_count());
     build_nodes_.reserve(tree.nodes.size() / 4 + 1);
-    collapse(tree, 0);
-    adopt_leaf_order(options, geometry_, build_leaf_triangles_);
+    collapse(tree, 0, leaf_triangles);
+    adopt_leaf_order(options, geometry_, leaf_triangles);
+    LargeArray<TriangleBlock> blocks = block_leaves(leaf_triangles);
     nodes_ = StoredArray<WideBvhNode>(std::move(build_nodes_));
-    leaf_triangles_ = StoredArray<std::uint32_t>(std::move(build_leaf_triangles_));
+    blocks_ = StoredArray<TriangleBlock>(std::move(blocks));
     build_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     build_.peak_bytes = bvh_build_peak_bytes(tree, geometry_, memory().total());
   }
 
   std::string name() const override { return "bvh8"; }
 
-
+  // The face set stays for the hit's surface, the id map and saving; the walk reads blocks.
   MemoryReport memory() const override {
-    return {nodes_.size() * sizeof(WideBvhNode) + leaf_triangles_.size() * sizeof(std::uint32_t),
-            geometry_.geometry_bytes(), geometry_.id_map_bytes()};
+    return {nodes_.size() * sizeof(WideBvhNode), blocks_.size() * sizeof(TriangleBlock) + geometry_.geometry_bytes(),
+            geometry_.id_map_bytes()};
   }
   BuildReport build() const override { return build_; }
 
   std::vector<std::span<const std::byte>> memory_spans() const override {
-    return bvh_memory_spans(nodes_, leaf_triangles_, geometry_);
+    std::vector<std::span<const std::byte>> spans = {std::as_bytes(std::span(nodes_)), std::as_bytes(std::span(blocks_))};
+    for (const auto& span : geometry_.spans()) spans.push_back(span);
+    return spans;
   }
 
  private:
   // Writes the wide node for binary node `root` (and, depth-first, everything below it);
-  // returns its index. A binary leaf at the root becomes a wide node with one leaf lane.
-  std::uint32_t collapse(const BuildTree& tree, std::uint32_t root) {
+  // returns its index. A binary leaf at the root becomes a wide node with one leaf lane, whose
+  // child is its first slot in `leaf_triangles` until block_leaves makes it a block.
+  std::uint32_t collapse(const BuildTree& tree, std::uint32_t root, LargeArray<std::uint32_t>& leaf_triangles) {
     std::vector<std::uint32_t> lanes;
     if (tree.nodes[root].leaf()) {
       lanes.push_back(root);
@@ -205,16 +224,44 @@ class WideBvhAccelerator final : public ProbedAccelerator<WideBvhAccelerator> {
       node.lower_x[k] = child.bounds.lower.x, node.lower_y[k] = child.bounds.lower.y, node.lower_z[k] = child.bounds.lower.z;
       node.upper_x[k] = child.bounds.upper.x, node.upper_y[k] = child.bounds.upper.y, node.upper_z[k] = child.bounds.upper.z;
       if (child.leaf()) {
-        node.child[k] = static_cast<std::uint32_t>(build_leaf_triangles_.size());
+        node.child[k] = static_cast<std::uint32_t>(leaf_triangles.size());
         node.count[k] = static_cast<std::uint8_t>(child.count);
-        for (std::uint32_t i = 0; i < child.count; ++i) build_leaf_triangles_.push_back(tree.primitive_order[child.first + i]);
+        for (std::uint32_t i = 0; i < child.count; ++i) leaf_triangles.push_back(tree.primitive_order[child.first + i]);
       } else {
-        node.child[k] = collapse(tree, lanes[k]);
+        node.child[k] = collapse(tree, lanes[k], leaf_triangles);
         node.count[k] = 0;
       }
     }
     build_nodes_[index] = node;
     return index;
+  }
+
+  // Copies each leaf's triangles into blocks, leaves in node order, and points the leaf lanes
+  // at them. `leaf_index` maps leaf slots to face-set slots (empty: the same).
+  LargeArray<TriangleBlock> block_leaves(const LargeArray<std::uint32_t>& leaf_index) {
+    LargeArray<TriangleBlock> blocks;
+    const glm::vec3* positions = geometry_.positions();
+    for (WideBvhNode& node : build_nodes_) {
+      for (int k = 0; k < kWidth; ++k) {
+        if (node.count[k] == 0) continue;  // an inner or unused lane
+        const std::uint32_t first_slot = node.child[k];
+        node.child[k] = static_cast<std::uint32_t>(blocks.size());
+        for (std::uint32_t base = 0; base < node.count[k]; base += TriangleBlock::kLanes) {
+          TriangleBlock block{};
+          for (std::uint32_t lane = 0; lane < TriangleBlock::kLanes && base + lane < node.count[k]; ++lane) {
+            const std::uint32_t slot = first_slot + base + lane;
+            const std::uint32_t triangle = leaf_index.empty() ? slot : leaf_index[slot];
+            const glm::uvec3 corners = geometry_.triangles()[triangle];
+            block.slot[lane] = triangle;
+            for (int c = 0; c < 3; ++c) {
+              for (int axis = 0; axis < 3; ++axis) block.corners.corner[c][axis][lane] = positions[corners[c]][axis];
+            }
+          }
+          blocks.push_back(block);
+        }
+      }
+    }
+    return blocks;
   }
 
   template <bool kAnyHit, typename Probe>
@@ -225,7 +272,7 @@ class WideBvhAccelerator final : public ProbedAccelerator<WideBvhAccelerator> {
       const glm::vec3& direction = ray.direction;
       const WideRay box_ray{ray.origin, ray.box.inverse_direction,
                             (direction.x == 0.0f) | (direction.y == 0.0f) << 1 | (direction.z == 0.0f) << 2};
-      LeafQuery query(geometry_, leaf_triangles_, ray);
+      LeafQuery query(geometry_, {}, ray);
       const float tmin = query.tmin;
       float& tmax = query.tmax;
 
@@ -244,7 +291,7 @@ class WideBvhAccelerator final : public ProbedAccelerator<WideBvhAccelerator> {
           }
           push_nearest_last(node, mask, distance, stack, top);
         } else {
-          query.test_leaf<kAnyHit>(child, count, probe);
+          query.test_blocks<kAnyHit>(blocks_.data() + child, count, probe);
           if (kAnyHit && query.found()) break;
         }
         while (top > 0 && stack.distance[top - 1] > pruning_distance(tmax)) --top;
@@ -258,9 +305,8 @@ class WideBvhAccelerator final : public ProbedAccelerator<WideBvhAccelerator> {
 
   IndexedFaceSet geometry_;
   StoredArray<WideBvhNode> nodes_;
-  StoredArray<std::uint32_t> leaf_triangles_;
-  LargeArray<WideBvhNode> build_nodes_;              // while collapsing; empty once built
-  LargeArray<std::uint32_t> build_leaf_triangles_;
+  StoredArray<TriangleBlock> blocks_;
+  LargeArray<WideBvhNode> build_nodes_;  // while collapsing; empty once built
   BuildReport build_;
 };
 

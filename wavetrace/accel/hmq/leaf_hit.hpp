@@ -45,7 +45,7 @@ struct LeafHit {
 struct LeafTriangles {
   DecodedLeaf decoded;
 #if WAVETRACE_AVX2
-  TriangleLanes lanes[2];  // triangles 0-7 and 8-13
+  TriangleLanes<8> lanes[2];  // triangles 0-7 and 8-13
 #endif
   glm::vec3 corner(std::uint32_t k, std::uint32_t c) const {
     return decoded.slot_position(decoded.layout->first_slot[k] + c);
@@ -65,7 +65,7 @@ template <typename Probe>
     __m128i first_bytes = _mm_setzero_si128();
     std::memcpy(&first_bytes, layout.first_slot.data() + base, 8);
     const __m256i first_slot = _mm256_cvtepu8_epi32(first_bytes);
-    TriangleLanes& lanes = leaf.lanes[base / 8];
+    TriangleLanes<8>& lanes = leaf.lanes[base / 8];
     for (int c = 0; c < 3; ++c) {
       __m256i vertex = _mm256_and_si256(_mm256_add_epi32(first_slot, _mm256_set1_epi32(c)), index_mask);
       if (decoded.header.indexed) {
@@ -104,7 +104,7 @@ template <bool kAnyHit>
   // as the scalar loop takes them (same hits, same t).
   for (std::uint32_t base = 0; base < triangles; base += 8) {
     const std::uint32_t count = std::min<std::uint32_t>(8, triangles - base);
-    WatertightLanes result;
+    WatertightLanes<8> result;
     intersect_watertight_lanes(sheared, leaf.lanes[base / 8], (1u << count) - 1, tmin, tmax, result);
     for (unsigned pending = result.candidates | result.on_edge; pending != 0; pending &= pending - 1) {
       const int lane = std::countr_zero(pending);
