@@ -67,9 +67,13 @@ template <int kLanes>
   using V = lanes::Vector<kLanes>;
   using Float = typename V::Float;
   const int axes[3] = {ray.kx, ray.ky, ray.kz};
+  // An array, not glm's operator[], which compiles to a switch per use.
+  const float ray_origin[3] = {ray.origin.x, ray.origin.y, ray.origin.z};
+  Float origin[3];
+  for (int k = 0; k < 3; ++k) origin[k] = V::splat(ray_origin[axes[k]]);
   Float relative[3][3];  // corner, permuted axis (x, y, z of the sheared frame before shearing)
   for (int c = 0; c < 3; ++c) {
-    for (int k = 0; k < 3; ++k) relative[c][k] = V::load(lanes.corner[c][axes[k]]) - V::splat(ray.origin[axes[k]]);
+    for (int k = 0; k < 3; ++k) relative[c][k] = V::load(lanes.corner[c][axes[k]]) - origin[k];
   }
   const Float shear_x = V::splat(ray.shear_x), shear_y = V::splat(ray.shear_y);
   Float px[3], py[3];

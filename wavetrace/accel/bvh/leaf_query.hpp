@@ -80,7 +80,7 @@ class LeafQuery {
           if (result.t[lane] > tmax) continue;
           hit = {result.t[lane], result.u[lane], result.v[lane]};
         }
-        if (accept(block->slot[lane], hit)) {
+        if (accept(block->slot[lane], hit, block, static_cast<std::uint32_t>(lane))) {
           if constexpr (kAnyHit) return;
         }
       }
@@ -89,7 +89,7 @@ class LeafQuery {
         TriangleHit hit;
         if (intersect_watertight(ray_, block->corner(lane, 0), block->corner(lane, 1), block->corner(lane, 2), tmin, tmax,
                                  hit) &&
-            accept(block->slot[lane], hit)) {
+            accept(block->slot[lane], hit, block, lane)) {
           if constexpr (kAnyHit) return;
         }
       }
@@ -107,14 +107,20 @@ class LeafQuery {
     }
     hits.set_hit(i, best_.t, geometry_.input_id(found_), best_.u, best_.v);
     if constexpr (!kSurface) return;
+    if (found_block_) {  // the corners are in the block just tested, no face-set read
+      const std::uint32_t k = found_lane_;
+      return hits.set_surface(i, found_block_->corner(k, 0), found_block_->corner(k, 1), found_block_->corner(k, 2));
+    }
     const glm::uvec3& tri = geometry_.triangles()[found_];
     const glm::vec3* positions = geometry_.positions();
     hits.set_surface(i, positions[tri.x], positions[tri.y], positions[tri.z]);
   }
 
  private:
-  // True when `hit` on face-set slot `triangle` becomes the nearest (nearest_hit.hpp).
-  bool accept(std::uint32_t triangle, const TriangleHit& hit) {
+  // True when `hit` on face-set slot `triangle` (in lane `lane` of `block` when a block was
+  // tested) becomes the nearest (nearest_hit.hpp).
+  bool accept(std::uint32_t triangle, const TriangleHit& hit, const TriangleBlock* block = nullptr,
+              std::uint32_t lane = 0) {
     if (!replaces_nearest(
             hit.t, tmax, found(), [&] { return geometry_.input_id(triangle); },
             [&] { return geometry_.input_id(found_); })) {
@@ -123,6 +129,7 @@ class LeafQuery {
     tmax = hit.t;
     best_ = hit;
     found_ = triangle;
+    found_block_ = block, found_lane_ = lane;
     return true;
   }
 
@@ -130,6 +137,8 @@ class LeafQuery {
   const std::uint32_t* leaf_index_;
   WatertightRay ray_;
   std::uint32_t found_ = kInvalidPrimitive;
+  const TriangleBlock* found_block_ = nullptr;  // where test_blocks found it
+  std::uint32_t found_lane_ = 0;
   TriangleHit best_{std::numeric_limits<float>::infinity(), 0.0f, 0.0f};
 };
 

@@ -1,5 +1,5 @@
-// The cut of the binary tree into wide nodes (a surface-area DP) and the outward-rounded
-// quantization of every child box against its frame.
+// The quantized 8-wide tree: the binary tree cut into wide nodes (collapse_plan.hpp) and the
+// outward-rounded quantization of every child box against its frame.
 #include "wavetrace/accel/bvh/quantized_wide_tree.hpp"
 
 #include <algorithm>
@@ -10,17 +10,13 @@
 #include <stdexcept>
 #include <vector>
 
+#include "wavetrace/accel/bvh/collapse_plan.hpp"
 #include "wavetrace/kernels/checked_narrowing.hpp"
 
 namespace wavetrace {
 namespace {
 
 constexpr int kWidth = QuantizedWideNode::kWidth;
-
-float half_area(const Bounds3& b) {
-  const glm::vec3 e = b.extent();
-  return e.x * e.y + e.y * e.z + e.z * e.x;
-}
 
 // q for one plane: the largest step count whose decoded plane stays at or below the
 // child's lower bound (lower) or at or above its upper bound (upper).
@@ -36,85 +32,6 @@ std::uint8_t quantize_upper(float frame_upper, float step, float upper) {
   while (q > 0.0f && std::fma(-q, step, frame_upper) < upper) q -= 1.0f;
   return static_cast<std::uint8_t>(q);
 }
-
-// Which binary nodes become wide nodes (Ylitie et al. 2017, §3.1, without their leaf choices:
-// the owners' leaves are fixed): the cut of the binary tree into nodes of at most eight
-// children that minimizes the summed surface area of the wide nodes (the chance a ray visits
-// each). Greedy collapsing (open the widest child until eight) left HMQ's nodes half empty
-// near the leaves: 4.0 children a node on room:1M, against 6.2 with this cut. No price per
-// node beyond its area: 1e-4 of the root's (8% fewer nodes) measured no faster and would tie
-// the cut to the scene's size.
-class CollapsePlan {
- public:
-  explicit CollapsePlan(const BuildTree& tree)
-      : best_(tree.nodes.size() * kWidth), split_(tree.nodes.size() * kWidth), opened_split_(tree.nodes.size()) {
-    const float root_area = std::max(half_area(tree.nodes[0].bounds), std::numeric_limits<float>::min());
-    // Children before parents: an explicit post-order, the tree may be deeper than the call stack likes.
-    std::vector<std::uint32_t> order, pending = {0};
-    order.reserve(tree.nodes.size());
-    while (!pending.empty()) {
-      const std::uint32_t n = pending.back();
-      pending.pop_back();
-      order.push_back(n);
-      if (!tree.nodes[n].leaf()) pending.insert(pending.end(), {tree.nodes[n].left, tree.nodes[n].right});
-    }
-    for (auto n = order.rbegin(); n != order.rend(); ++n) {
-      const BuildNode& node = tree.nodes[*n];
-      float* best = &best_[std::size_t(*n) * kWidth];
-      std::uint8_t* split = &split_[std::size_t(*n) * kWidth];
-      if (node.leaf()) {  // a leaf is one child wherever it goes; its own cost is the same in every cut
-        std::fill(best, best + kWidth, 0.0f);
-        std::fill(split, split + kWidth, std::uint8_t{0});
-        continue;
-      }
-      const float* left = &best_[std::size_t(node.left) * kWidth];
-      const float* right = &best_[std::size_t(node.right) * kWidth];
-      // best[k - 1]: the cheapest way to hang the subtree below a node as at most k children.
-      auto cheapest_split = [&](int k, std::uint8_t& chosen) {
-        float cost = std::numeric_limits<float>::infinity();
-        for (int j = 1; j < k; ++j) {
-          const float c = left[j - 1] + right[k - j - 1];
-          if (c < cost) cost = c, chosen = static_cast<std::uint8_t>(j);
-        }
-        return cost;
-      };
-      std::uint8_t opened = 1;
-      const float as_node = half_area(node.bounds) / root_area + cheapest_split(kWidth, opened);
-      opened_split_[*n] = opened;
-      best[0] = as_node;
-      split[0] = 0;
-      for (int k = 2; k <= kWidth; ++k) {
-        std::uint8_t chosen = 0;
-        const float spread = cheapest_split(k, chosen);
-        best[k - 1] = spread < as_node ? spread : as_node;
-        split[k - 1] = spread < as_node ? chosen : 0;
-      }
-    }
-  }
-
-  // The children of the wide node for binary node `root` (a leaf at the root: itself).
-  std::vector<std::uint32_t> children(const BuildTree& tree, std::uint32_t root) const {
-    if (tree.nodes[root].leaf()) return {root};
-    std::vector<std::uint32_t> out;
-    const int left = opened_split_[root];
-    frontier(tree, tree.nodes[root].left, left, out);
-    frontier(tree, tree.nodes[root].right, kWidth - left, out);
-    return out;
-  }
-
- private:
-  // Appends the children that binary node `n` becomes when it may take `k` slots.
-  void frontier(const BuildTree& tree, std::uint32_t n, int k, std::vector<std::uint32_t>& out) const {
-    const std::uint8_t j = split_[std::size_t(n) * kWidth + k - 1];
-    if (j == 0) return out.push_back(n);
-    frontier(tree, tree.nodes[n].left, j, out);
-    frontier(tree, tree.nodes[n].right, k - j, out);
-  }
-
-  std::vector<float> best_;
-  std::vector<std::uint8_t> split_;         // 0: the node itself is the child; j: left gets j slots
-  std::vector<std::uint8_t> opened_split_;  // a wide node's split of its eight slots, left : right
-};
 
 class Encoder {
  public:

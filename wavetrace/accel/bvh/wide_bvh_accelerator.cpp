@@ -1,5 +1,5 @@
-// The 8-wide BVH: the binary SAH tree collapsed (each node adopts the largest-area inner
-// child's children until it has eight), traversed one ray at a time with all eight child
+// The 8-wide BVH: the binary SAH tree cut into nodes of up to eight children by the
+// surface-area plan (collapse_plan.hpp), traversed one ray at a time with all eight child
 // boxes tested in one AVX2 pass, nearest child first; leaves are blocks of four triangles
 // tested in one 4-lane pass.
 #include "wavetrace/accel/bvh/wide_bvh_accelerator.hpp"
@@ -17,6 +17,7 @@
 #endif
 
 #include "wavetrace/accel/bvh/bvh_build.hpp"
+#include "wavetrace/accel/bvh/collapse_plan.hpp"
 #include "wavetrace/accel/probed_accelerator.hpp"
 #include "wavetrace/accel/ray_loop.hpp"
 #include "wavetrace/accel/section_archive.hpp"
@@ -34,11 +35,6 @@ namespace {
 
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
 constexpr int kWidth = WideBvhNode::kWidth;
-
-float half_area(const Bounds3& b) {
-  const glm::vec3 e = b.extent();
-  return e.x * e.y + e.y * e.z + e.z * e.x;
-}
 
 // Per-ray constants of the eight-box test.
 struct WideRay {
@@ -163,7 +159,7 @@ class WideBvhAccelerator final : public ProbedAccelerator<WideBvhAccelerator> {
     LargeArray<std::uint32_t> leaf_triangles;
     leaf_triangles.reserve(geometry_.triangle_count());
     build_nodes_.reserve(tree.nodes.size() / 4 + 1);
-    collapse(tree, 0, leaf_triangles);
+    collapse(tree, CollapsePlan(tree), 0, leaf_triangles);
     adopt_leaf_order(options, geometry_, leaf_triangles);
     LargeArray<TriangleBlock> blocks = block_leaves(leaf_triangles);
     nodes_ = StoredArray<WideBvhNode>(std::move(build_nodes_));
@@ -191,27 +187,9 @@ class WideBvhAccelerator final : public ProbedAccelerator<WideBvhAccelerator> {
   // Writes the wide node for binary node `root` (and, depth-first, everything below it);
   // returns its index. A binary leaf at the root becomes a wide node with one leaf lane, whose
   // child is its first slot in `leaf_triangles` until block_leaves makes it a block.
-  std::uint32_t collapse(const BuildTree& tree, std::uint32_t root, LargeArray<std::uint32_t>& leaf_triangles) {
-    std::vector<std::uint32_t> lanes;
-    if (tree.nodes[root].leaf()) {
-      lanes.push_back(root);
-    } else {
-      lanes = {tree.nodes[root].left, tree.nodes[root].right};
-      while (lanes.size() < kWidth) {
-        // Open the inner child with the largest surface: the one most rays would enter.
-        auto widest = lanes.end();
-        for (auto lane = lanes.begin(); lane != lanes.end(); ++lane) {
-          if (!tree.nodes[*lane].leaf() &&
-              (widest == lanes.end() || half_area(tree.nodes[*lane].bounds) > half_area(tree.nodes[*widest].bounds))) {
-            widest = lane;
-          }
-        }
-        if (widest == lanes.end()) break;
-        const BuildNode& opened = tree.nodes[*widest];
-        *widest = opened.left;
-        lanes.push_back(opened.right);
-      }
-    }
+  std::uint32_t collapse(const BuildTree& tree, const CollapsePlan& plan, std::uint32_t root,
+                         LargeArray<std::uint32_t>& leaf_triangles) {
+    const std::vector<std::uint32_t> lanes = plan.children(tree, root);
     const auto index = static_cast<std::uint32_t>(build_nodes_.size());
     build_nodes_.emplace_back();
     WideBvhNode node{};
@@ -228,7 +206,7 @@ class WideBvhAccelerator final : public ProbedAccelerator<WideBvhAccelerator> {
         node.count[k] = static_cast<std::uint8_t>(child.count);
         for (std::uint32_t i = 0; i < child.count; ++i) leaf_triangles.push_back(tree.primitive_order[child.first + i]);
       } else {
-        node.child[k] = collapse(tree, lanes[k], leaf_triangles);
+        node.child[k] = collapse(tree, plan, lanes[k], leaf_triangles);
         node.count[k] = 0;
       }
     }
