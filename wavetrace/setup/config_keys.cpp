@@ -226,6 +226,11 @@ const std::vector<ConfigKey>& config_schema() {
       {"accel.embree.queries", T::text, std::string("stream"), 0, 0, {"single", "stream"},
        "rtcIntersect1 per ray, or a batch range through rtcIntersectNp (camera rays flagged coherent)",
        choice<parse_embree_queries, &P::accelerator, &A::embree, &EmbreeOptions::queries>},
+      {"accel.embree.isa", T::text, std::string("native"), 0, 0, {"native", "avx2", "sse4.2"},
+       "Embree's kernels: the best the CPU has (AVX-512 where present), or forced down, for a comparison "
+       "with walks of that ISA",
+       choice<parse_embree_isa, &P::accelerator, &A::embree, &EmbreeOptions::isa>,
+       [](const RenderPlan& plan) -> Recorded { return plan.accelerator.embree.isa; }},
       {"accel.bvh.leaf_size", T::integer, std::int64_t{4}, 1, 16, {}, "most triangles per BVH leaf",
        integer<&P::accelerator, &A::bvh, &BvhOptions::max_leaf_size>},
       {"accel.bvh.layout", T::text, std::string("depth_first"), 0, 0, {"depth_first", "breadth_first", "veb"},

@@ -43,7 +43,8 @@ class EmbreeAccelerator final : public Accelerator {
  public:
   EmbreeAccelerator(const TriangleMesh& mesh, const EmbreeOptions& options) : mesh_(mesh), options_(options) {
     const auto start = std::chrono::steady_clock::now();
-    const std::string config = options.threads > 0 ? fmt::format("threads={}", options.threads) : std::string();
+    std::string config = options.threads > 0 ? fmt::format("threads={}", options.threads) : std::string();
+    if (options.isa != "native") config += (config.empty() ? "isa=" : ",isa=") + options.isa;
     device_ = rtcNewDevice(config.empty() ? nullptr : config.c_str());
     if (device_ == nullptr) throw std::runtime_error("embree: could not create a device");
     rtcSetDeviceMemoryMonitorFunction(device_, &MemoryMonitor::callback, &monitor_);
@@ -82,7 +83,8 @@ class EmbreeAccelerator final : public Accelerator {
   }
 
   std::string name() const override {
-    return options_.mode == EmbreeMode::standard ? "embree" : "embree-" + to_string(options_.mode);
+    const std::string isa = options_.isa == "native" ? "" : "-" + options_.isa;
+    return (options_.mode == EmbreeMode::standard ? "embree" : "embree-" + to_string(options_.mode)) + isa;
   }
 
   // A stream of one ray (the megakernel's) goes to rtcIntersect1: the same hits, without
@@ -273,6 +275,11 @@ EmbreeQueries parse_embree_queries(const std::string& text) {
 }
 
 std::string to_string(EmbreeQueries queries) { return queries == EmbreeQueries::stream ? "stream" : "single"; }
+
+std::string parse_embree_isa(const std::string& text) {
+  if (text == "native" || text == "avx2" || text == "sse4.2") return text;
+  throw std::invalid_argument(fmt::format("unknown embree isa '{}' (native, avx2, sse4.2)", text));
+}
 
 std::unique_ptr<Accelerator> make_embree_accelerator(const TriangleMesh& mesh, const EmbreeOptions& options) {
   return std::make_unique<EmbreeAccelerator>(mesh, options);

@@ -20,6 +20,7 @@ struct EmbreeOptions {
   EmbreeMode mode = EmbreeMode::standard;
   EmbreeQueries queries = EmbreeQueries::stream;
   int threads = 0;  // build threads; 0 = the TBB arena's
+  std::string isa = "native";  // Embree's kernels: the best this CPU has, or an ISA Embree names (avx2, sse4.2)
   bool operator==(const EmbreeOptions&) const = default;
 };
 
@@ -27,6 +28,7 @@ EmbreeMode parse_embree_mode(const std::string& text);  // "default" | "compact"
 std::string to_string(EmbreeMode mode);
 EmbreeQueries parse_embree_queries(const std::string& text);  // "single" | "stream"
 std::string to_string(EmbreeQueries queries);
+std::string parse_embree_isa(const std::string& text);  // "native" | "avx2" | "sse4.2"
 
 // Builds an Embree scene over `mesh`, which must outlive the accelerator (its buffers are
 // shared, not copied). Memory is Embree's own, measured by its memory monitor, plus the
