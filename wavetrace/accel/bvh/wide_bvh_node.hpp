@@ -15,8 +15,8 @@ namespace wavetrace {
 //       96    32  upper_y[8]  float
 //      128    32  lower_z[8]  float
 //      160    32  upper_z[8]  float
-//      192    32  child[8]    uint32  inner child: index of its node; leaf child: first
-//                                     slot in the leaf-triangle array
+//      192    32  child[8]    uint32  inner child: index of its node; leaf child: its first
+//                                     triangle block (triangle_block.hpp), ceil(count / 4) of them
 //      224     8  count[8]    uint8   0: inner child; 1..16: leaf with that many triangles
 //      232    24  (padding)
 //
