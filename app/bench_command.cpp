@@ -30,6 +30,7 @@ struct BenchArguments {
   bool packets = false;
   std::string json;
   std::string budgets;
+  bool reads = false;
   std::vector<std::string> assignments;
 };
 
@@ -91,6 +92,7 @@ int run_accel(const BenchArguments& args) {
   request.packets = args.packets;
   request.memory = plan_memory(setup.config);
   request.budgets = split_commas(args.budgets);
+  request.count_reads = args.reads;
   for (const std::string& budget : request.budgets) {
     try {
       parse_memory_budget(budget);
@@ -251,6 +253,8 @@ void add_bench_command(CLI::App& app, int& exit_code) {
                   "primary rays as 2x2 packets (intersect_coherent) where an accelerator has packet traversal");
   accel->add_option("--reference", accel_args->reference,
                     "accelerator the accuracy is measured against (default embree; embree:mode=robust is watertight)");
+  accel->add_flag("--reads", accel_args->reads,
+                  "one more probed pass counting reads a ray by the accelerator's arrays (nodes and leaves visited)");
   accel->add_option("--budgets", accel_args->budgets,
                     "simulated page pool budgets, one probed pass each, e.g. 100%,50%,20%,10% (see [memory])");
   accel->callback([accel_args, &exit_code] { exit_code = run_accel(*accel_args); });

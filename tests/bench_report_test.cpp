@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -101,6 +102,30 @@ TEST(BenchReport, FromTakesAnyBenchJsonAndAFailingScriptShowsItsOwnError) {
   EXPECT_NE(failed.exit_code, 0);
   EXPECT_NE(failed.output.find("the chart writer broke on purpose"), std::string::npos) << failed.output;
   EXPECT_EQ(failed.output.find("python3-matplotlib"), std::string::npos) << failed.output;
+}
+
+// --reads: every ray reads the 8-wide root, the walk reads blocks and never the face set (the
+// hit's surface comes from the block), and every read falls in one of the world's arrays.
+TEST(BenchAccel, ReadsCountNodesAndLeavesARay) {
+  const fs::path dir = fresh_dir("bench_reads");
+  fs::create_directories(dir);
+  const fs::path json = dir / "reads.json";
+  const auto bench = testing::run_wavetrace("bench accel --scene builtin:sphere:2000 --accel embree,bvh:width=8 --count 2000 "
+                                            "--repeat 1 --rays primary --reads --json " + json.string());
+  ASSERT_EQ(bench.exit_code, 0) << bench.output;
+  EXPECT_NE(bench.output.find("reads a ray, by array"), std::string::npos) << bench.output;
+  std::ifstream in(json);
+  const nlohmann::json report = nlohmann::json::parse(in);
+  const nlohmann::json& embree = report["results"][0];
+  EXPECT_TRUE(embree["reads_by_array"].empty());
+  const nlohmann::json& wide = report["results"][1];
+  const auto reads = wide["reads_by_array"].get<std::vector<std::uint64_t>>();
+  const auto bytes = wide["array_bytes"].get<std::vector<std::size_t>>();
+  ASSERT_EQ(reads.size(), bytes.size() + 1);
+  ASSERT_GE(reads.size(), 3u);
+  EXPECT_GE(reads[0], 2000u);  // nodes: the root at least, for each ray
+  EXPECT_GT(reads[1], 0u);     // triangle blocks
+  for (std::size_t array = 2; array < reads.size(); ++array) EXPECT_EQ(reads[array], 0u) << array;
 }
 
 }  // namespace

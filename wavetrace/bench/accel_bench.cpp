@@ -10,6 +10,7 @@
 #include <glm/geometric.hpp>
 
 #include "wavetrace/memory/process_memory.hpp"
+#include "wavetrace/memory/read_tally.hpp"
 #include "wavetrace/setup/render_setup.hpp"
 #include "wavetrace/pipeline/tracing_arena.hpp"
 
@@ -193,6 +194,14 @@ AccelBenchReport run_accel_bench(const Scene& scene, const AccelBenchRequest& re
       if (report.memory_observed && result.probed) {
         result.memory_runs = memory_runs(*accelerator, rays, request, report.threads);
       }
+      if (request.count_reads && result.probed) {
+        ReadTally tally(accelerator->memory_spans(), std::size_t(std::max(report.threads, 1)));
+        MemoryObservers observers;
+        observers.tally = &tally;
+        trace_ray_set_probed(*accelerator, rays, observers);
+        result.reads_by_array = tally.totals();
+        for (const auto& array : tally.arrays()) result.array_bytes.push_back(array.size());
+      }
       report.results.push_back(std::move(result));
     }
   });
@@ -244,6 +253,8 @@ nlohmann::json to_json(const AccelBenchReport& report) {
                        {"t_error_max", json_or_null(r.t_error_max)},
                        {"t_error_mean", json_or_null(r.t_error_mean)},
                        {"memory_runs", memory_runs_json(report, r)},
+                       {"reads_by_array", r.reads_by_array},
+                       {"array_bytes", r.array_bytes},
                        {"auto", r.auto_choice ? to_json(*r.auto_choice) : nlohmann::json(nullptr)}});
   }
   return {{"scene", {{"source", report.scene}, {"triangles", report.triangles}}},
@@ -268,6 +279,26 @@ std::string to_csv(const AccelBenchReport& report) {
                        optional(r.t_error_max), optional(r.t_error_mean));
   }
   return csv;
+}
+
+// Reads a ray by world array: for a BVH the nodes and leaves (blocks, records) it visits.
+std::string reads_table(const AccelBenchReport& report) {
+  const double rays = double(std::max<std::size_t>(report.ray_count, 1));
+  std::string table = "\nreads a ray, by array of the accelerator (its memory spans in order, with their MB):\n";
+  for (const AccelBenchResult& r : report.results) {
+    if (r.reads_by_array.empty()) {
+      table += fmt::format("{:<24} cannot be observed: no counters\n", r.label);
+      continue;
+    }
+    std::string cells;
+    for (std::size_t array = 0; array < r.array_bytes.size(); ++array) {
+      cells += fmt::format("{}{:.1f} MB: {:.2f}", array == 0 ? "" : " | ", double(r.array_bytes[array]) * 1e-6,
+                           double(r.reads_by_array[array]) / rays);
+    }
+    if (r.reads_by_array.back() > 0) cells += fmt::format(" | elsewhere: {:.2f}", double(r.reads_by_array.back()) / rays);
+    table += fmt::format("{:<24} {}\n", r.label, cells);
+  }
+  return table;
 }
 
 std::string memory_table(const AccelBenchReport& report) {
@@ -326,6 +357,9 @@ std::string to_table(const AccelBenchReport& report) {
                          r.label, *r.surface_error_max, *r.vertex_error_max);
   }
   if (report.memory_observed) table += memory_table(report);
+  if (std::any_of(report.results.begin(), report.results.end(), [](const auto& r) { return !r.reads_by_array.empty(); })) {
+    table += reads_table(report);
+  }
   return table;
 }
 

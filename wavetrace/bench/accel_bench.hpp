@@ -65,6 +65,10 @@ struct AccelBenchResult {
   std::optional<double> vertex_error_max;
   bool probed = false;                 // false: the accelerator's reads cannot be observed (Embree)
   std::vector<MemoryRun> memory_runs;  // one per budget, when memory observation was asked for
+  // With --reads: the probe's reads of one pass, by world array (memory_spans order; the last
+  // entry counts reads outside them), and each array's bytes.
+  std::vector<std::uint64_t> reads_by_array;
+  std::vector<std::size_t> array_bytes;
   std::optional<AccelChoice> auto_choice;  // the spec was auto: its candidates and reasons
 };
 
@@ -93,6 +97,7 @@ struct AccelBenchRequest {
   // The simulated pager's settings and cache; `budgets` (e.g. "100%", "20%") replace memory.budget when given.
   MemoryPlan memory;
   std::vector<std::string> budgets;
+  bool count_reads = false;  // one probed pass counting reads per world array (nodes, leaves, ...)
   // A saved world (bench accel --scene FILE.wtw): measured instead of `accelerators`, with
   // its load in place of a build; the reference is built from its geometry when it has some,
   // else the world answers for itself (accuracy then compares it with itself).

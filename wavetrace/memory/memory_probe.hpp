@@ -13,6 +13,7 @@
 
 #include "wavetrace/memory/cache_simulator.hpp"
 #include "wavetrace/memory/file_pager.hpp"
+#include "wavetrace/memory/read_tally.hpp"
 #include "wavetrace/memory/simulated_pager.hpp"
 
 namespace wavetrace {
@@ -28,7 +29,8 @@ struct MemoryObservers {
   SimulatedPager* pager = nullptr;
   CacheBank* caches = nullptr;
   FilePager* file_pager = nullptr;  // real paging: reads keep its LRU order and load its pages
-  bool any() const { return pager != nullptr || caches != nullptr || file_pager != nullptr; }
+  ReadTally* tally = nullptr;       // reads counted by world array
+  bool any() const { return pager != nullptr || caches != nullptr || file_pager != nullptr || tally != nullptr; }
 };
 
 // One thread's probe for one batch: lives on the stack of the stage call.
@@ -40,7 +42,9 @@ class RecordingProbe {
       : pager_(observers.pager),
         cache_(observers.caches ? &observers.caches->for_thread(thread % observers.caches->threads()) : nullptr),
         file_pager_(observers.file_pager),
-        client_(client) {
+        tally_(observers.tally),
+        client_(client),
+        thread_(thread) {
     if (file_pager_ != nullptr) {
       file_page_shift_ = static_cast<unsigned>(std::countr_zero(file_pager_->page_bytes()));
       client_scope_.emplace(client);  // faults this thread takes count to this stage
@@ -71,6 +75,7 @@ class RecordingProbe {
   }
 
   void read(const void* address, std::size_t bytes) {
+    if (tally_ != nullptr) tally_->count(thread_, address);
     if (cache_ != nullptr) cache_->access(address, bytes, client_);
     if (file_pager_ != nullptr) {
       // The page is loaded now, before the read it announces; a page change is a touch.
@@ -108,7 +113,9 @@ class RecordingProbe {
   SimulatedPager* pager_;
   CacheSimulator* cache_;
   FilePager* file_pager_;
+  ReadTally* tally_;
   std::size_t client_;
+  std::size_t thread_;
   unsigned file_page_shift_ = 0;
   std::uintptr_t last_file_page_ = ~std::uintptr_t{0};
   std::optional<FilePager::ClientScope> client_scope_;
