@@ -128,5 +128,27 @@ TEST(BenchAccel, ReadsCountNodesAndLeavesARay) {
   for (std::size_t array = 2; array < reads.size(); ++array) EXPECT_EQ(reads[array], 0u) << array;
 }
 
+// A lossy layout's diffuse rays measured again from beyond its stated error: the self-hits of
+// its own surface leave the agreement, which cannot fall; an exact layout gets no such pass.
+TEST(BenchAccel, LossyAgreementIsMeasuredAgainBeyondTheStatedError) {
+  const fs::path dir = fresh_dir("bench_beyond_error");
+  fs::create_directories(dir);
+  const fs::path json = dir / "beyond.json";
+  const auto bench = testing::run_wavetrace("bench accel --scene builtin:room:20k --accel bvh,hmq:width=8 --count 4000 "
+                                            "--repeat 1 --rays diffuse --json " + json.string());
+  ASSERT_EQ(bench.exit_code, 0) << bench.output;
+  EXPECT_NE(bench.output.find("x its vertex error"), std::string::npos) << bench.output;
+  std::ifstream in(json);
+  const nlohmann::json report = nlohmann::json::parse(in);
+  const nlohmann::json& exact = report["results"][0];
+  EXPECT_TRUE(exact["beyond_error_start"].is_null());
+  const nlohmann::json& lossy = report["results"][1];
+  ASSERT_FALSE(lossy["beyond_error_start"].is_null());
+  EXPECT_NEAR(lossy["beyond_error_start"].get<double>(), 16.0 * lossy["vertex_error_max"].get<double>(), 1e-6);
+  EXPECT_GE(lossy["beyond_error_hit_agreement"].get<double>(), lossy["hit_agreement"].get<double>());
+  EXPECT_GE(lossy["beyond_error_prim_agreement"].get<double>(), lossy["prim_agreement"].get<double>());
+  EXPECT_GT(lossy["self_hits"].get<double>(), 0.0);  // the room's flat walls: some rays meet their own quantized wall
+}
+
 }  // namespace
 }  // namespace wavetrace

@@ -48,6 +48,39 @@ void compare(const RaySet& rays, const std::vector<std::unique_ptr<HitBatch>>& h
   }
 }
 
+// For a lossy accelerator on rays that start on a surface: the rays again with tmin raised
+// past its stated error, traced by it and by the reference (see AccelBenchResult).
+void measure_agreement_beyond_error(const RaySet& rays, const Accelerator& reference, const Accelerator& accelerator,
+                                    const std::vector<std::unique_ptr<HitBatch>>& hits,
+                                    const std::vector<std::unique_ptr<HitBatch>>& reference_hits, AccelBenchResult& result) {
+  if (!result.vertex_error_max || !(*result.vertex_error_max > 0.0) || rays.kind == RaySetKind::primary ||
+      rays.kind == RaySetKind::random) {
+    return;
+  }
+  const float start = static_cast<float>(kBeyondErrorFactor * *result.vertex_error_max);
+  RaySet later{rays.kind, {}};
+  std::size_t self_hits = 0;
+  for (std::size_t b = 0; b < rays.batches.size(); ++b) {
+    const RayBatch& batch = *rays.batches[b];
+    auto copy = std::make_unique<RayBatch>(batch.capacity());
+    for (std::size_t i = 0; i < batch.count; ++i) {
+      copy->copy_ray(i, batch, i);
+      copy->tmin[i] = std::max(batch.tmin[i], start);
+      const bool own = hits[b]->is_hit(i) && hits[b]->t[i] < start;
+      const bool theirs = reference_hits[b]->is_hit(i) && reference_hits[b]->t[i] < start;
+      self_hits += own && !theirs;
+    }
+    copy->count = batch.count;
+    later.batches.push_back(std::move(copy));
+  }
+  AccelBenchResult beyond;
+  compare(later, trace_ray_set(accelerator, later), trace_ray_set(reference, later), 1.0f, beyond);
+  result.beyond_error_start = start;
+  result.beyond_error_hit_agreement = beyond.hit_agreement;
+  result.beyond_error_prim_agreement = beyond.prim_agreement;
+  result.self_hits = double(self_hits) / double(std::max<std::size_t>(rays.count(), 1));
+}
+
 }  // namespace
 
 AcceleratorSpec parse_accelerator_spec(const std::string& text, const Config& base) {
@@ -190,6 +223,7 @@ AccelBenchReport run_accel_bench(const Scene& scene, const AccelBenchRequest& re
       result.mrays_per_s = median(result.mrays_per_s_runs);
       compare(rays, hits, reference_hits, diagonal, result);
       if (!rays.any_hit() && has_mesh) measure_surface_error(scene.mesh, *accelerator, rays, hits, result);
+      if (has_mesh) measure_agreement_beyond_error(rays, *reference, *accelerator, hits, reference_hits, result);
       result.probed = accelerator->probed();
       if (report.memory_observed && result.probed) {
         result.memory_runs = memory_runs(*accelerator, rays, request, report.threads);
@@ -250,6 +284,10 @@ nlohmann::json to_json(const AccelBenchReport& report) {
                        {"prim_agreement", json_or_null(r.prim_agreement)},
                        {"surface_error_max", json_or_null(r.surface_error_max)},
                        {"vertex_error_max", json_or_null(r.vertex_error_max)},
+                       {"beyond_error_start", json_or_null(r.beyond_error_start)},
+                       {"beyond_error_hit_agreement", json_or_null(r.beyond_error_hit_agreement)},
+                       {"beyond_error_prim_agreement", json_or_null(r.beyond_error_prim_agreement)},
+                       {"self_hits", json_or_null(r.self_hits)},
                        {"t_error_max", json_or_null(r.t_error_max)},
                        {"t_error_mean", json_or_null(r.t_error_mean)},
                        {"memory_runs", memory_runs_json(report, r)},
@@ -355,6 +393,16 @@ std::string to_table(const AccelBenchReport& report) {
     if (!r.surface_error_max) continue;
     table += fmt::format("{}: hit points lie at most {:.3g} from the mesh's triangles (vertices moved at most {:.3g})\n",
                          r.label, *r.surface_error_max, *r.vertex_error_max);
+  }
+  for (const AccelBenchResult& r : report.results) {
+    if (!r.beyond_error_start) continue;
+    table += fmt::format("{}: rays started {:.3g} out ({}x its vertex error): hit agreement {:.4f}%{}; {:.4f}% of rays "
+                         "hit its own surface before that and the reference's not\n",
+                         r.label, *r.beyond_error_start, kBeyondErrorFactor, 100.0 * *r.beyond_error_hit_agreement,
+                         r.beyond_error_prim_agreement
+                             ? fmt::format(", primitive agreement {:.4f}%", 100.0 * *r.beyond_error_prim_agreement)
+                             : std::string(),
+                         100.0 * *r.self_hits);
   }
   if (report.memory_observed) table += memory_table(report);
   if (std::any_of(report.results.begin(), report.results.end(), [](const auto& r) { return !r.reads_by_array.empty(); })) {

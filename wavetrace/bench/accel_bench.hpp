@@ -43,6 +43,11 @@ struct MemoryRun {
   double instrumented_mrays_per_s = 0.0;
 };
 
+// How far beyond a lossy accelerator's vertex error its agreement is measured again: a ray
+// leaving a surface offset by e meets it within e / cos(angle) of its start, and under 0.4% of
+// cosine-distributed directions lie within cos = 1/16 of the surface.
+inline constexpr double kBeyondErrorFactor = 16.0;
+
 struct AccelBenchResult {
   std::string label;
   MemoryReport memory;
@@ -63,6 +68,15 @@ struct AccelBenchResult {
   // distance any vertex moved). Closest-hit sets only.
   std::optional<double> surface_error_max;
   std::optional<double> vertex_error_max;
+  // Lossy accelerators, rays that start on a surface (diffuse, shadow): the same rays started
+  // beyond kBeyondErrorFactor times the vertex error, traced by it and by the reference, so a
+  // ray no longer meets the lossy surface it starts on. What is left to disagree are cracks
+  // and real differences of shape; `self_hits` is the share of rays that found a hit of the
+  // accelerator's own within that start and none of the reference's.
+  std::optional<double> beyond_error_start;
+  std::optional<double> beyond_error_hit_agreement;
+  std::optional<double> beyond_error_prim_agreement;
+  std::optional<double> self_hits;
   bool probed = false;                 // false: the accelerator's reads cannot be observed (Embree)
   std::vector<MemoryRun> memory_runs;  // one per budget, when memory observation was asked for
   // With --reads: the probe's reads of one pass, by world array (memory_spans order; the last
