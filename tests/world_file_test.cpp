@@ -297,7 +297,11 @@ TEST(WorldFile, TracesLookAheadReadsPagesAheadAndChangesNoPixel) {
       } else {
         EXPECT_GT(disk.prefetched, 0u) << threads;
         EXPECT_LT(disk.prefetched, disk.counters.faults) << threads;
-        EXPECT_GT(disk.prefetch_hits, disk.prefetched / 5) << threads;  // 40% here, on 4 KiB pages
+        // Which look-ahead pages are still resident when trace reaches them depends on timing:
+        // 40% in the plain build, 17-18% under the sanitizers with TBB held to one worker
+        // (Intel Xeon, 2026-12-03). The bound guards against a look-ahead whose pages are not
+        // the ones trace reads next.
+        EXPECT_GT(disk.prefetch_hits, disk.prefetched / 10) << threads;
       }
     }
   }
