@@ -164,6 +164,7 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
         {"load_seconds", facts.phases.load_seconds}}},
       {"accel",
        {{"type", facts.accelerator.name()},
+        {"isa", facts.accelerator.isa()},
         {"bytes", memory.total()},
         {"bytes_per_triangle", double(memory.total()) / triangles},
         {"parts", {{"hierarchy", memory.hierarchy}, {"geometry", memory.geometry}, {"other", memory.other}}},
@@ -225,8 +226,9 @@ std::string render_table(const RenderFacts& facts) {
   const BuildReport build = facts.accelerator.build();
   table += fmt::format("render ({}): {:.3f} s wall on {} threads ({:.3f} thread-seconds), {:.2f} Mrays/s traced\n",
                        to_string(facts.plan.pipeline.mode), run.seconds, run.threads, thread_seconds, traced / run.seconds * 1e-6);
-  table += fmt::format("accel {}: {:.1f} MB, {:.1f} bytes/triangle (hierarchy {:.1f}, geometry {:.1f}), built in {:.3f} s\n",
-                       facts.accelerator.name(), double(memory.total()) * 1e-6,
+  const std::string isa = facts.accelerator.isa();
+  table += fmt::format("accel {}{}: {:.1f} MB, {:.1f} bytes/triangle (hierarchy {:.1f}, geometry {:.1f}), built in {:.3f} s\n",
+                       facts.accelerator.name(), isa.empty() ? "" : " (" + isa + " walks)", double(memory.total()) * 1e-6,
                        double(memory.total()) / double(facts.scene.triangle_count),
                        double(memory.hierarchy) / double(facts.scene.triangle_count),
                        double(memory.geometry) / double(facts.scene.triangle_count), build.seconds);

@@ -4,7 +4,7 @@
 include(CheckCXXSourceCompiles)
 string(MAKE_C_IDENTIFIER "${WAVETRACE_ARCH}" wavetrace_arch_id)
 set(CMAKE_REQUIRED_FLAGS "-march=${WAVETRACE_ARCH}")
-foreach(feature AVX2 FMA BMI2)
+foreach(feature AVX2 FMA BMI2 AVX512F)
   check_cxx_source_compiles("#ifndef __${feature}__\n#error\n#endif\nint main() { return 0; }"
                             WAVETRACE_${wavetrace_arch_id}_HAS_${feature})
   if(WAVETRACE_${wavetrace_arch_id}_HAS_${feature})

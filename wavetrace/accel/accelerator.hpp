@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "wavetrace/memory/kernel_isa_choice.hpp"
 #include "wavetrace/memory/memory_probe.hpp"
 #include "wavetrace/memory/ray_batch.hpp"
 #include "wavetrace/scene/triangle_mesh.hpp"
@@ -60,6 +61,13 @@ class Accelerator {
                                         RecordingProbe& probe) const;
   virtual void intersect_any_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
                                     RecordingProbe& probe) const;
+
+  // The instruction set its walks run (accel.isa in the stats): one of the kernel sets
+  // compiled into this binary (memory/kernel_isa.hpp), or Embree's setting; empty where
+  // there is no choice. use_isa switches to a set runnable_kernel_isas() lists; the
+  // accelerators without a choice ignore it.
+  virtual std::string isa() const { return {}; }
+  virtual void use_isa(KernelIsa isa) {}
 
   virtual MemoryReport memory() const = 0;
   virtual BuildReport build() const = 0;

@@ -10,6 +10,7 @@
 #include "wavetrace/accel/chunked/chunked_accelerator.hpp"
 #include "wavetrace/accel/section_archive.hpp"
 #include "wavetrace/kernels/checked_narrowing.hpp"
+#include "wavetrace/memory/kernel_isa_choice.hpp"
 
 namespace wavetrace {
 namespace {
@@ -145,8 +146,15 @@ double estimated_bytes_per_triangle(const AcceleratorOptions& options) {
 }
 double estimated_build_bytes_per_triangle(std::string_view type) { return accelerator_type(type).build_bytes_per_triangle; }
 
-std::unique_ptr<Accelerator> make_world_accelerator(const TriangleSource& source, const TriangleMesh* whole,
-                                                    const AcceleratorOptions& options, const ChunkStream* stream) {
+namespace {
+
+std::unique_ptr<Accelerator> with_kernels(std::unique_ptr<Accelerator> accelerator, const AcceleratorOptions& options) {
+  accelerator->use_isa(parse_kernel_isa(options.isa));
+  return accelerator;
+}
+
+std::unique_ptr<Accelerator> build_for_world(const TriangleSource& source, const TriangleMesh* whole,
+                                             const AcceleratorOptions& options, const ChunkStream* stream) {
   checked_uint32(source.triangle_count(), "triangles of a scene, which hits name by 32-bit ids");
   const AcceleratorType& type = accelerator_type(options.type);
   AcceleratorOptions chunk_options = options;
@@ -164,6 +172,14 @@ std::unique_ptr<Accelerator> make_world_accelerator(const TriangleSource& source
   return type.make(mesh, chunk_options);
 }
 
+}  // namespace
+
+std::unique_ptr<Accelerator> make_world_accelerator(const TriangleSource& source, const TriangleMesh* whole,
+                                                    const AcceleratorOptions& options, const ChunkStream* stream) {
+  parse_kernel_isa(options.isa);  // a bad setting fails before the build, not after it
+  return with_kernels(build_for_world(source, whole, options, stream), options);
+}
+
 std::unique_ptr<Accelerator> load_accelerator(SectionLoader& in) {
   const SavedKind kind = in.file()->value<SavedKind>(in.prefix() + "kind");
   const std::string name(kind.type, strnlen(kind.type, sizeof(kind.type)));
@@ -177,7 +193,8 @@ std::unique_ptr<Accelerator> load_accelerator(SectionLoader& in) {
 }
 
 std::unique_ptr<Accelerator> make_accelerator(const TriangleMesh& mesh, const AcceleratorOptions& options) {
-  return accelerator_type(options.type).make(mesh, options);
+  parse_kernel_isa(options.isa);
+  return with_kernels(accelerator_type(options.type).make(mesh, options), options);
 }
 
 }  // namespace wavetrace

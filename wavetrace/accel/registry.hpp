@@ -34,6 +34,8 @@ struct AcceleratorOptions {
   RayStripsOptions raystrips;
   HmqOptions hmq;
   TinyBvhOptions tinybvh;
+  // The kernel set of our walks (memory/kernel_isa.hpp): auto, avx2 or avx512.
+  std::string isa = "auto";
   // Scenes of more triangles are built in chunks of at most this many (hmq, raystrips, bvh).
   std::size_t chunk_triangles = std::size_t{1} << 22;
   bool operator==(const AcceleratorOptions&) const = default;
@@ -89,7 +91,8 @@ const AcceleratorType* find_accelerator_type(std::string_view name);
 const AcceleratorType& accelerator_type(std::string_view name);
 std::vector<std::string> accelerator_names();
 
-// Throws std::invalid_argument naming an unknown type.
+// Throws std::invalid_argument naming an unknown type or kernel set (options.isa); the
+// accelerator walks with that set.
 std::unique_ptr<Accelerator> make_accelerator(const TriangleMesh& mesh, const AcceleratorOptions& options);
 
 // The accelerator saved under the loader's prefix (its "kind" names the type), traced in

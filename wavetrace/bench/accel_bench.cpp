@@ -213,6 +213,7 @@ AccelBenchReport run_accel_bench(const Scene& scene, const AccelBenchRequest& re
       result.memory = accelerator->memory();
       result.bytes_per_triangle = double(result.memory.total()) / double(scene.triangle_count);
       result.build_notes = accelerator->build_notes();
+      result.isa = accelerator->isa();
       std::vector<std::unique_ptr<HitBatch>> hits;
       for (int run = 0; run < std::max(1, request.repeats); ++run) {
         const auto start = std::chrono::steady_clock::now();
@@ -278,6 +279,7 @@ nlohmann::json to_json(const AccelBenchReport& report) {
                        {"build_peak_accounted_bytes", r.build.peak_bytes},
                        {"build_peak_rss_above_start_bytes", r.build_peak_rss_above_start_bytes},
                        {"build_notes", r.build_notes},
+                       {"isa", r.isa},
                        {"mrays_per_s", r.mrays_per_s},
                        {"mrays_per_s_runs", r.mrays_per_s_runs},
                        {"hit_agreement", r.hit_agreement},
@@ -306,12 +308,12 @@ nlohmann::json to_json(const AccelBenchReport& report) {
 
 std::string to_csv(const AccelBenchReport& report) {
   std::string csv =
-      "scene,triangles,rays,count,threads,accel,bytes,bytes_per_triangle,hierarchy,geometry,other,build_seconds,"
+      "scene,triangles,rays,count,threads,accel,isa,bytes,bytes_per_triangle,hierarchy,geometry,other,build_seconds,"
       "build_peak_accounted_bytes,build_peak_rss_above_start_bytes,mrays_per_s,hit_agreement,prim_agreement,t_error_max,t_error_mean\n";
   const auto optional = [](const std::optional<double>& v) { return v ? fmt::format("{:.9g}", *v) : std::string(); };
   for (const AccelBenchResult& r : report.results) {
-    csv += fmt::format("{},{},{},{},{},{},{},{:.3f},{},{},{},{:.4f},{},{},{:.4f},{:.9g},{},{},{}\n", report.scene,
-                       report.triangles, report.rays, report.ray_count, report.threads, r.label, r.memory.total(),
+    csv += fmt::format("{},{},{},{},{},{},{},{},{:.3f},{},{},{},{:.4f},{},{},{:.4f},{:.9g},{},{},{}\n", report.scene,
+                       report.triangles, report.rays, report.ray_count, report.threads, r.label, r.isa, r.memory.total(),
                        r.bytes_per_triangle, r.memory.hierarchy, r.memory.geometry, r.memory.other, r.build.seconds,
                        r.build.peak_bytes, r.build_peak_rss_above_start_bytes, r.mrays_per_s, r.hit_agreement, optional(r.prim_agreement),
                        optional(r.t_error_max), optional(r.t_error_mean));
@@ -372,14 +374,14 @@ std::string to_table(const AccelBenchReport& report) {
       "{}: {} triangles; {} {} rays{} ({:.1f}% hit the reference, {}); {} threads; median of {} runs\n", report.scene,
       report.triangles, report.ray_count, report.rays, report.packets ? " as 2x2 packets" : "",
       100.0 * report.reference_hit_rate, report.reference, report.threads, report.repeats);
-  table += fmt::format("{:<24} {:>9} {:>8} {:>8} {:>8} {:>9} {:>11} {:>8} {:>10} {:>10} {:>10} {:>10}\n", "accel",
-                       "MB", "B/tri", "hier", "geom", "build s", "peak RSS MB", "Mrays/s", "vs first", "hit agr", "prim agr",
+  table += fmt::format("{:<24} {:<7} {:>9} {:>8} {:>8} {:>8} {:>9} {:>11} {:>8} {:>10} {:>10} {:>10} {:>10}\n", "accel",
+                       "isa", "MB", "B/tri", "hier", "geom", "build s", "peak RSS MB", "Mrays/s", "vs first", "hit agr", "prim agr",
                        "t err max");
   const double first = report.results.empty() ? 0.0 : report.results.front().mrays_per_s;
   const double triangles = double(report.triangles);
   for (const AccelBenchResult& r : report.results) {
-    table += fmt::format("{:<24} {:>9.1f} {:>8.1f} {:>8.1f} {:>8.1f} {:>9.3f} {:>11.1f} {:>8.2f} {:>9.2f}x {:>9.4f}% {:>9} {:>10}\n",
-                         r.label, double(r.memory.total()) * 1e-6, r.bytes_per_triangle,
+    table += fmt::format("{:<24} {:<7} {:>9.1f} {:>8.1f} {:>8.1f} {:>8.1f} {:>9.3f} {:>11.1f} {:>8.2f} {:>9.2f}x {:>9.4f}% {:>9} {:>10}\n",
+                         r.label, r.isa.empty() ? "-" : r.isa, double(r.memory.total()) * 1e-6, r.bytes_per_triangle,
                          double(r.memory.hierarchy) / triangles, double(r.memory.geometry) / triangles, r.build.seconds,
                          double(r.build_peak_rss_above_start_bytes) * 1e-6, r.mrays_per_s, first > 0 ? r.mrays_per_s / first : 0.0,
                          100.0 * r.hit_agreement,

@@ -57,6 +57,7 @@ struct AccelBenchResult {
   // what the process held when it began; 0 where the peak cannot be reset.
   std::size_t build_peak_rss_above_start_bytes = 0;
   std::string build_notes;
+  std::string isa;  // the instruction set its walks ran (Accelerator::isa)
   std::vector<double> mrays_per_s_runs;
   double mrays_per_s = 0.0;      // median of the runs
   double hit_agreement = 0.0;    // same hit / miss as the reference

@@ -1,6 +1,7 @@
 // Opening or building a benchmark's world once.
 #include "wavetrace/scene/load_scene.hpp"
 #include "wavetrace/bench/render_world.hpp"
+#include "wavetrace/memory/kernel_isa_choice.hpp"
 
 #include <fmt/format.h>
 
@@ -16,6 +17,7 @@ Config heuristic_variant(const Config& config, ReorderHeuristic heuristic) {
 RenderWorld::RenderWorld(const RenderPlan& base, bool needs_proxy) {
   if (is_world_file(base.scene.source)) {
     saved_ = load_world(base.scene.source, world_paging(base), base.pipeline.threads);
+    saved_->accelerator->use_isa(parse_kernel_isa(base.accelerator.isa));
     if (needs_proxy && !saved_->proxy) {
       throw ConfigError(fmt::format("{} was saved without a proxy, which hit-point heuristics need: build it with --proxy",
                                     base.scene.source));

@@ -36,17 +36,29 @@ extern "C" __attribute__((constructor(101))) void wavetrace_check_cpu_at_start()
 
 namespace wavetrace {
 
-CpuFeatures required_cpu_features() { return {WAVETRACE_AVX2 != 0, WAVETRACE_FMA != 0, WAVETRACE_BMI2 != 0}; }
+CpuFeatures required_cpu_features() {
+  return {WAVETRACE_AVX2 != 0, WAVETRACE_FMA != 0, WAVETRACE_BMI2 != 0, WAVETRACE_AVX512F != 0};
+}
 
 CpuFeatures running_cpu_features() {
   __builtin_cpu_init();
-  return {__builtin_cpu_supports("avx2") != 0, __builtin_cpu_supports("fma") != 0, __builtin_cpu_supports("bmi2") != 0};
+  // libgcc's answer for avx512* already asks the OS (XGETBV) whether it saves the ZMM state.
+  const bool avx512 = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+                      __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq") &&
+                      __builtin_cpu_supports("avx512cd");
+  return {__builtin_cpu_supports("avx2") != 0, __builtin_cpu_supports("fma") != 0, __builtin_cpu_supports("bmi2") != 0,
+          avx512};
 }
 
 const char* cpu_support_error(const CpuFeatures& have, const CpuFeatures& need) {
   if (need.avx2 && !have.avx2) return "wavetrace: error: this CPU has no AVX2" WAVETRACE_REBUILD_HINT;
   if (need.fma && !have.fma) return "wavetrace: error: this CPU has no FMA" WAVETRACE_REBUILD_HINT;
   if (need.bmi2 && !have.bmi2) return "wavetrace: error: this CPU has no BMI2" WAVETRACE_REBUILD_HINT;
+  if (need.avx512 && !have.avx512) {
+    return "wavetrace: error: this CPU has no AVX-512 (F, VL, BW, DQ, CD), which this build of wavetrace needs "
+           "(-march=" WAVETRACE_ARCH "): rebuild it with the default -DWAVETRACE_ARCH=x86-64-v3, whose AVX-512 walks "
+           "are chosen at start only where the CPU has them\n";
+  }
   return nullptr;
 }
 

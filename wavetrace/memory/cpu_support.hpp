@@ -7,6 +7,7 @@ namespace wavetrace {
 
 struct CpuFeatures {
   bool avx2 = false, fma = false, bmi2 = false;
+  bool avx512 = false;  // x86-64-v4's F, VL, BW, DQ and CD, with the OS saving their registers
 };
 
 // What this build of the library executes (its -march).

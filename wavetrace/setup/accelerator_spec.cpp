@@ -1,6 +1,8 @@
 // TYPE[:key=value]... to config keys.
 #include "wavetrace/setup/accelerator_spec.hpp"
 
+#include <algorithm>
+
 #include <fmt/format.h>
 
 namespace wavetrace {
@@ -15,9 +17,15 @@ void apply_accelerator_spec(Config& config, const std::string& text) {
     if (option.find('=') == std::string::npos) {
       throw ConfigError(fmt::format("--accel '{}': '{}' is not key=value", text, option));
     }
-    const std::string section = option.starts_with("chunk_triangles=") ? "build."
-                                : type == "auto"                        ? "accel."
-                                                                        : "accel." + type + ".";
+    // A key the type does not have itself is a general one: isa= is the kernel set of our
+    // walks (accel.isa) for every type but one with its own (accel.embree.isa).
+    const std::string name = option.substr(0, option.find('='));
+    const bool own = std::ranges::any_of(config_schema(), [&](const ConfigKey& key) {
+      return key.name == "accel." + type + "." + name;
+    });
+    const std::string section = name == "chunk_triangles"                  ? "build."
+                                : type == "auto" || (name == "isa" && !own) ? "accel."
+                                                                            : "accel." + type + ".";
     config.set(section + option);
     colon = next;
   }

@@ -8,6 +8,7 @@
 #include "wavetrace/memory/process_memory.hpp"
 #include "wavetrace/setup/world_file.hpp"
 #include "wavetrace/setup/world_setup.hpp"
+#include "wavetrace/memory/kernel_isa_choice.hpp"
 
 namespace wavetrace {
 
@@ -30,6 +31,7 @@ BuiltWorld::~BuiltWorld() = default;
 
 void BuiltWorld::open_world_file() {
   loaded_ = load_world(plan_.scene.source, world_paging(plan_), plan_.pipeline.threads);
+  loaded_->accelerator->use_isa(parse_kernel_isa(plan_.accelerator.isa));
   phases_.load_seconds = loaded_->seconds;
   phases_.after_load_bytes = phases_.after_build_bytes = read_resident_memory().current_bytes;
   plan_.accelerator.type = loaded_->type;

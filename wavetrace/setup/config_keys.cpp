@@ -11,6 +11,7 @@
 #include "wavetrace/pipeline/pipeline.hpp"
 #include "wavetrace/setup/config.hpp"
 #include "wavetrace/setup/render_plan.hpp"
+#include "wavetrace/memory/kernel_isa_choice.hpp"
 
 namespace wavetrace {
 namespace {
@@ -51,6 +52,13 @@ void text(const Config& config, std::string_view key, RenderPlan& plan) {
 template <auto Parse, auto... Path>
 void choice(const Config& config, std::string_view key, RenderPlan& plan) {
   field<Path...>(plan) = Parse(config.text(key));
+}
+
+// accel.isa kept as written ("auto" is resolved when an accelerator is made), once checked
+// against this build and CPU.
+std::string checked_kernel_isa(const std::string& text) {
+  parse_kernel_isa(text);
+  return text;
 }
 
 // A built accelerator's setting as the world file records it (ConfigKey::record).
@@ -231,6 +239,10 @@ const std::vector<ConfigKey>& config_schema() {
        "with walks of that ISA",
        choice<parse_embree_isa, &P::accelerator, &A::embree, &EmbreeOptions::isa>,
        [](const RenderPlan& plan) -> Recorded { return plan.accelerator.embree.isa; }},
+      {"accel.isa", T::text, std::string("auto"), 0, 0, {"auto", "avx2", "avx512"},
+       "kernels of our walks: auto (AVX-512 where the CPU has it, or what the environment variable WAVETRACE_ISA "
+       "names), or one set forced; an error names a set this CPU cannot run (accel.embree.isa is Embree's)",
+       choice<checked_kernel_isa, &P::accelerator, &A::isa>},
       {"accel.bvh.leaf_size", T::integer, std::int64_t{4}, 1, 16, {}, "most triangles per BVH leaf",
        integer<&P::accelerator, &A::bvh, &BvhOptions::max_leaf_size>},
       {"accel.bvh.layout", T::text, std::string("depth_first"), 0, 0, {"depth_first", "breadth_first", "veb"},

@@ -77,7 +77,7 @@ class BvhAccelerator final : public ProbedAccelerator<BvhAccelerator> {
   }
 
  private:
-  template <bool kAnyHit, typename Probe>
+  template <bool kAnyHit, KernelIsa kIsa, typename Probe>
   void traverse(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
     for_each_ray(rays, hits, range, [&](const SingleRay& ray, std::uint32_t i) {
       LeafQuery query(geometry_, leaf_triangles_, ray);

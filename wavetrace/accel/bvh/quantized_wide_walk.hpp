@@ -17,6 +17,7 @@
 #include "wavetrace/accel/bvh/quantized_wide_node.hpp"
 #include "wavetrace/accel/bvh/sah_builder.hpp"
 #include "wavetrace/accel/ray_loop.hpp"
+#include "wavetrace/kernels/kernel_isa.hpp"
 #include "wavetrace/kernels/lane_sort.hpp"
 #include "wavetrace/kernels/ray_box.hpp"
 #include "wavetrace/kernels/nearest_hit.hpp"
@@ -99,7 +100,7 @@ namespace quantized_wide {
 // `visit_leaf(reference, box)` handles a leaf (its reference without the leaf bit, its
 // decoded box) and returns true to end the walk (an any-hit query found one); it may shrink
 // `tmax`, which prunes what is left on the stack.
-template <typename Probe, typename VisitLeaf>
+template <KernelIsa kIsa, typename Probe, typename VisitLeaf>
 [[gnu::always_inline]] inline void walk_quantized_wide(const QuantizedWideNode* nodes, const Bounds3& root_frame,
                                                        const SingleRay& ray, const float& tmax, Probe& probe,
                                                        QuantizedWideStack& stack, VisitLeaf&& visit_leaf) {
@@ -129,7 +130,7 @@ template <typename Probe, typename VisitLeaf>
         continue;
       }
       if (entered_mask != 0) {  // nearest first, by sorting
-        const __m256i order = lane_sort::nearest_last(near, entered_mask);
+        const __m256i order = lane_sort::nearest_last_for<kIsa>(near, entered_mask);
         _mm256_storeu_si256(reinterpret_cast<__m256i*>(stack.reference + top),
                             _mm256_permutevar8x32_epi32(child_references(node), order));
         _mm256_storeu_ps(stack.distance + top, _mm256_permutevar8x32_ps(near, order));
@@ -169,7 +170,7 @@ struct QuantizedWidePacketStack {
 
 // `visit_leaf(reference, box, rays)` handles a leaf for the rays in the mask `rays`, shrinking
 // their `tmax`; `live` marks the rays of `rays_in` that take part.
-template <typename Probe, typename VisitLeaf>
+template <KernelIsa kIsa, typename Probe, typename VisitLeaf>
 [[gnu::always_inline]] inline void walk_quantized_wide_packet(const QuantizedWideNode* nodes, const Bounds3& root_frame,
                                                               const SingleRay* rays_in, unsigned live,
                                                               const float* tmax, Probe& probe,
@@ -210,7 +211,7 @@ template <typename Probe, typename VisitLeaf>
         alignas(32) std::int32_t order[8];
         alignas(32) std::uint32_t reference[8];
         alignas(32) float lanes[6][8];
-        _mm256_store_si256(reinterpret_cast<__m256i*>(order), lane_sort::nearest_last(least, any));
+        _mm256_store_si256(reinterpret_cast<__m256i*>(order), lane_sort::nearest_last_for<kIsa>(least, any));
         _mm256_store_si256(reinterpret_cast<__m256i*>(reference), child_references(node));
         for (int b = 0; b < 6; ++b) _mm256_store_ps(lanes[b], bound[b]);
         for (int n = 0, count = std::popcount(any); n < count; ++n) {  // farthest first: the nearest ends on top

@@ -192,6 +192,12 @@ class ChunkedAccelerator final : public Accelerator {
   }
 
   std::string name() const override { return chunks_.front().accelerator->name(); }
+  std::string isa() const override { return chunks_.front().accelerator ? chunks_.front().accelerator->isa() : ""; }
+  void use_isa(KernelIsa isa) override {
+    for (Chunk& chunk : chunks_) {
+      if (chunk.accelerator) chunk.accelerator->use_isa(isa);  // else streamed to a file
+    }
+  }
 
   void intersect_closest(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
     NullProbe probe;

@@ -82,6 +82,7 @@ class EmbreeAccelerator final : public Accelerator {
     rtcReleaseDevice(device_);
   }
 
+  std::string isa() const override { return options_.isa; }  // Embree's own choice under "native"
   std::string name() const override {
     const std::string isa = options_.isa == "native" ? "" : "-" + options_.isa;
     return (options_.mode == EmbreeMode::standard ? "embree" : "embree-" + to_string(options_.mode)) + isa;

@@ -229,7 +229,7 @@ class ArrayGridAccelerator final : public ProbedAccelerator<ArrayGridAccelerator
     }
   }
 
-  template <bool kAnyHit, typename Probe>
+  template <bool kAnyHit, KernelIsa kIsa, typename Probe>
   void traverse(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
     for_each_ray(rays, hits, range, [&](const SingleRay& ray, std::uint32_t i) {
       RayState state;

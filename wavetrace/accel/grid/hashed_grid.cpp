@@ -243,7 +243,7 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
     }
   }
 
-  template <bool kAnyHit, typename Probe>
+  template <bool kAnyHit, KernelIsa kIsa, typename Probe>
   void traverse(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
     const glm::vec3* positions = mesh_.positions.data();
     const glm::uvec3* triangles = mesh_.triangles.data();

@@ -327,7 +327,7 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
  private:
   std::size_t triangles() const { return std::max<std::size_t>(1, triangles_); }
 
-  template <bool kAnyHit, typename Probe>
+  template <bool kAnyHit, KernelIsa kIsa, typename Probe>
   void traverse(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
     for_each_ray(rays, hits, range, [&](const SingleRay& ray, std::uint32_t i) {
       float tmax = ray.tmax;

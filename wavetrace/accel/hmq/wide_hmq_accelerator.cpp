@@ -171,41 +171,43 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
   // rays). On room:1M primary rays: 3.1-3.5 Mrays/s single, 5.0 in packets of 4, 6.2-6.8 of 8,
   // 6.1 of 16.
   void intersect_coherent(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
-    NullProbe probe;
-    QuantizedWidePacketStack stack;
-    const std::byte* leaves = leaf_records();
-    for (std::uint32_t begin = range.begin; begin < range.end; begin += kWidePacketRays) {
-      const std::uint32_t end = std::min<std::uint32_t>(begin + kWidePacketRays, range.end);
-      SingleRay packet[kWidePacketRays];
-      float tmax[kWidePacketRays];
-      LeafHit best[kWidePacketRays];
-      unsigned live = 0;
-      for (std::uint32_t i = begin; i < end; ++i) {
-        if (!(rays.flags[i] & ray_flags::alive)) continue;
-        packet[i - begin] = load_ray(rays, i);
-        tmax[i - begin] = packet[i - begin].tmax;
-        live |= 1u << (i - begin);
-      }
-      if (live != 0) {
-        walk_quantized_wide_packet(nodes_.data(), root_, packet, live, tmax, probe, stack,
-                                   [&](std::uint32_t units, const Bounds3& box, unsigned members) {
-                                     LeafTriangles leaf;
-                                     prepare_leaf(leaves + std::size_t(units) * kUnit, grid_, Box{box.lower, box.upper},
-                                                  leaf, probe);
-                                     for (; members != 0; members &= members - 1) {
-                                       const int r = std::countr_zero(members);
-                                       test_leaf_triangles<false>(leaf, packet[r].sheared, packet[r].tmin, tmax[r], best[r]);
-                                     }
-                                   });
-      }
-      for (std::uint32_t i = begin; i < end; ++i) {
-        if (live >> (i - begin) & 1u) {
-          write_leaf_hit<true>(best[i - begin], hits, i);
-        } else {
-          hits.set_miss(i);
+    walk_with(kernel_isa(), [&]<KernelIsa kIsa>() {
+      NullProbe probe;
+      QuantizedWidePacketStack stack;
+      const std::byte* leaves = leaf_records();
+      for (std::uint32_t begin = range.begin; begin < range.end; begin += kWidePacketRays) {
+        const std::uint32_t end = std::min<std::uint32_t>(begin + kWidePacketRays, range.end);
+        SingleRay packet[kWidePacketRays];
+        float tmax[kWidePacketRays];
+        LeafHit best[kWidePacketRays];
+        unsigned live = 0;
+        for (std::uint32_t i = begin; i < end; ++i) {
+          if (!(rays.flags[i] & ray_flags::alive)) continue;
+          packet[i - begin] = load_ray(rays, i);
+          tmax[i - begin] = packet[i - begin].tmax;
+          live |= 1u << (i - begin);
+        }
+        if (live != 0) {
+          walk_quantized_wide_packet<kIsa>(nodes_.data(), root_, packet, live, tmax, probe, stack,
+                                     [&](std::uint32_t units, const Bounds3& box, unsigned members) {
+                                       LeafTriangles leaf;
+                                       prepare_leaf(leaves + std::size_t(units) * kUnit, grid_, Box{box.lower, box.upper},
+                                                    leaf, probe);
+                                       for (; members != 0; members &= members - 1) {
+                                         const int r = std::countr_zero(members);
+                                         test_leaf_triangles<false>(leaf, packet[r].sheared, packet[r].tmin, tmax[r], best[r]);
+                                       }
+                                     });
+        }
+        for (std::uint32_t i = begin; i < end; ++i) {
+          if (live >> (i - begin) & 1u) {
+            write_leaf_hit<true>(best[i - begin], hits, i);
+          } else {
+            hits.set_miss(i);
+          }
         }
       }
-    }
+    });
   }
 
   MemoryReport memory() const override { return {parts_.hierarchy, parts_.geometry, parts_.other}; }
@@ -233,14 +235,14 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
   glm::vec3 represented_point(const glm::vec3& point) const override { return grid_.point(grid_.snap(point)); }
 
  private:
-  template <bool kAnyHit, typename Probe>
+  template <bool kAnyHit, KernelIsa kIsa, typename Probe>
   void traverse(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
     QuantizedWideStack stack;
     const std::byte* leaves = leaf_records();
     for_each_ray(rays, hits, range, [&](const SingleRay& ray, std::uint32_t i) {
       float tmax = ray.tmax;
       LeafHit best;
-      walk_quantized_wide(nodes_.data(), root_, ray, tmax, probe, stack, [&](std::uint32_t units, const Bounds3& box) {
+      walk_quantized_wide<kIsa>(nodes_.data(), root_, ray, tmax, probe, stack, [&](std::uint32_t units, const Bounds3& box) {
         test_leaf_record<kAnyHit>(leaves + std::size_t(units) * kUnit, grid_, Box{box.lower, box.upper}, ray.sheared,
                                   ray.tmin, tmax, best, probe);
         return kAnyHit && best.found;

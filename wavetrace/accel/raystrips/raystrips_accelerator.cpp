@@ -360,12 +360,14 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
 
   void intersect_coherent(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
     if (!options_.packets || options_.width == 8) return intersect_closest(rays, hits, range);
-    PacketTraversal packets{nodes_.data(), strip_bytes_.data(), positions_.data(), options_.run_triangles,
-                            options_.packet_min_active};
-    for (std::uint32_t begin = range.begin; begin < range.end; begin += kPacketRays) {
-      const std::uint32_t end = std::min(begin + kPacketRays, range.end);
-      packets.trace(rays, hits, {begin, end}, [&](const StripRay& ray, std::uint32_t i) { write_hit(ray, hits, i); });
-    }
+    walk_with(kernel_isa(), [&]<KernelIsa>() {
+      PacketTraversal packets{nodes_.data(), strip_bytes_.data(), positions_.data(), options_.run_triangles,
+                              options_.packet_min_active};
+      for (std::uint32_t begin = range.begin; begin < range.end; begin += kPacketRays) {
+        const std::uint32_t end = std::min(begin + kPacketRays, range.end);
+        packets.trace(rays, hits, {begin, end}, [&](const StripRay& ray, std::uint32_t i) { write_hit(ray, hits, i); });
+      }
+    });
   }
   MemoryReport memory() const override {
     MemoryReport report;
@@ -454,10 +456,10 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
     set_surface_from_strip(hits, i, strip_corner, corners);
   }
 
-  template <bool kAnyHit, typename Probe>
+  template <bool kAnyHit, KernelIsa kIsa, typename Probe>
   void traverse(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
 #if WAVETRACE_AVX2 && WAVETRACE_FMA
-    if (options_.width == 8) return traverse_wide<kAnyHit>(rays, hits, range, probe);
+    if (options_.width == 8) return traverse_wide<kAnyHit, kIsa>(rays, hits, range, probe);
 #endif
     const glm::vec3* positions = positions_.data();
     for_each_ray(rays, hits, range, [&](const SingleRay& single, std::uint32_t i) {
@@ -474,14 +476,14 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
   }
 
 #if WAVETRACE_AVX2 && WAVETRACE_FMA
-  template <bool kAnyHit, typename Probe>
+  template <bool kAnyHit, KernelIsa kIsa, typename Probe>
   void traverse_wide(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
     const glm::vec3* positions = positions_.data();
     const std::uint32_t* leaf_words = leaf_words_.data();
     QuantizedWideStack stack;
     for_each_ray(rays, hits, range, [&](const SingleRay& single, std::uint32_t i) {
       StripRay ray(single);
-      walk_quantized_wide(wide_nodes_.data(), root_, single, ray.tmax, probe, stack, [&](std::uint32_t leaf, const Bounds3& box) {
+      walk_quantized_wide<kIsa>(wide_nodes_.data(), root_, single, ray.tmax, probe, stack, [&](std::uint32_t leaf, const Bounds3& box) {
         float near, far;
         if (!clip_to_box(ray.box, box.lower, box.upper, ray.tmin, pruning_distance(ray.tmax), near, far)) return false;
         probe.read(leaf_words + leaf, 2 * sizeof(std::uint32_t));

@@ -68,6 +68,7 @@ class TinyBvhAccelerator final : public Accelerator {
   }
 
   std::string name() const override { return "tinybvh-" + to_string(options_.layout); }
+  std::string isa() const override { return std::string(to_string(KernelIsa::baseline)); }  // its code, our -march
 
   void intersect_closest(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
     for_each_ray(rays, hits, range, [&](const SingleRay& in, std::uint32_t i) {

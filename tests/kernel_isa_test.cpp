@@ -1,0 +1,117 @@
+// The kernel sets compiled into one binary (kernels/kernel_isa.hpp): the AVX-512 walks answer
+// what the baseline's do, bit for bit, and a set is chosen, forced and refused by name.
+#include <bit>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "accel_options.hpp"
+#include "test_support.hpp"
+#include "wavetrace/accel/registry.hpp"
+#include "wavetrace/bench/ray_sets.hpp"
+#include "wavetrace/memory/kernel_isa_choice.hpp"
+#include "wavetrace/scene/load_scene.hpp"
+
+namespace wavetrace {
+namespace {
+
+bool cpu_runs_avx512() { return runnable_kernel_isas().back() == KernelIsa::avx512; }
+
+TEST(KernelIsa, SetsAreChosenByNameAndABadNameIsRefused) {
+  EXPECT_EQ(runnable_kernel_isas().front(), KernelIsa::baseline);
+  EXPECT_EQ(parse_kernel_isa(to_string(KernelIsa::baseline)), KernelIsa::baseline);
+  try {
+    parse_kernel_isa("avx1024");
+    FAIL() << "no such set";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("accel.isa 'avx1024': expected auto, avx2 or avx512"), std::string::npos)
+        << error.what();
+  }
+  if (!WAVETRACE_AVX512_DISPATCH) GTEST_SKIP() << "this build (-march=" WAVETRACE_ARCH ") has one set of walks";
+  if (cpu_runs_avx512()) {
+    EXPECT_EQ(parse_kernel_isa("avx512"), KernelIsa::avx512);
+  } else {
+    EXPECT_THROW(parse_kernel_isa("avx512"), std::invalid_argument);
+  }
+}
+
+// Every accelerator whose walk is ours, through each query, on camera, diffuse and shadow
+// rays: t, primitive and barycentrics bit for bit between the sets.
+class KernelIsaWalks : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(KernelIsaWalks, Avx512AnswersWhatTheBaselineAnswersBitForBit) {
+  if (!WAVETRACE_AVX512_DISPATCH || !cpu_runs_avx512()) GTEST_SKIP() << "this CPU or build runs no AVX-512 walks";
+  const Scene scene = load_scene({"builtin:room:60k", 0});
+  const auto accelerator = make_accelerator(scene.mesh, testing::options_for(GetParam()));
+  const auto reference = make_accelerator(scene.mesh, testing::options_for("embree"));
+  for (const RaySetKind kind : {RaySetKind::primary, RaySetKind::diffuse, RaySetKind::shadow}) {
+    const RaySet rays = make_ray_set(kind, scene, *reference, 20000);
+    for (const bool coherent : {false, true}) {
+      if (coherent && kind != RaySetKind::primary) continue;
+      accelerator->use_isa(KernelIsa::baseline);
+      ASSERT_EQ(accelerator->isa(), to_string(KernelIsa::baseline));
+      const auto baseline = trace_ray_set(*accelerator, rays, coherent);
+      accelerator->use_isa(KernelIsa::avx512);
+      ASSERT_EQ(accelerator->isa(), "avx512");
+      const auto avx512 = trace_ray_set(*accelerator, rays, coherent);
+      std::size_t hits = 0;
+      for (std::size_t b = 0; b < rays.batches.size(); ++b) {
+        const HitBatch &e = *baseline[b], &a = *avx512[b];
+        for (std::size_t i = 0; i < rays.batches[b]->count; ++i) {
+          hits += e.is_hit(i);
+          ASSERT_EQ(e.primitive[i], a.primitive[i]) << to_string(kind) << " ray " << i << " of batch " << b;
+          if (rays.any_hit()) continue;
+          ASSERT_EQ(std::bit_cast<std::uint32_t>(e.t[i]), std::bit_cast<std::uint32_t>(a.t[i])) << to_string(kind);
+          ASSERT_EQ(std::bit_cast<std::uint32_t>(e.u[i]), std::bit_cast<std::uint32_t>(a.u[i])) << to_string(kind);
+          ASSERT_EQ(std::bit_cast<std::uint32_t>(e.v[i]), std::bit_cast<std::uint32_t>(a.v[i])) << to_string(kind);
+        }
+      }
+      EXPECT_GT(hits, rays.batches.size()) << to_string(kind) << ": the rays must meet the room";
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Ours, KernelIsaWalks,
+                         ::testing::Values("bvh", "bvh accel.bvh.width=8", "hmq", "hmq accel.hmq.width=8", "raystrips",
+                                           "raystrips accel.raystrips.width=8", "grid", "arraygrid"),
+                         [](const ::testing::TestParamInfo<std::string>& info) {
+                           std::string name = info.param.substr(0, info.param.find(' '));
+                           return info.param.find("width=8") != std::string::npos ? name + "8" : name;
+                         });
+
+std::string read_bytes(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+}
+
+// End to end: WAVETRACE_ISA=avx2 forces the lower set, the stats name the set that ran, and
+// the image is the same file.
+TEST(KernelIsa, ForcedBaselineRendersTheSameImage) {
+  const auto dir = std::filesystem::temp_directory_path() / "wavetrace_kernel_isa_tests";
+  std::filesystem::create_directories(dir);
+  const std::string render = "render builtin:room:20k --accel bvh:width=8 --size 48x32 --spp 2 --threads 2";
+  const std::string forced = "WAVETRACE_ISA=" + std::string(to_string(KernelIsa::baseline));
+  const auto lower = testing::run_wavetrace(render + " --out " + (dir / "lower.exr").string() + " --stats " +
+                                                (dir / "lower.json").string(),
+                                            forced);
+  ASSERT_EQ(lower.exit_code, 0) << lower.output;
+  const auto best = testing::run_wavetrace(render + " --out " + (dir / "best.exr").string() + " --stats " +
+                                           (dir / "best.json").string());
+  ASSERT_EQ(best.exit_code, 0) << best.output;
+  std::ifstream lower_stats(dir / "lower.json"), best_stats(dir / "best.json");
+  EXPECT_EQ(nlohmann::json::parse(lower_stats)["accel"]["isa"], to_string(KernelIsa::baseline));
+  EXPECT_EQ(nlohmann::json::parse(best_stats)["accel"]["isa"], to_string(runnable_kernel_isas().back()));
+  EXPECT_EQ(read_bytes((dir / "lower.exr").string()), read_bytes((dir / "best.exr").string()));
+
+  const auto bad = testing::run_wavetrace(render + " --out " + (dir / "never.exr").string(), "WAVETRACE_ISA=avx1024");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.output.find("WAVETRACE_ISA 'avx1024': expected auto, avx2 or avx512"), std::string::npos) << bad.output;
+}
+
+}  // namespace
+}  // namespace wavetrace

@@ -1,0 +1,36 @@
+// The sets of walks compiled into this binary: the build's own (-march, x86-64-v3 by default:
+// AVX2) and, in an AVX2 build, the same walks compiled for AVX-512, and the call that runs a
+// walk in one of them. Which one runs is chosen at start (memory/kernel_isa_choice.hpp).
+#pragma once
+
+#include "wavetrace/build_config.hpp"
+
+namespace wavetrace {
+
+enum class KernelIsa : unsigned char {
+  baseline,  // the build's -march
+  avx512,    // only in a build with WAVETRACE_AVX512_DISPATCH
+};
+
+// Calls `walk.operator()<isa>()` compiled for `isa`: with AVX-512, every function it calls is
+// inlined into one function of that target (flatten), so the walks' AVX2 intrinsics and vector
+// code are compiled again with mask registers and 32 vector registers, and their own AVX-512
+// paths (chosen by the KernelIsa template argument) inline where they are called. Nothing it
+// inlines is emitted as a shared copy, so no function the baseline calls can end up compiled
+// for AVX-512; what GCC cannot inline stays a call to the baseline's copy.
+#if WAVETRACE_AVX512_DISPATCH
+template <typename Walk>
+[[WAVETRACE_AVX512_TARGET, gnu::flatten]] void walk_with_avx512(Walk& walk) {
+  walk.template operator()<KernelIsa::avx512>();
+}
+#endif
+
+template <typename Walk>
+[[gnu::always_inline]] inline void walk_with(KernelIsa isa, Walk&& walk) {
+#if WAVETRACE_AVX512_DISPATCH
+  if (isa == KernelIsa::avx512) return walk_with_avx512(walk);
+#endif
+  walk.template operator()<KernelIsa::baseline>();
+}
+
+}  // namespace wavetrace
