@@ -61,7 +61,7 @@ class LeafQuery {
   // compute what the scalar test does, and a candidate is then taken against the tmax of the
   // moment, as the scalar loop takes it).
   template <bool kAnyHit, typename Probe>
-  void test_blocks(const TriangleBlock* block, std::uint32_t count, Probe& probe) {
+  [[gnu::always_inline]] void test_blocks(const TriangleBlock* block, std::uint32_t count, Probe& probe) {
     for (std::uint32_t base = 0; base < count; base += TriangleBlock::kLanes, ++block) {
       probe.read(block, sizeof *block);
       const std::uint32_t used = (1u << std::min(TriangleBlock::kLanes, count - base)) - 1;

@@ -43,9 +43,11 @@ struct GlobalGrid {
   // Lines of boxes the encoder writes lie inside the grid (< 2^24) and pass unchanged; a box
   // from a crafted world file may lie far outside it, or be NaN, and is clamped so that the
   // conversion to int is defined.
+  // Comparisons, not std::fmin/fmax, which GCC leaves as two libm calls (six pairs a leaf
+  // decoded); the same answer, NaN included (to -2^30, as fmax(NaN, -2^30) gives).
   static int to_line(float line) {
     constexpr float kLimit = 1073741824.0f;  // 2^30
-    return static_cast<int>(std::fmin(std::fmax(line, -kLimit), kLimit));
+    return static_cast<int>(line >= -kLimit ? (line <= kLimit ? line : kLimit) : -kLimit);
   }
 };
 
