@@ -133,6 +133,7 @@ INSTANTIATE_TEST_SUITE_P(
                       BadInput{"render /nonexistent/scene.toml", "/nonexistent/scene.toml: no such scene file"},
                       BadInput{"render --set memory.budget=lots", "memory.budget"},
                       BadInput{"render --set memory.cache=l3", "memory.cache = 'l3' is not one of"},
+                      BadInput{"render --accel bvh:isa=avx1024", "accel.isa = 'avx1024' is not one of"},
                       BadInput{"render --set reorder.heuristic=magic", "reorder.heuristic = 'magic' is not one of"},
                       BadInput{"render --set proxy.share=2", "proxy.share = 2 is out of range"},
                       BadInput{"render --set reorder.heuristic=hph --set pipeline.stages=generate,zsort,trace",

@@ -94,6 +94,13 @@ TEST(PlanKeys, AcceleratorSpecsSetTheirKeysAndNameWhatIsWrong) {
   EXPECT_EQ(plan.accelerator.hmq.width, 8u);
   EXPECT_EQ(plan.accelerator.chunk_triangles, 125000u);
   EXPECT_TRUE(plan.accel_goal.hmq_epsilon_pixel);
+  // isa= is our walks' kernel set for our types, Embree's own key for Embree.
+  Config ours, embree;
+  apply_accelerator_spec(ours, "bvh:width=8:isa=avx2");
+  EXPECT_EQ(ours.text("accel.isa"), "avx2");
+  apply_accelerator_spec(embree, "embree:isa=avx2");
+  EXPECT_EQ(embree.text("accel.embree.isa"), "avx2");
+  EXPECT_EQ(embree.text("accel.isa"), "auto");
   Config automatic;
   apply_accelerator_spec(automatic, "auto:memory_budget=1GB:max_error=0");
   EXPECT_TRUE(accel_goal(automatic).automatic);

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "wavetrace/memory/kernel_isa_choice.hpp"
+#include "wavetrace/kernels/kernel_isa.hpp"
 #include "wavetrace/memory/memory_probe.hpp"
 #include "wavetrace/memory/ray_batch.hpp"
 #include "wavetrace/scene/triangle_mesh.hpp"
@@ -63,7 +63,7 @@ class Accelerator {
                                     RecordingProbe& probe) const;
 
   // The instruction set its walks run (accel.isa in the stats): one of the kernel sets
-  // compiled into this binary (memory/kernel_isa.hpp), or Embree's setting; empty where
+  // compiled into this binary (kernels/kernel_isa.hpp), or Embree's setting; empty where
   // there is no choice. use_isa switches to a set runnable_kernel_isas() lists; the
   // accelerators without a choice ignore it.
   virtual std::string isa() const { return {}; }

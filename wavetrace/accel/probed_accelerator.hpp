@@ -1,6 +1,6 @@
 // The query entry points of an accelerator whose traversal is one template over the probe
 // type and the kernel set: the plain queries instantiate it with NullProbe (no cost) for the
-// set chosen at start (memory/kernel_isa.hpp), the probed ones with RecordingProbe. Static
+// set chosen at start (memory/kernel_isa_choice.hpp), the probed ones with RecordingProbe. Static
 // dispatch only; no virtual call per ray, one branch per batch range.
 #pragma once
 

@@ -17,8 +17,8 @@ void apply_accelerator_spec(Config& config, const std::string& text) {
     if (option.find('=') == std::string::npos) {
       throw ConfigError(fmt::format("--accel '{}': '{}' is not key=value", text, option));
     }
-    // A key the type does not have itself is a general one: isa= is the kernel set of our
-    // walks (accel.isa) for every type but one with its own (accel.embree.isa).
+    // isa= names the kernel set of our walks (accel.isa), but a type's own key where it has
+    // one (accel.embree.isa).
     const std::string name = option.substr(0, option.find('='));
     const bool own = std::ranges::any_of(config_schema(), [&](const ConfigKey& key) {
       return key.name == "accel." + type + "." + name;
