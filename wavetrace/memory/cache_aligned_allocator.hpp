@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdlib>
 #include <new>
+#include <string_view>
 #include <vector>
 
 #include <sys/mman.h>
@@ -17,8 +18,18 @@ namespace wavetrace {
 
 inline constexpr std::size_t kHugePageBytes = std::size_t{2} << 20;
 
+// WAVETRACE_HUGE_PAGES=0 in the environment leaves large arrays to 4 KiB pages: the A/B of
+// what huge pages buy (memory.md, "Huge pages at scale"). Read once.
+inline bool huge_pages_advised() {
+  static const bool advised = [] {
+    const char* setting = std::getenv("WAVETRACE_HUGE_PAGES");
+    return setting == nullptr || std::string_view(setting) != "0";
+  }();
+  return advised;
+}
+
 inline void* allocate_large_array(std::size_t bytes) {
-  const bool huge = bytes >= kHugePageBytes;
+  const bool huge = bytes >= kHugePageBytes && huge_pages_advised();
   const std::size_t alignment = huge ? kHugePageBytes : kColumnAlignment;
   void* memory = std::aligned_alloc(alignment, align_up(bytes, alignment));
   if (memory == nullptr) throw std::bad_alloc();
