@@ -1,4 +1,6 @@
 // Config: defaults, TOML files, --set overrides, and every kind of bad input naming its key.
+#include <cstdlib>
+
 #include <gtest/gtest.h>
 
 #include "wavetrace/setup/config.hpp"
@@ -139,6 +141,17 @@ TEST(Config, KeysThatOverrideEachOtherAreAConflictWhenBothAreGiven) {
         plan_render(config);
       },
       "set one of them");
+}
+
+// accel.isa is checked against the CPU as the plan is read: a set it cannot run, or a bad
+// WAVETRACE_ISA behind "auto", is a ConfigError like any bad key, not a logic error later.
+TEST(Config, AKernelSetNamedBadlyIsAConfigError) {
+  Config config;
+  plan_render(config);
+  ::setenv("WAVETRACE_ISA", "avx1024", 1);
+  expect_config_error([&] { plan_render(config); }, "WAVETRACE_ISA 'avx1024': expected auto, avx2 or avx512");
+  ::unsetenv("WAVETRACE_ISA");
+  plan_render(config);
 }
 
 TEST(Config, RestoredSettingsAreNotGiven) {

@@ -148,8 +148,8 @@ double estimated_build_bytes_per_triangle(std::string_view type) { return accele
 
 namespace {
 
-std::unique_ptr<Accelerator> with_kernels(std::unique_ptr<Accelerator> accelerator, const AcceleratorOptions& options) {
-  accelerator->use_isa(parse_kernel_isa(options.isa));
+std::unique_ptr<Accelerator> with_kernels(std::unique_ptr<Accelerator> accelerator, KernelIsa isa) {
+  accelerator->use_isa(isa);
   return accelerator;
 }
 
@@ -176,8 +176,8 @@ std::unique_ptr<Accelerator> build_for_world(const TriangleSource& source, const
 
 std::unique_ptr<Accelerator> make_world_accelerator(const TriangleSource& source, const TriangleMesh* whole,
                                                     const AcceleratorOptions& options, const ChunkStream* stream) {
-  parse_kernel_isa(options.isa);  // a bad setting fails before the build, not after it
-  return with_kernels(build_for_world(source, whole, options, stream), options);
+  const KernelIsa isa = parse_kernel_isa(options.isa);  // a bad setting fails before the build, not after it
+  return with_kernels(build_for_world(source, whole, options, stream), isa);
 }
 
 std::unique_ptr<Accelerator> load_accelerator(SectionLoader& in) {
@@ -193,8 +193,8 @@ std::unique_ptr<Accelerator> load_accelerator(SectionLoader& in) {
 }
 
 std::unique_ptr<Accelerator> make_accelerator(const TriangleMesh& mesh, const AcceleratorOptions& options) {
-  parse_kernel_isa(options.isa);
-  return with_kernels(accelerator_type(options.type).make(mesh, options), options);
+  const KernelIsa isa = parse_kernel_isa(options.isa);  // before the build, as above
+  return with_kernels(accelerator_type(options.type).make(mesh, options), isa);
 }
 
 }  // namespace wavetrace

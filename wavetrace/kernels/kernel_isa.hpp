@@ -14,7 +14,7 @@ enum class KernelIsa : unsigned char {
 
 // Calls `walk.operator()<isa>()` compiled for `isa`: with AVX-512, every function it calls is
 // inlined into one function of that target (flatten), so the walks' AVX2 intrinsics and vector
-// code are compiled again with mask registers and 32 vector registers, and their own AVX-512
+// code are compiled again in EVEX form with 32 vector registers, and their own AVX-512
 // paths (chosen by the KernelIsa template argument) inline where they are called. Nothing it
 // inlines is emitted as a shared copy, so no function the baseline calls can end up compiled
 // for AVX-512; what GCC cannot inline stays a call to the baseline's copy.

@@ -54,12 +54,6 @@ void choice(const Config& config, std::string_view key, RenderPlan& plan) {
   field<Path...>(plan) = Parse(config.text(key));
 }
 
-// accel.isa kept as written ("auto" is resolved when an accelerator is made), once checked
-// against this build and CPU.
-std::string checked_kernel_isa(const std::string& text) {
-  parse_kernel_isa(text);
-  return text;
-}
 
 // A built accelerator's setting as the world file records it (ConfigKey::record).
 using Recorded = std::optional<ConfigValue>;
@@ -119,6 +113,17 @@ void read_memory_budget(const Config& config, std::string_view key, RenderPlan& 
   } catch (const std::invalid_argument& error) {
     throw ConfigError(fmt::format("{}: {}", key, error.what()));
   }
+}
+// accel.isa kept as written ("auto" is resolved when an accelerator is made), once checked
+// against this build and CPU.
+void read_kernel_isa(const Config& config, std::string_view key, RenderPlan& plan) {
+  const std::string& isa = config.text(key);
+  try {
+    parse_kernel_isa(isa);
+  } catch (const std::invalid_argument& error) {
+    throw ConfigError(error.what());  // the message names accel.isa, or WAVETRACE_ISA where that chose
+  }
+  plan.accelerator.isa = isa;
 }
 void read_backing(const Config& config, std::string_view key, RenderPlan& plan) {
   plan.memory.file_backing = config.text(key) == "file";
@@ -242,7 +247,7 @@ const std::vector<ConfigKey>& config_schema() {
       {"accel.isa", T::text, std::string("auto"), 0, 0, {"auto", "avx2", "avx512"},
        "kernels of our walks: auto (AVX-512 where the CPU has it, or what the environment variable WAVETRACE_ISA "
        "names), or one set forced; an error names a set this CPU cannot run (accel.embree.isa is Embree's)",
-       choice<checked_kernel_isa, &P::accelerator, &A::isa>},
+       read_kernel_isa},
       {"accel.bvh.leaf_size", T::integer, std::int64_t{4}, 1, 16, {}, "most triangles per BVH leaf",
        integer<&P::accelerator, &A::bvh, &BvhOptions::max_leaf_size>},
       {"accel.bvh.layout", T::text, std::string("depth_first"), 0, 0, {"depth_first", "breadth_first", "veb"},

@@ -52,51 +52,12 @@ struct WideStack {
   alignas(32) float distance[kEntries];
 };
 
-#if WAVETRACE_AVX512_DISPATCH
-// intersect_children for the AVX-512 walks: the compares into mask registers, masked blends
-// for the axes the ray does not move along. The same operations on the same lanes, so the
-// same distances and mask. Not always_inline: only a function of this target may inline it.
-[[WAVETRACE_AVX512_TARGET]] inline unsigned intersect_children_avx512(const WideBvhNode& node, const WideRay& ray,
-                                                                     float tmin, float tmax, float distance[kWidth]) {
-  const float* lower[3] = {node.lower_x, node.lower_y, node.lower_z};
-  const float* upper[3] = {node.upper_x, node.upper_y, node.upper_z};
-  const __m256 infinity = _mm256_set1_ps(kInfinity);
-  __m256 near = _mm256_set1_ps(tmin);
-  __m256 far = infinity;
-  for (int axis = 0; axis < 3; ++axis) {
-    const __m256 lo = _mm256_load_ps(lower[axis]);
-    const __m256 hi = _mm256_load_ps(upper[axis]);
-    const __m256 origin = _mm256_set1_ps(ray.origin[axis]);
-    __m256 entry, exit;
-    if (ray.zero_axes & (1 << axis)) {
-      const __mmask8 inside =
-          _mm256_mask_cmp_ps_mask(_mm256_cmp_ps_mask(lo, origin, _CMP_LE_OQ), origin, hi, _CMP_LE_OQ);
-      entry = _mm256_mask_blend_ps(inside, infinity, _mm256_set1_ps(-kInfinity));
-      exit = _mm256_mask_blend_ps(inside, _mm256_set1_ps(-kInfinity), infinity);
-    } else {
-      const __m256 inverse = _mm256_set1_ps(ray.inverse[axis]);
-      const __m256 t0 = _mm256_mul_ps(_mm256_sub_ps(lo, origin), inverse);
-      const __m256 t1 = _mm256_mul_ps(_mm256_sub_ps(hi, origin), inverse);
-      entry = _mm256_min_ps(t0, t1);
-      exit = _mm256_max_ps(t0, t1);
-    }
-    near = _mm256_max_ps(near, entry);
-    far = _mm256_min_ps(far, exit);
-  }
-  far = _mm256_min_ps(_mm256_mul_ps(far, _mm256_set1_ps(kSlabFarScale)), _mm256_set1_ps(tmax));
-  _mm256_store_ps(distance, near);
-  return _mm256_mask_cmp_ps_mask(_mm256_cmp_ps_mask(near, far, _CMP_LE_OQ), near, infinity, _CMP_LT_OQ);
-}
-#endif
-
 // Entry distances of the ray into the node's eight child boxes; returns the mask of the
-// lanes entered (bit k: child k), whose distances are valid.
-template <KernelIsa kIsa>
+// lanes entered (bit k: child k), whose distances are valid. One source for both kernel sets:
+// the AVX-512 walk inlines it in EVEX form. A copy comparing into mask registers duplicated
+// this loop for no measurable gain (docs/measurements.md, "Kernel sets").
 [[gnu::always_inline]] inline unsigned intersect_children(const WideBvhNode& node, const WideRay& ray, float tmin,
                                                           float tmax, float distance[kWidth]) {
-#if WAVETRACE_AVX512_DISPATCH
-  if constexpr (kIsa == KernelIsa::avx512) return intersect_children_avx512(node, ray, tmin, tmax, distance);
-#endif
 #if WAVETRACE_AVX2
   const float* lower[3] = {node.lower_x, node.lower_y, node.lower_z};
   const float* upper[3] = {node.upper_x, node.upper_y, node.upper_z};
@@ -323,7 +284,7 @@ class WideBvhAccelerator final : public ProbedAccelerator<WideBvhAccelerator> {
           alignas(32) float distance[kWidth];
           const WideBvhNode& node = nodes[child];
           probe.read(&node, sizeof node);
-          const unsigned mask = intersect_children<kIsa>(node, box_ray, tmin, pruning_distance(tmax), distance);
+          const unsigned mask = intersect_children(node, box_ray, tmin, pruning_distance(tmax), distance);
           if (std::has_single_bit(mask)) {  // one child entered: nothing to order or stack
             const int k = std::countr_zero(mask);
             child = node.child[k], count = node.count[k];
