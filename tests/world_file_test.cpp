@@ -246,11 +246,14 @@ TEST(WorldFile, RealPagingChangesNoPixelAndCountsItsReadsOnTwoAndEightThreads) {
     EXPECT_GT(stage.disk->counters.read_seconds, 0.0);
     EXPECT_GE(stage.disk->counters.wait_seconds, stage.disk->counters.read_seconds * 0.5) << threads;
     EXPECT_GE(stage.disk->reads_in_flight_max, 1u);
-    // The simulated pager, asked to run beside, saw the same reads: its faults within 25% of
-    // the real ones (the real pool evicts in groups and keeps LRU order loosely; on this
-    // tiny pool of 4 KiB pages the two differ by up to 15.1% in 14 runs on 2 threads).
-    EXPECT_NEAR(double(stage.pager->counters.faults), double(stage.disk->counters.faults),
-                0.25 * double(stage.disk->counters.faults)) << threads;
+    // The simulated pager, asked to run beside, saw the same reads: the real faults are near
+    // its count. Not equal: the real pool evicts in groups and keeps LRU order loosely. On
+    // this tiny pool of 4 KiB pages the real pager read 0.89-0.92 of the simulated count in 20
+    // runs on an idle machine, and 0.77 with other tests running beside (threads descheduled
+    // in turn interleave their rays' reads less, which the looser order rewards more).
+    const double simulated = double(stage.pager->counters.faults);
+    EXPECT_GE(double(stage.disk->counters.faults), 0.6 * simulated) << threads;
+    EXPECT_LE(double(stage.disk->counters.faults), 1.25 * simulated) << threads;
     counted = true;
   }
   EXPECT_TRUE(counted) << threads;
