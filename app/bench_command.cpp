@@ -1,4 +1,5 @@
 // `wavetrace bench accel`, `bench leak`, `bench reorder`, `bench pipeline` and `bench image`.
+#include <functional>
 #include <fstream>
 #include <memory>
 #include <sstream>
@@ -137,24 +138,29 @@ struct ReorderArguments {
   std::vector<std::string> assignments;
 };
 
-// A rendering benchmark's config: `defaults`, then the --set assignments, then its own flags.
+// A rendering benchmark's config: `defaults`, its own flags (defaulted or given), what
+// `flags` sets besides, then the --set assignments, last, as `render` applies them: a key
+// given with --set is never overridden by a flag's default.
 Config render_bench_config(const std::vector<std::string>& defaults, const std::vector<std::string>& assignments,
-                           const std::string& scene, int spp, int threads, const std::string& size) {
+                           const std::string& scene, int spp, int threads, const std::string& size,
+                           const std::function<void(Config&)>& flags = {}) {
   Config config;
   for (const std::string& assignment : defaults) config.set(assignment);
-  for (const std::string& assignment : assignments) config.set(assignment);
   config.set_value("scene.source", scene);
   config.set("render.spp=" + std::to_string(spp));
   config.set("render.threads=" + std::to_string(threads));
   set_image_size(config, size);
+  if (flags) flags(config);
+  for (const std::string& assignment : assignments) config.set(assignment);
   return config;
 }
 
 int run_reorder(const ReorderArguments& args) {
-  Config config =
-      render_bench_config({"render.max_depth=5"}, args.assignments, args.scene, args.spp, args.threads, args.size);
-  apply_accelerator_spec(config, args.accel);
-  config.set("reorder.curve=" + args.curve);
+  const Config config = render_bench_config({"render.max_depth=5"}, args.assignments, args.scene, args.spp, args.threads,
+                                            args.size, [&](Config& flags) {
+                                              apply_accelerator_spec(flags, args.accel);
+                                              flags.set("reorder.curve=" + args.curve);
+                                            });
   std::vector<ReorderHeuristic> heuristics;
   for (const std::string& name : split_commas(args.heuristics)) {
     try {
@@ -182,8 +188,8 @@ struct PipelineArguments {
 };
 
 int run_pipeline(const PipelineArguments& args) {
-  Config config = render_bench_config({}, args.assignments, args.scene, args.spp, 0, args.size);
-  apply_accelerator_spec(config, args.accel);
+  const Config config = render_bench_config({}, args.assignments, args.scene, args.spp, 0, args.size,
+                                            [&](Config& flags) { apply_accelerator_spec(flags, args.accel); });
   PipelineBenchRequest request;
   for (const std::string& name : split_commas(args.heuristics)) {
     try {

@@ -229,6 +229,19 @@ TEST(Cli, BenchReorderReportsEveryHeuristicWithTheIssuesKeys) {
   EXPECT_TRUE(spilled["results"][1]["disk_pages_per_1000_rays"].is_null());  // no world file paged
 }
 
+// A key given with --set wins over a bench flag left at its default, as in `render`: before,
+// `bench reorder --set reorder.curve=hilbert` rendered with the --curve default, morton.
+TEST(Cli, BenchSetAssignmentsAreNotOverriddenByFlagDefaults) {
+  const std::string json_path = testing::write_temp_file("reorder_set.json", "");
+  const auto result = testing::run_wavetrace(
+      "bench reorder --scene builtin:room:5000 --accel bvh --size 16x12 --threads 1 --heuristics none "
+      "--set reorder.curve=hilbert --set render.spp=2 --set render.width=20 --json " + json_path);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const nlohmann::json json = nlohmann::json::parse(std::ifstream(json_path));
+  EXPECT_EQ(json["curve"], "hilbert");
+  EXPECT_EQ(json["image"], "20x12, 2 spp, depth 5");
+}
+
 TEST(Cli, BenchPipelineComparesTheMegakernelWithEachHeuristic) {
   const std::string json_path = testing::write_temp_file("pipeline.json", "");
   const auto result = testing::run_wavetrace(
