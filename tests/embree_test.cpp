@@ -1,13 +1,20 @@
 // The Embree reference against analytic answers: distances, primitives, barycentrics,
 // ray intervals, any-hit, memory accounting.
+#include <chrono>
 #include <cmath>
+#include <mutex>
+#include <set>
+#include <thread>
 #include <limits>
 #include <stdexcept>
 #include <tuple>
 
 #include <gtest/gtest.h>
+#include <tbb/info.h>
+#include <tbb/parallel_for.h>
 
 #include "wavetrace/accel/registry.hpp"
+#include "wavetrace/pipeline/tracing_arena.hpp"
 #include "wavetrace/scene/builtin_scenes.hpp"
 
 namespace wavetrace {
@@ -221,6 +228,28 @@ TEST(Embree, UnknownAcceleratorIsAnError) {
   } catch (const std::invalid_argument& error) {
     EXPECT_NE(std::string(error.what()).find("octree"), std::string::npos);
   }
+}
+
+// An Embree device asked for more threads than there are cores must not cap our arenas at the
+// cores: Embree's TBB scheduler holds min(threads, cores) as a process-wide limit, so before,
+// `--threads 8` on a 2-core machine traced on 2 threads while an Embree device lived.
+TEST(Embree, ADeviceLeavesArenasOfMoreThreadsThanCoresTheirThreads) {
+  const int threads = tbb::info::default_concurrency() * 4;
+  AcceleratorOptions options;
+  options.type = "embree";
+  options.embree.threads = threads;
+  const auto accel = make_accelerator(unit_square(), options);
+  TracingArena arena(threads);
+  std::mutex mutex;
+  std::set<std::thread::id> seen;
+  arena.execute([&] {
+    tbb::parallel_for(0, threads * 8, [&](int) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));  // every thread gets a turn
+      std::lock_guard lock(mutex);
+      seen.insert(std::this_thread::get_id());
+    });
+  });
+  EXPECT_EQ(seen.size(), std::size_t(threads));
 }
 
 }  // namespace

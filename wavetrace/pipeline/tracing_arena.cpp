@@ -7,8 +7,19 @@
 
 namespace wavetrace {
 
+namespace {
+std::optional<tbb::global_control> parallelism_for(int threads) {
+  if (threads <= tbb::info::default_concurrency()) return std::nullopt;
+  return std::optional<tbb::global_control>(std::in_place, tbb::global_control::max_allowed_parallelism,
+                                            static_cast<std::size_t>(threads));
+}
+}  // namespace
+
 TracingArena::TracingArena(int threads)
-    : threads_(threads > 0 ? threads : tbb::info::default_concurrency()), arena_(threads_), observer_(arena_) {}
+    : threads_(threads > 0 ? threads : tbb::info::default_concurrency()),
+      parallelism_(parallelism_for(threads_)),
+      arena_(threads_),
+      observer_(arena_) {}
 
 TracingArena::~TracingArena() = default;
 

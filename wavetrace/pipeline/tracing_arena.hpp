@@ -2,6 +2,9 @@
 // asks for (flush-to-zero, denormals-are-zero), so all tracing code sees the same mode.
 #pragma once
 
+#include <optional>
+
+#include <tbb/global_control.h>
 #include <tbb/task_arena.h>
 #include <tbb/task_scheduler_observer.h>
 
@@ -33,6 +36,10 @@ class TracingArena {
   static void enter_calling_thread();
 
   int threads_;
+  // More threads than cores: TBB lets an arena's workers run only up to the cores (less the
+  // caller) unless the process's limit is raised, so `--threads 8` on 2 cores ran on 2. Out of
+  // core, threads beyond the cores are how more page reads get in flight.
+  std::optional<tbb::global_control> parallelism_;
   tbb::task_arena arena_;
   FloatModeObserver observer_;
 };

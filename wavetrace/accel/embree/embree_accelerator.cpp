@@ -13,6 +13,7 @@
 
 #include <embree3/rtcore.h>
 #include <fmt/format.h>
+#include <tbb/info.h>
 #include <pmmintrin.h>
 #include <xmmintrin.h>
 
@@ -43,7 +44,12 @@ class EmbreeAccelerator final : public Accelerator {
  public:
   EmbreeAccelerator(const TriangleMesh& mesh, const EmbreeOptions& options) : mesh_(mesh), options_(options) {
     const auto start = std::chrono::steady_clock::now();
-    std::string config = options.threads > 0 ? fmt::format("threads={}", options.threads) : std::string();
+    // Embree's TBB scheduler holds threads=N as a process-wide tbb::global_control of
+    // min(N, cores) for the device's life, and TBB obeys the smallest such limit: any N would
+    // cap every arena of ours at the cores, and `--threads 8` on 2 cores ran on 2. N is
+    // passed only where it lowers Embree's builds below the cores; above, Embree takes them all.
+    const bool below_cores = options.threads > 0 && options.threads < tbb::info::default_concurrency();
+    std::string config = below_cores ? fmt::format("threads={}", options.threads) : std::string();
     if (options.isa != "native") config += (config.empty() ? "isa=" : ",isa=") + options.isa;
     device_ = rtcNewDevice(config.empty() ? nullptr : config.c_str());
     if (device_ == nullptr) throw std::runtime_error("embree: could not create a device");
