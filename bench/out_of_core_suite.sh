@@ -6,7 +6,9 @@
 # Settings (environment): SIZE (640x480), SPP (16), DEPTH (3), PAGES (page sizes in bytes, the
 #   sweep of item 2: "131072"), BUDGETS ("24 10"),
 #   HEURISTICS (none,origin,origin_dir,hph,hph_origin,hph_dir), BUFFERS ("memory disk"),
-#   LOW_HEURISTICS (the heuristics at budgets after the first; default HEURISTICS).
+#   LOW_HEURISTICS (the heuristics at budgets after the first; default HEURISTICS),
+#   THREADS (2; paged renders keep more reads in flight with more threads than cores: 8 on
+#   2 cores rendered room:64M 1.3x faster, docs/measurements.md), CURVE (morton).
 # The paper's setting is a world of about 3,200 pages of 4 MB and over 10,000 rays a page: a
 # saved builtin:room:64M hmq:width=8 world with its proxy at the defaults (hours on 2 cores).
 set -euo pipefail
@@ -15,8 +17,8 @@ out=${2:-out/out_of_core}
 mkdir -p "$out"
 wavetrace=${WAVETRACE:-build/wavetrace}
 heuristics=${HEURISTICS:-none,origin,origin_dir,hph,hph_origin,hph_dir}
-common=(--scene "$world" --size "${SIZE:-640x480}" --spp "${SPP:-16}" --threads 2
-        --set "render.max_depth=${DEPTH:-3}")
+common=(--scene "$world" --size "${SIZE:-640x480}" --spp "${SPP:-16}" --threads "${THREADS:-2}"
+        --curve "${CURVE:-morton}" --set "render.max_depth=${DEPTH:-3}")
 drop_caches() { sync; echo 3 > /proc/sys/vm/drop_caches 2>/dev/null || true; }
 
 { lscpu | grep "Model name" | tr -s " "; grep -o 'avx512[a-z_0-9]*' /proc/cpuinfo | sort -u | tr '\n' ' '; echo; } > "$out/cpu.txt"

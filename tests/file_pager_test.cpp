@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "wavetrace/memory/file_pager.hpp"
+#include "wavetrace/memory/page_trace.hpp"
 
 namespace wavetrace {
 namespace {
@@ -47,6 +48,30 @@ TEST(FilePager, ShowsTheFileAndEvictsTheLeastRecentlyUsedPage) {
   EXPECT_EQ(word(pager, 1, 7), 1007u);  // unannounced read of the evicted page: faults and loads it
   EXPECT_EQ(pager.total().faults, 6u);
   for (std::size_t page = 0; page < kPages; ++page) EXPECT_EQ(word(pager, page, 100), page * 1000 + 100) << page;
+}
+
+// memory.page_trace: every touch, in order, as the page numbers the file holds; reads the
+// probes did not announce (faults) are not touches.
+TEST(FilePager, RecordsEveryTouchInOrderWhenTraced) {
+  const std::string path = numbered_file("pager_trace.bin");
+  const std::string trace_path = path + ".pages";
+  FilePager pager(path, kPages * kPage, kPage, 4 * kPage, 1);
+  {
+    PageTrace trace(trace_path);
+    pager.set_page_trace(&trace);
+    for (std::size_t page : {3, 1, 3, 7, 15}) pager.touch(pager.base() + page * kPage + 8);
+    EXPECT_EQ(word(pager, 9, 0), 9000u);  // a fault, not a touch
+    pager.set_page_trace(nullptr);
+    pager.touch(pager.base());  // after the trace is detached
+    EXPECT_EQ(trace.recorded(), 5u);
+  }
+  std::ifstream in(trace_path, std::ios::binary);
+  std::vector<std::uint32_t> pages(8);
+  in.read(reinterpret_cast<char*>(pages.data()), std::streamsize(pages.size() * 4));
+  pages.resize(std::size_t(in.gcount()) / 4);
+  EXPECT_EQ(pages, (std::vector<std::uint32_t>{3, 1, 3, 7, 15}));
+  EXPECT_THROW(PageTrace("/nonexistent_dir/x.pages"), std::runtime_error);
+  std::filesystem::remove(trace_path);
 }
 
 // A full pool of 16 slots evicts its two least recently used pages at once (an eighth of

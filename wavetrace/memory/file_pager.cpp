@@ -3,6 +3,7 @@
 // outside the pool's lock, straight into their slot: threads reading different pages keep
 // that many reads in flight.
 #include "wavetrace/memory/file_pager.hpp"
+#include "wavetrace/memory/page_trace.hpp"
 
 #include <algorithm>
 #include <array>
@@ -325,6 +326,7 @@ std::string FilePager::load(std::uint32_t page, std::uint64_t address_offset, st
 void FilePager::touch(const void* address) {
   if (!contains(address)) return;
   const std::uint32_t page = page_of(address);
+  if (page_trace_ != nullptr) page_trace_->record(page);
   // Resident and near the LRU head: nothing to do, and no lock taken. Should the page be
   // evicted right after this check, the read it announces faults and loads it again.
   const std::uint32_t slot = slot_of_[page].load(std::memory_order_relaxed);

@@ -20,6 +20,8 @@
 
 namespace wavetrace {
 
+class PageTrace;
+
 struct DiskCounters {
   std::uint64_t faults = 0;      // pages read from the file
   std::uint64_t bytes_read = 0;
@@ -69,6 +71,8 @@ class FilePager {
   void touch(const void* address);
   // Evicts every page and zeroes the counters, so a render starts from an empty pool.
   void reset();
+  // Every touch from now on is also recorded in `trace` (null: none). Set while no reader runs.
+  void set_page_trace(PageTrace* trace) { page_trace_ = trace; }
 
   // Names the file's parts: each extent's faults count to names[extent.part]; bytes no
   // extent covers count to a last part, "other". Extents may come in any order but must
@@ -188,6 +192,7 @@ class FilePager {
   std::vector<FilePart> parts_;                  // sorted by offset
   std::vector<std::uint64_t> part_faults_;       // clients_.size() rows of part_names_.size()
   RayWindowCounters ray_windows_;
+  PageTrace* page_trace_ = nullptr;
 };
 
 }  // namespace wavetrace

@@ -14,6 +14,10 @@ MemoryObservation::MemoryObservation(const MemoryPlan& plan, std::vector<std::sp
   if (file_pager_ != nullptr) {
     file_pager_->reset();
     file_pager_->set_prefetch_client(kLookAheadClient);
+    if (!plan.page_trace.empty()) {
+      page_trace_ = std::make_unique<PageTrace>(plan.page_trace);
+      file_pager_->set_page_trace(page_trace_.get());
+    }
   }
   // Beside real paging the simulated pager is a cross-check that costs time in the measured
   // render (a lock per page change: room:8M at 24%, 13.9 s against 15.3 with it; 2.2 against
@@ -23,6 +27,10 @@ MemoryObservation::MemoryObservation(const MemoryPlan& plan, std::vector<std::sp
   }
   if (plan.cache) caches_ = std::make_unique<CacheBank>(*plan.cache, std::size_t(threads), kObservedStageCount);
   observers_ = {pager_.get(), caches_.get(), file_pager_};
+}
+
+MemoryObservation::~MemoryObservation() {
+  if (page_trace_ != nullptr) file_pager_->set_page_trace(nullptr);
 }
 
 void MemoryObservation::report(std::vector<StageStats>& stages) const {

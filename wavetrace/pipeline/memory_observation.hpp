@@ -11,6 +11,7 @@
 
 #include "wavetrace/memory/cache_simulator.hpp"
 #include "wavetrace/memory/memory_probe.hpp"
+#include "wavetrace/memory/page_trace.hpp"
 #include "wavetrace/memory/simulated_pager.hpp"
 #include "wavetrace/pipeline/stage_counters.hpp"
 #include "wavetrace/stages/observed_stage.hpp"
@@ -26,6 +27,7 @@ struct MemoryPlan {
   // Threads reading ahead, each on its own queued batch: reads in flight beside trace's own.
   std::size_t look_ahead_threads = 1;
   bool simulate_beside_file = false;  // real paging: also count the reads in the simulated pager
+  std::string page_trace;             // real paging: the file each render's page touches go to (memory/page_trace.hpp)
   IoModel io = io_preset("disk");  // memory.io
   std::optional<CacheGeometry> cache;  // no cache simulation without one
   bool enabled() const { return budget.has_value() || cache.has_value(); }
@@ -38,6 +40,9 @@ class MemoryObservation {
   // cold, or null.
   MemoryObservation(const MemoryPlan& plan, std::vector<std::span<const std::byte>> world, int threads,
                     FilePager* file_pager = nullptr);
+  ~MemoryObservation();  // detaches and writes the page trace
+  MemoryObservation(const MemoryObservation&) = delete;
+  MemoryObservation& operator=(const MemoryObservation&) = delete;
   const MemoryObservers& observers() const { return observers_; }
   // Fills the pager and cache objects of the observed stages in `stages`.
   void report(std::vector<StageStats>& stages) const;
@@ -46,6 +51,7 @@ class MemoryObservation {
   std::unique_ptr<SimulatedPager> pager_;
   std::unique_ptr<CacheBank> caches_;
   FilePager* file_pager_ = nullptr;
+  std::unique_ptr<PageTrace> page_trace_;
   MemoryObservers observers_;
 };
 

@@ -370,6 +370,10 @@ const std::vector<ConfigKey>& config_schema() {
        "real paging: also run the simulated pager over the same reads (a cross-check of the real faults; it costs "
        "render time, a lock per page change)",
        boolean<&P::memory, &MemoryPlan::simulate_beside_file>},
+      {"memory.page_trace", T::text, std::string(""), 0, 0, {},
+       "real paging: a file to write every page the render touches to, in order (32-bit little-endian page numbers, "
+       "replaced at each render), for replacement policies studied offline: bench/page_policies.py",
+       text<&P::memory, &MemoryPlan::page_trace>},
       {"memory.io", T::text, std::string("disk"), 0, 0, {"disk", "nvme"},
        "simulated device per fault: disk (the paper's, 101 MB/s, 8 ms) or nvme (3.5 GB/s, 80 us)",
        read_io},

@@ -123,6 +123,11 @@ void check_memory_plan(const Config& config, const MemoryPlan& plan) {
                                   "which is 0: set memory.look_ahead (for example 4)",
                                   plan.look_ahead_threads));
   }
+  if (!plan.page_trace.empty() && !plan.file_backing) {
+    throw ConfigError(fmt::format("memory.page_trace = '{}' records the pages of real paging: set memory.backing = "
+                                  "file (and memory.budget)",
+                                  plan.page_trace));
+  }
   if (!plan.cache) return;
   if (plan.cache->name == "custom" && !(config.has("memory.cache_bytes") && config.has("memory.cache_ways"))) {
     throw ConfigError("memory.cache = 'custom' needs memory.cache_bytes and memory.cache_ways");
