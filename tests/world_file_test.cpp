@@ -261,6 +261,45 @@ TEST(WorldFile, RealPagingChangesNoPixelAndCountsItsReadsOnTwoAndEightThreads) {
   fs::remove(path);
 }
 
+// memory.page_trace: a paged render writes the pages its probes touched, each a page of the
+// file, at least one per read from disk that a probe announced.
+TEST(WorldFile, APagedRenderWritesItsPageTrace) {
+  const std::string path = temp_path("traced.wtw");
+  const std::string trace_path = temp_path("traced.pages");
+  const std::vector<std::string> build = {"accel.type=hmq", "build.chunk_triangles=4096"};
+  build_and_save(build, path);
+  std::vector<std::string> paged = build;
+  for (const char* s : {"memory.backing=file", "memory.budget=5%", "memory.page_bytes=4096", "render.threads=2"}) {
+    paged.emplace_back(s);
+  }
+  paged.push_back("memory.page_trace=" + trace_path);
+  const RenderPlan plan = plan_render(small_render(paged));
+  const std::unique_ptr<LoadedWorld> world = load_world(path, world_paging(plan), 2);
+  const RenderOutput output = render_image(
+      plan, World{world->scene, *world->accelerator, *world->lights, nullptr, world->file->pager()},
+      resolve_camera(plan.camera, world->scene));
+  const std::uint64_t pages = world->file->pager()->page_count();
+  std::uint64_t faults = 0;
+  for (const StageStats& stage : output.run.stages) {
+    if (stage.name == "trace") faults = stage.disk->counters.faults;
+  }
+  std::ifstream in(trace_path, std::ios::binary);
+  std::vector<std::uint32_t> touches;
+  for (std::uint32_t page; in.read(reinterpret_cast<char*>(&page), sizeof page);) touches.push_back(page);
+  EXPECT_GT(faults, 0u);
+  EXPECT_GE(touches.size(), faults / 2) << "faults " << faults;  // most reads are announced
+  for (const std::uint32_t page : touches) ASSERT_LT(page, pages);
+  // Without real paging there is nothing to trace: an error naming the keys.
+  try {
+    plan_render(small_render({"memory.budget=5%", "memory.page_trace=" + trace_path}));
+    FAIL() << "memory.page_trace without memory.backing = file";
+  } catch (const ConfigError& error) {
+    EXPECT_NE(std::string(error.what()).find("set memory.backing = file"), std::string::npos) << error.what();
+  }
+  fs::remove(path);
+  fs::remove(trace_path);
+}
+
 // Trace's look-ahead reads the pages of the sorted batches queued for it before trace gets
 // there: the same image with it and without, with one reader ahead and three, on 2 and 8
 // threads; its reads are counted as trace's, and a good share of them are used by trace
