@@ -71,6 +71,16 @@ TEST(FilePager, RecordsEveryTouchInOrderWhenTraced) {
   pages.resize(std::size_t(in.gcount()) / 4);
   EXPECT_EQ(pages, (std::vector<std::uint32_t>{3, 1, 3, 7, 15}));
   EXPECT_THROW(PageTrace("/nonexistent_dir/x.pages"), std::runtime_error);
+  if (std::filesystem::exists("/dev/full")) {  // a full disk: an error naming the file
+    PageTrace full("/dev/full");
+    full.record(1);
+    try {
+      full.flush();
+      FAIL() << "a write to /dev/full succeeded";
+    } catch (const std::runtime_error& error) {
+      EXPECT_NE(std::string(error.what()).find("writing '/dev/full' failed"), std::string::npos) << error.what();
+    }
+  }
   std::filesystem::remove(trace_path);
 }
 

@@ -58,16 +58,17 @@ std::uint64_t PageTrace::recorded() const {
 void PageTrace::flush_locked() {
   const auto* bytes = reinterpret_cast<const char*>(buffer_.data());
   const std::size_t total = buffer_.size() * sizeof(std::uint32_t);
-  buffer_.clear();
   for (std::size_t done = 0; done < total;) {
     const ssize_t wrote = ::write(fd_, bytes + done, total - done);
     if (wrote < 0 && errno == EINTR) continue;
     if (wrote <= 0) {
+      buffer_.clear();  // not written again by the destructor
       throw std::runtime_error(fmt::format("memory.page_trace: writing '{}' failed: {}", path_,
                                            wrote < 0 ? std::strerror(errno) : "no progress"));
     }
     done += std::size_t(wrote);
   }
+  buffer_.clear();
 }
 
 }  // namespace wavetrace

@@ -34,6 +34,7 @@ MemoryObservation::~MemoryObservation() {
 }
 
 void MemoryObservation::report(std::vector<StageStats>& stages) const {
+  if (page_trace_ != nullptr) page_trace_->flush();  // a full disk is an error naming the file, not a note at exit
   for (StageStats& stage : stages) {
     for (std::size_t client = 0; client < kObservedStageCount; ++client) {
       if (stage.name != to_string(ObservedStage(client))) continue;

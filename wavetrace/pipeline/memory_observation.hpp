@@ -44,7 +44,8 @@ class MemoryObservation {
   MemoryObservation(const MemoryObservation&) = delete;
   MemoryObservation& operator=(const MemoryObservation&) = delete;
   const MemoryObservers& observers() const { return observers_; }
-  // Fills the pager and cache objects of the observed stages in `stages`.
+  // Fills the pager and cache objects of the observed stages in `stages`, and writes out the
+  // page trace (throws naming its file when that fails).
   void report(std::vector<StageStats>& stages) const;
 
  private:
