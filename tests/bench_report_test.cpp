@@ -104,17 +104,10 @@ TEST(BenchReport, FromTakesAnyBenchJsonAndAFailingScriptShowsItsOwnError) {
   EXPECT_EQ(failed.output.find("python3-matplotlib"), std::string::npos) << failed.output;
 }
 
-// `bench accel ARGS --repeat 1` with its JSON in a fresh directory `name`: the report, after
+// `bench accel ARGS --repeat 1` with its JSON in the temporary file `name`.json: the report, after
 // checking the command succeeded and printed `printed`.
 nlohmann::json bench_accel_json(const std::string& name, const std::string& args, const std::string& printed) {
-  const fs::path dir = fresh_dir(name);
-  fs::create_directories(dir);
-  const fs::path json = dir / "bench.json";
-  const auto bench = testing::run_wavetrace("bench accel " + args + " --repeat 1 --json " + json.string());
-  EXPECT_EQ(bench.exit_code, 0) << bench.output;
-  EXPECT_NE(bench.output.find(printed), std::string::npos) << bench.output;
-  std::ifstream in(json);
-  return nlohmann::json::parse(in);
+  return testing::run_bench_json(name + ".json", "accel " + args + " --repeat 1", printed);
 }
 
 // --reads: every ray reads the 8-wide root, the walk reads blocks and never the face set (the

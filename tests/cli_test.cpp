@@ -194,13 +194,10 @@ TEST(Cli, OutOfMemoryIsReportedWithWhatWasBeingBuilt) {
 }
 
 TEST(Cli, BenchReorderReportsEveryHeuristicWithTheIssuesKeys) {
-  const std::string json_path = testing::write_temp_file("reorder.json", "");
-  const auto result = testing::run_wavetrace(
-      "bench reorder --scene builtin:room:5000 --accel bvh --size 16x12 --spp 1 --threads 1 --heuristics none,origin,hph "
-      "--set memory.budget=50% --set memory.page_bytes=4096 --set memory.cache=l1d --set proxy.accel=bvh --json " +
-      json_path);
-  ASSERT_EQ(result.exit_code, 0) << result.output;
-  const nlohmann::json json = nlohmann::json::parse(std::ifstream(json_path));
+  const nlohmann::json json = testing::run_bench_json(
+      "reorder.json", "reorder --scene builtin:room:5000 --accel bvh --size 16x12 --spp 1 --threads 1 "
+      "--heuristics none,origin,hph --set memory.budget=50% --set memory.page_bytes=4096 --set memory.cache=l1d "
+      "--set proxy.accel=bvh");
   ASSERT_EQ(json["results"].size(), 3u);
   for (const auto& entry : json["results"]) {
     for (const char* key : {"heuristic", "render_seconds", "trace_seconds", "trace_mrays_per_s", "approx_hit_seconds",
@@ -216,11 +213,9 @@ TEST(Cli, BenchReorderReportsEveryHeuristicWithTheIssuesKeys) {
 
   // With the disk buffer (an in-core part of 64 rays: every generation spills) beside none,
   // which has no buffer: the same image.
-  const auto disk = testing::run_wavetrace(
-      "bench reorder --scene builtin:room:5000 --accel bvh --size 16x12 --spp 1 --threads 2 --heuristics none,hph "
-      "--set reorder.buffer=disk --set reorder.buffer_rays=64 --json " + json_path);
-  ASSERT_EQ(disk.exit_code, 0) << disk.output;
-  const nlohmann::json spilled = nlohmann::json::parse(std::ifstream(json_path));
+  const nlohmann::json spilled = testing::run_bench_json(
+      "reorder_disk.json", "reorder --scene builtin:room:5000 --accel bvh --size 16x12 --spp 1 --threads 2 "
+      "--heuristics none,hph --set reorder.buffer=disk --set reorder.buffer_rays=64");
   ASSERT_EQ(spilled["results"].size(), 2u);
   EXPECT_TRUE(spilled["results"][1]["image_identical"].get<bool>());
   EXPECT_TRUE(spilled["results"][0]["spill"].is_null());  // none has no buffer
@@ -232,23 +227,17 @@ TEST(Cli, BenchReorderReportsEveryHeuristicWithTheIssuesKeys) {
 // A key given with --set wins over a bench flag left at its default, as in `render`: before,
 // `bench reorder --set reorder.curve=hilbert` rendered with the --curve default, morton.
 TEST(Cli, BenchSetAssignmentsAreNotOverriddenByFlagDefaults) {
-  const std::string json_path = testing::write_temp_file("reorder_set.json", "");
-  const auto result = testing::run_wavetrace(
-      "bench reorder --scene builtin:room:5000 --accel bvh --size 16x12 --threads 1 --heuristics none "
-      "--set reorder.curve=hilbert --set render.spp=2 --set render.width=20 --json " + json_path);
-  ASSERT_EQ(result.exit_code, 0) << result.output;
-  const nlohmann::json json = nlohmann::json::parse(std::ifstream(json_path));
+  const nlohmann::json json = testing::run_bench_json(
+      "reorder_set.json", "reorder --scene builtin:room:5000 --accel bvh --size 16x12 --threads 1 --heuristics none "
+      "--set reorder.curve=hilbert --set render.spp=2 --set render.width=20");
   EXPECT_EQ(json["curve"], "hilbert");
   EXPECT_EQ(json["image"], "20x12, 2 spp, depth 5");
 }
 
 TEST(Cli, BenchPipelineComparesTheMegakernelWithEachHeuristic) {
-  const std::string json_path = testing::write_temp_file("pipeline.json", "");
-  const auto result = testing::run_wavetrace(
-      "bench pipeline --scene builtin:room:5000 --accel bvh:width=8 --size 16x12 --spp 1 --threads 1,2 --repeat 2 "
-      "--heuristics none,hph --json " + json_path);
-  ASSERT_EQ(result.exit_code, 0) << result.output;
-  const nlohmann::json json = nlohmann::json::parse(std::ifstream(json_path));
+  const nlohmann::json json = testing::run_bench_json(
+      "pipeline.json", "pipeline --scene builtin:room:5000 --accel bvh:width=8 --size 16x12 --spp 1 --threads 1,2 "
+      "--repeat 2 --heuristics none,hph");
   ASSERT_EQ(json["results"].size(), 6u);  // megakernel, none, hph at 1 and at 2 threads
   for (const auto& entry : json["results"]) {
     for (const char* key : {"mode", "heuristic", "threads", "render_seconds", "median_seconds", "rays_traced", "mrays_per_s",

@@ -9,6 +9,8 @@
 #include <unistd.h>
 
 #include <glm/geometric.hpp>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "wavetrace/scene/triangle_mesh.hpp"
 
@@ -60,6 +62,19 @@ inline CommandResult run_shell(const std::string& command) {
 // such as "ulimit -v 300000;") when given.
 inline CommandResult run_wavetrace(const std::string& arguments, const std::string& limits = "") {
   return run_shell(limits + " exec " + std::string(WAVETRACE_BINARY) + " " + arguments + " 2>&1");
+}
+
+// `wavetrace bench ARGUMENTS --json F`, F a fresh temporary file `name`: the report it wrote,
+// after checking that the command succeeded and, when given, printed `printed`; null (and the
+// test failed) when it did not succeed.
+inline nlohmann::json run_bench_json(const std::string& name, const std::string& arguments,
+                                     const std::string& printed = "") {
+  const std::string json_path = write_temp_file(name, "");
+  const CommandResult result = run_wavetrace("bench " + arguments + " --json " + json_path);
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  if (result.exit_code != 0) return nullptr;
+  EXPECT_NE(result.output.find(printed), std::string::npos) << result.output;
+  return nlohmann::json::parse(std::ifstream(json_path));
 }
 
 }  // namespace wavetrace::testing

@@ -106,23 +106,27 @@ void read_hmq_epsilon(const Config& config, std::string_view key, RenderPlan& pl
   // "pixel" is resolved against the camera once the scene is loaded (resolve_accelerator).
   plan.accelerator.hmq.epsilon = plan.accel_goal.hmq_epsilon_pixel ? 0.0 : config.real(key);
 }
-void read_memory_budget(const Config& config, std::string_view key, RenderPlan& plan) {
-  const std::string& budget = config.text(key);
+// A parser's std::invalid_argument becomes the ConfigError every bad value raises; the key is
+// named in front unless the parser's own message names it (name_key = false).
+template <class Parse>
+auto parsed_as_config(std::string_view key, bool name_key, Parse&& parse) {
   try {
-    plan.memory.budget = budget == "none" ? std::nullopt : std::optional<MemoryBudget>(parse_memory_budget(budget));
+    return parse();
   } catch (const std::invalid_argument& error) {
-    throw ConfigError(fmt::format("{}: {}", key, error.what()));
+    throw ConfigError(name_key ? fmt::format("{}: {}", key, error.what()) : std::string(error.what()));
   }
 }
+void read_memory_budget(const Config& config, std::string_view key, RenderPlan& plan) {
+  const std::string& budget = config.text(key);
+  plan.memory.budget = parsed_as_config(key, true, [&] {
+    return budget == "none" ? std::nullopt : std::optional<MemoryBudget>(parse_memory_budget(budget));
+  });
+}
 // accel.isa kept as written ("auto" is resolved when an accelerator is made), once checked
-// against this build and CPU.
+// against this build and CPU; the parser's message names accel.isa, or WAVETRACE_ISA where that chose.
 void read_kernel_isa(const Config& config, std::string_view key, RenderPlan& plan) {
   const std::string& isa = config.text(key);
-  try {
-    parse_kernel_isa(isa);
-  } catch (const std::invalid_argument& error) {
-    throw ConfigError(error.what());  // the message names accel.isa, or WAVETRACE_ISA where that chose
-  }
+  parsed_as_config(key, false, [&] { return parse_kernel_isa(isa); });
   plan.accelerator.isa = isa;
 }
 void read_backing(const Config& config, std::string_view key, RenderPlan& plan) {
