@@ -14,6 +14,8 @@
 #include "app/image_output.hpp"
 #include "app/progress_line.hpp"
 #include "app/render_report.hpp"
+#include "wavetrace/distribute/image_parallel.hpp"
+#include "wavetrace/distribute/mpi_session.hpp"
 #include "wavetrace/memory/process_memory.hpp"
 #include "wavetrace/scene/lights.hpp"
 #include "wavetrace/setup/accelerator_spec.hpp"
@@ -48,13 +50,19 @@ Config build_config(const RenderArguments& args) {
 }
 
 // Renders through the pipeline and writes the image, the report and the stats.
-int finish_render(const RenderArguments& args, const RenderPlan& plan, const Scene& scene, const World& world,
-                  const Camera& camera, RenderPhases measured, const AccelChoice* choice = nullptr) {
+// Under mpirun every rank renders its share and only rank 0 writes and reports.
+int finish_render(const RenderArguments& args, const MpiSession& session, const RenderPlan& plan, const Scene& scene,
+                  const World& world, const Camera& camera, RenderPhases measured,
+                  const AccelChoice* choice = nullptr) {
   ProgressLine progress(stderr);
-  const RenderOutput output =
-      render_image(plan, world, camera, progress.enabled() ? [&](const Progress& p) { progress.update(p); }
-                                                          : std::function<void(const Progress&)>());
-  progress.finish();
+  const bool show_progress = progress.enabled() && session.rank() == 0;
+  const auto on_progress =
+      show_progress ? [&](const Progress& p) { progress.update(p); } : std::function<void(const Progress&)>();
+  std::optional<DistributedRender> distributed;
+  if (session.distributed()) distributed = render_image_parallel(session, plan, world, camera, on_progress);
+  const RenderOutput output = distributed ? std::move(distributed->output) : render_image(plan, world, camera, on_progress);
+  if (show_progress) progress.finish();
+  if (session.rank() != 0) return 0;
   measured.after_render_bytes = read_resident_memory().current_bytes;
   measured.peak_rss_bytes = read_resident_memory().peak_bytes;
 
@@ -62,7 +70,8 @@ int finish_render(const RenderArguments& args, const RenderPlan& plan, const Sce
   const std::string preview = preview_path_for(args.out);
   write_png_preview(preview, plan.image.width, plan.image.height, output.image);
 
-  const RenderFacts facts{scene, world.accelerator, plan, output, args.out, world.proxy, measured, choice};
+  const RenderFacts facts{scene, world.accelerator, plan, output, args.out, world.proxy, measured, choice,
+                          distributed ? &*distributed : nullptr};
   fmt::print("{}: {} triangles, {} vertices{}\n", scene.name, scene.triangle_count, scene.vertex_count,
              scene.cleanup.degenerate_dropped ? fmt::format(", {} degenerate dropped", scene.cleanup.degenerate_dropped)
                                               : std::string());
@@ -76,7 +85,7 @@ int finish_render(const RenderArguments& args, const RenderPlan& plan, const Sce
   return 0;
 }
 
-int run_render(const RenderArguments& args) {
+int render_in_session(const RenderArguments& args, const MpiSession& session) {
   const Config config = build_config(args);
   const RenderPlan plan = plan_render(config);
   // What was being done, so that running out of memory says where (and not "bad_alloc").
@@ -94,11 +103,24 @@ int run_render(const RenderArguments& args) {
     activity = fmt::format("rendering {}x{} at {} spp", done.image.width, done.image.height, done.image.samples_per_pixel);
     const AccelChoice* choice =
         built.resolution() != nullptr && built.resolution()->choice ? &*built.resolution()->choice : nullptr;
-    return finish_render(args, done, built.scene(), built.world(), built.camera(), measured, choice);
+    return finish_render(args, session, done, built.scene(), built.world(), built.camera(), measured, choice);
   } catch (const std::bad_alloc&) {
     throw std::runtime_error(fmt::format("out of memory {} ({:.2f} GB resident at most, {:.2f} GB available now)",
                                          activity, double(read_resident_memory().peak_bytes) * 1e-9,
                                          double(available_memory_bytes()) * 1e-9));
+  }
+}
+
+int run_render(const RenderArguments& args) {
+  const MpiSession session;
+  try {
+    return render_in_session(args, session);
+  } catch (const std::exception& error) {
+    if (!session.distributed()) throw;
+    // The other ranks may be waiting on this one: say which failed and why, and end them all.
+    fmt::print(stderr, "wavetrace: error: rank {} of {} ({}): {}\n", session.rank(), session.ranks(), session.host(),
+               error.what());
+    session.abort(1);
   }
 }
 

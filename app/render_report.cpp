@@ -188,7 +188,29 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
                      {"after_build_bytes", measured.after_build_bytes},
                      {"after_render_bytes", measured.after_render_bytes},
                      {"peak_rss_bytes_per_triangle", double(measured.peak_rss_bytes) / triangles}};
+  if (facts.distributed != nullptr) stats["distribute"] = distribute_json(*facts.distributed, facts.plan);
   return stats;
+}
+
+nlohmann::json distribute_json(const DistributedRender& render, const RenderPlan& plan) {
+  nlohmann::json ranks = nlohmann::json::array();
+  for (const RankReport& rank : render.ranks) {
+    ranks.push_back({{"rank", rank.rank},
+                     {"host", rank.host},
+                     {"ranges", rank.ranges},
+                     {"camera_rays", rank.camera_rays},
+                     {"rays_traced", rank.rays_traced},
+                     {"render_seconds", rank.render_seconds},
+                     {"wait_seconds", rank.wait_seconds},
+                     {"peak_resident_bytes", rank.peak_resident_bytes}});
+  }
+  return {{"mode", to_string(plan.distribute.mode)},
+          {"ranks", render.ranks.size()},
+          {"range_rays", render.range_rays},
+          {"wall_seconds", render.wall_seconds},
+          {"rays_traced", render.rays_traced()},
+          {"mrays_per_s", double(render.rays_traced()) / render.wall_seconds * 1e-6},
+          {"per_rank", ranks}};
 }
 
 std::string render_table(const RenderFacts& facts) {
@@ -226,6 +248,18 @@ std::string render_table(const RenderFacts& facts) {
   const BuildReport build = facts.accelerator.build();
   table += fmt::format("render ({}): {:.3f} s wall on {} threads ({:.3f} thread-seconds), {:.2f} Mrays/s traced\n",
                        to_string(facts.plan.pipeline.mode), run.seconds, run.threads, thread_seconds, traced / run.seconds * 1e-6);
+  if (const DistributedRender* shared = facts.distributed) {
+    table += fmt::format("distributed ({} mode, {} ranks, ranges of {} camera rays): {:.3f} s wall, {:.2f} Mrays/s "
+                         "traced by all; the table above is rank 0's\n",
+                         to_string(facts.plan.distribute.mode), shared->ranks.size(), shared->range_rays,
+                         shared->wall_seconds, double(shared->rays_traced()) / shared->wall_seconds * 1e-6);
+    for (const RankReport& rank : shared->ranks) {
+      table += fmt::format("  rank {} on {}: {} ranges, {} camera rays, {} traced in {:.3f} s (waited {:.3f} s for "
+                           "ranges), {:.2f} GB resident at most\n",
+                           rank.rank, rank.host, rank.ranges, rank.camera_rays, rank.rays_traced, rank.render_seconds,
+                           rank.wait_seconds, double(rank.peak_resident_bytes) * 1e-9);
+    }
+  }
   const std::string isa = facts.accelerator.isa();
   table += fmt::format("accel {}{}: {:.1f} MB, {:.1f} bytes/triangle (hierarchy {:.1f}, geometry {:.1f}), built in {:.3f} s\n",
                        facts.accelerator.name(), isa.empty() ? "" : " (" + isa + " walks)", double(memory.total()) * 1e-6,

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "wavetrace/accel/accelerator.hpp"
+#include "wavetrace/distribute/image_parallel.hpp"
 #include "wavetrace/scene/scene.hpp"
 #include "wavetrace/setup/render_setup.hpp"
 
@@ -30,11 +31,14 @@ struct RenderFacts {
   const Proxy* proxy = nullptr;
   RenderPhases phases;
   const AccelChoice* accel_choice = nullptr;  // accel.type = auto: its candidates and reasons
+  // A render shared by ranks (mpirun): every rank's report; the stages above are rank 0's.
+  const DistributedRender* distributed = nullptr;
 };
 
 nlohmann::json proxy_json(const Proxy& proxy);
 
 nlohmann::json render_stats_json(const RenderFacts& facts);
+nlohmann::json distribute_json(const DistributedRender& render, const RenderPlan& plan);
 std::string render_table(const RenderFacts& facts);
 
 nlohmann::json bounds_json(const Bounds3& bounds);

@@ -4,14 +4,14 @@
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
-set(wavetrace_layers kernels memory scene accel stages pipeline setup bench)
+set(wavetrace_layers kernels memory scene accel stages pipeline setup distribute bench)
 foreach(layer ${wavetrace_layers})
   set_target_properties(wavetrace_${layer} PROPERTIES EXPORT_NAME ${layer})
   add_library(wavetrace::${layer} ALIAS wavetrace_${layer})
 endforeach()
 set_target_properties(wavetrace_library PROPERTIES EXPORT_NAME wavetrace)
 
-install(TARGETS wavetrace_kernels wavetrace_memory wavetrace_scene wavetrace_accel wavetrace_stages wavetrace_pipeline wavetrace_setup wavetrace_bench
+install(TARGETS wavetrace_kernels wavetrace_memory wavetrace_scene wavetrace_accel wavetrace_stages wavetrace_pipeline wavetrace_setup wavetrace_distribute wavetrace_bench
                 wavetrace_library
         EXPORT wavetraceTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}

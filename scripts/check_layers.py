@@ -9,7 +9,7 @@ import re
 import sys
 
 # Lowest first: a layer may include from itself and from those before it.
-LAYERS = ["kernels", "memory", "scene", "accel", "stages", "pipeline", "setup", "bench"]
+LAYERS = ["kernels", "memory", "scene", "accel", "stages", "pipeline", "setup", "distribute", "bench"]
 TYPE_NAMES = ("embree", "bvh", "raystrips", "hmq", "grid", "mlgrid", "arraygrid", "tinybvh")
 TYPE_COMPARISON = re.compile(r'[=!]=\s*"(' + "|".join(TYPE_NAMES) + r')"|"(' + "|".join(TYPE_NAMES) + r')"\s*[=!]=')
 REGISTRY = pathlib.PurePath("accel/registry.cpp")

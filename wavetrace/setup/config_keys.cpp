@@ -166,8 +166,8 @@ std::vector<std::string> accel_type_choices() {
 }  // namespace
 
 const std::vector<std::string>& config_sections() {
-  static const std::vector<std::string> sections = {"scene", "camera", "render", "accel", "build",
-                                                    "proxy", "reorder", "memory", "pipeline"};
+  static const std::vector<std::string> sections = {"scene",   "camera", "render",   "accel",     "build",
+                                                    "proxy",   "reorder", "memory", "pipeline", "distribute"};
   return sections;
 }
 
@@ -435,6 +435,15 @@ const std::vector<ConfigKey>& config_schema() {
       {"pipeline.tile", T::integer, std::int64_t{16}, 1, 4096, {},
        "megakernel: side in pixels of the square tiles workers take",
        integer<&P::pipeline, &PipelineOptions::tile_side>},
+
+      {"distribute.mode", T::text, std::string("image"), 0, 0, {"image"},
+       "ranks started by mpirun: image (each rank holds the whole world and renders the camera rays rank 0 hands "
+       "out on demand; the films are summed exactly: the single process's image); alone, the whole image",
+       choice<parse_distribute_mode, &P::distribute, &DistributePlan::mode>},
+      {"distribute.range_rays", T::integer, std::int64_t{0}, 0, std::int64_t{1} << 40, {},
+       "image mode: camera rays rank 0 hands out at a time (0: the image's rays over 64 ranges a rank, at least "
+       "16 batches)",
+       integer<&P::distribute, &DistributePlan::range_rays>},
   };
   return schema;
 }

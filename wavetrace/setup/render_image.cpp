@@ -34,11 +34,15 @@ void check_spill_space(const RenderPlan& plan) {
 }  // namespace
 
 RenderOutput render_image(const RenderPlan& plan, const World& world, const Camera& camera,
-                          const std::function<void(const Progress&)>& on_progress) {
+                          const std::function<void(const Progress&)>& on_progress, const ImageShare& share) {
   check_spill_space(plan);
   const int workers = worker_count(plan.pipeline);
   Film film(plan.image.width, plan.image.height, plan.film_per_thread ? std::uint32_t(workers) : 0);
-  GenerateStage generate(camera, plan.image, plan.pixel_order);
+  GenerateStage generate(camera, plan.image, plan.pixel_order, share.camera_rays);
+  if (share.camera_rays && plan.pipeline.mode == PipelineMode::megakernel) {
+    throw ConfigError("pipeline.mode = megakernel walks the image's pixels itself: a shared image (a distributed "
+                      "render) needs the wavefront pipeline");
+  }
   std::optional<MemoryObservation> observation;
   RenderOutput output;
   if (plan.memory.enabled()) {
@@ -78,7 +82,13 @@ RenderOutput render_image(const RenderPlan& plan, const World& world, const Came
     output.any_mrays_per_s = chain.trace_times().any_mrays_per_s();
     output.hit_rates = chain.hit_rates().snapshot();
   }
-  output.image = film.resolve(plan.image.samples_per_pixel);
+  if (share.combine_film) {
+    std::vector<std::int64_t> sums = film.sums();
+    share.combine_film(sums);
+    output.image = Film::resolve(sums, plan.image.samples_per_pixel);
+  } else {
+    output.image = film.resolve(plan.image.samples_per_pixel);
+  }
   output.rejected_contributions = film.rejected_contributions();
   return output;
 }

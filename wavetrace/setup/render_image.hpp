@@ -12,6 +12,7 @@
 #include "wavetrace/stages/hit_rates.hpp"
 #include "wavetrace/pipeline/pipeline.hpp"
 #include "wavetrace/setup/render_plan.hpp"
+#include "wavetrace/stages/generate.hpp"
 #include "wavetrace/stages/world.hpp"
 
 namespace wavetrace {
@@ -28,7 +29,17 @@ struct RenderOutput {
   std::uint64_t rejected_contributions = 0;
 };
 
+// How one render shares its image with others (a distributed render): which camera rays it
+// generates, and how its film's fixed-point sums are combined with theirs before the image
+// is resolved (in place; the sum over processes is exactly one process's film). Left empty:
+// the whole image, alone.
+struct ImageShare {
+  CameraRaySource camera_rays;
+  std::function<void(std::vector<std::int64_t>& film_sums)> combine_film;
+};
+
 RenderOutput render_image(const RenderPlan& plan, const World& world, const Camera& camera,
-                          const std::function<void(const Progress&)>& on_progress = {});
+                          const std::function<void(const Progress&)>& on_progress = {},
+                          const ImageShare& share = {});
 
 }  // namespace wavetrace

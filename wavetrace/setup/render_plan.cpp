@@ -2,6 +2,7 @@
 #include "wavetrace/setup/render_plan.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 
 #include <tbb/info.h>
 
@@ -20,5 +21,12 @@ std::vector<std::string> stages_for(ReorderHeuristic heuristic) {
   stages.insert(stages.end(), {"trace", "shade", "spawn"});
   return stages;
 }
+
+DistributeMode parse_distribute_mode(const std::string& text) {
+  if (text == "image") return DistributeMode::image;
+  throw std::invalid_argument("unknown distribute mode '" + text + "' (image)");
+}
+
+std::string to_string(DistributeMode mode) { return mode == DistributeMode::image ? "image" : "?"; }
 
 }  // namespace wavetrace

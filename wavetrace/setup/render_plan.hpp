@@ -2,6 +2,7 @@
 // config_keys.cpp; plan_render.hpp makes one), and the stage chain it names.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -28,6 +29,17 @@ struct CameraOverride {
   bool operator==(const CameraOverride&) const = default;
 };
 
+// distribute.*: how the ranks of a render started by mpirun share it (wavetrace/distribute/);
+// a process started alone renders the whole image whatever they say.
+enum class DistributeMode { image };
+DistributeMode parse_distribute_mode(const std::string& text);
+std::string to_string(DistributeMode mode);
+struct DistributePlan {
+  DistributeMode mode = DistributeMode::image;
+  std::uint64_t range_rays = 0;  // camera rays handed out at a time (0: chosen from the image and ranks)
+  bool operator==(const DistributePlan&) const = default;
+};
+
 struct RenderPlan {
   SceneRequest scene;
   CameraOverride camera;
@@ -42,6 +54,7 @@ struct RenderPlan {
   ProxyOptions proxy;
   ZSortOptions reorder;
   std::vector<std::string> stages = {"auto"};  // pipeline.stages, "auto" expanded by stages_for
+  DistributePlan distribute;
   bool needs_proxy() const;
   bool operator==(const RenderPlan&) const = default;
 };

@@ -40,14 +40,22 @@ void Film::add(std::uint32_t pixel, float r, float g, float b) {
   }
 }
 
-std::vector<float> Film::resolve(std::uint32_t samples_per_pixel) const {
-  std::vector<float> image(std::size_t(width_) * height_ * 3);
-  const double scale = 1.0 / (kScale * samples_per_pixel);
-  for (std::size_t i = 0; i < image.size(); ++i) {
-    std::int64_t sum = sums_[i];
-    for (std::uint32_t copy = 0; copy < copies_; ++copy) sum += thread_sums_[copy * image.size() + i];
-    image[i] = static_cast<float>(double(sum) * scale);
+std::vector<std::int64_t> Film::sums() const {
+  const std::size_t size = std::size_t(width_) * height_ * 3;
+  std::vector<std::int64_t> sums(sums_.get(), sums_.get() + size);
+  for (std::uint32_t copy = 0; copy < copies_; ++copy) {
+    const std::int64_t* own = thread_sums_.get() + std::size_t(copy) * size;
+    for (std::size_t i = 0; i < size; ++i) sums[i] += own[i];
   }
+  return sums;
+}
+
+std::vector<float> Film::resolve(std::uint32_t samples_per_pixel) const { return resolve(sums(), samples_per_pixel); }
+
+std::vector<float> Film::resolve(std::span<const std::int64_t> sums, std::uint32_t samples_per_pixel) {
+  std::vector<float> image(sums.size());
+  const double scale = 1.0 / (kScale * samples_per_pixel);
+  for (std::size_t i = 0; i < image.size(); ++i) image[i] = static_cast<float>(double(sums[i]) * scale);
   return image;
 }
 

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 namespace wavetrace {
@@ -27,6 +28,13 @@ class Film {
 
   // Linear RGB, rows top to bottom, averaged over `samples_per_pixel`.
   std::vector<float> resolve(std::uint32_t samples_per_pixel) const;
+
+  // The fixed-point sums (r, g, b per pixel, rows top to bottom; the per-thread copies
+  // folded in): films of processes that shared an image add up to the one film that a
+  // single process would have held, exactly, in any order.
+  std::vector<std::int64_t> sums() const;
+  // The image of such sums, as resolve makes it.
+  static std::vector<float> resolve(std::span<const std::int64_t> sums, std::uint32_t samples_per_pixel);
 
   std::uint64_t rejected_contributions() const { return rejected_.load(std::memory_order_relaxed); }
 

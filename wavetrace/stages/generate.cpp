@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <utility>
 
 #include <glm/geometric.hpp>
 
@@ -18,12 +19,13 @@ PixelOrder parse_pixel_order(const std::string& text) {
   throw std::invalid_argument("unknown pixel order '" + text + "' (scanline, zcurve)");
 }
 
-GenerateStage::GenerateStage(const Camera& camera, const ImageSpec& image, PixelOrder order)
+GenerateStage::GenerateStage(const Camera& camera, const ImageSpec& image, PixelOrder order, CameraRaySource ranges)
     : frame_(camera, float(image.width) / float(image.height)),
       image_(image),
       inverse_width_(1.0f / float(image.width)),
       inverse_height_(1.0f / float(image.height)),
-      total_(std::uint64_t(image.pixel_count()) * image.samples_per_pixel) {
+      total_(std::uint64_t(image.pixel_count()) * image.samples_per_pixel),
+      ranges_(std::move(ranges)) {
   if (order == PixelOrder::zcurve) {
     // Walk the Z-curve of the enclosing power-of-two square, keeping the pixels inside.
     std::uint32_t side = 1;
@@ -37,9 +39,25 @@ GenerateStage::GenerateStage(const Camera& camera, const ImageSpec& image, Pixel
 }
 
 GenerateStage::Claim GenerateStage::claim(std::size_t capacity) {
-  const std::uint64_t first = next_.fetch_add(capacity, std::memory_order_relaxed);
-  if (first >= total_) return {};
-  return {first, static_cast<std::size_t>(std::min<std::uint64_t>(capacity, total_ - first))};
+  if (!ranges_) {
+    const std::uint64_t first = next_.fetch_add(capacity, std::memory_order_relaxed);
+    if (first >= total_) return {};
+    return {first, static_cast<std::size_t>(std::min<std::uint64_t>(capacity, total_ - first))};
+  }
+  std::lock_guard lock(range_mutex_);
+  if (range_.count == 0 && !ranges_done_.load(std::memory_order_relaxed)) {
+    range_ = ranges_();
+    if (range_.first > total_ || range_.count > total_ - range_.first) {
+      throw std::logic_error("a ray range source handed out rays past the image's");
+    }
+    if (range_.count == 0) ranges_done_.store(true, std::memory_order_release);
+  }
+  if (range_.count == 0) return {};
+  const Claim claimed{range_.first, static_cast<std::size_t>(std::min<std::uint64_t>(capacity, range_.count))};
+  range_.first += claimed.count;
+  range_.count -= claimed.count;
+  claimed_.fetch_add(claimed.count, std::memory_order_relaxed);
+  return claimed;
 }
 
 void GenerateStage::fill_range(RayBatch& rays, const Claim& claimed) const {

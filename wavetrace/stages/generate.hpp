@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdint>
+#include <functional>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -27,14 +29,29 @@ struct ImageSpec {
   bool operator==(const ImageSpec&) const = default;
 };
 
+// A run of camera rays by their index in the image's order (pixel in pixel order, then
+// sample): [first, first + count).
+struct CameraRayRange {
+  std::uint64_t first = 0;
+  std::uint64_t count = 0;
+};
+// Hands out the camera rays one process is to generate when several share an image (a
+// distributed render): each call the next range, count 0 once there are no more. Called under
+// generate's lock, one call at a time, a range per many batches.
+using CameraRaySource = std::function<CameraRayRange()>;
+
 class GenerateStage {
  public:
-  GenerateStage(const Camera& camera, const ImageSpec& image, PixelOrder order);
+  // Without `ranges`, every camera ray of the image; with them, the ranges they hand out.
+  GenerateStage(const Camera& camera, const ImageSpec& image, PixelOrder order, CameraRaySource ranges = {});
 
   std::string name() const { return "generate"; }
   std::uint64_t total_rays() const { return total_; }
-  std::uint64_t generated() const { return std::min(next_.load(std::memory_order_relaxed), total_); }
-  bool exhausted() const { return generated() >= total_; }
+  // Camera rays claimed so far (with ranges: of this process's ranges).
+  std::uint64_t generated() const {
+    return ranges_ ? claimed_.load(std::memory_order_relaxed) : std::min(next_.load(std::memory_order_relaxed), total_);
+  }
+  bool exhausted() const { return ranges_ ? ranges_done_.load(std::memory_order_acquire) : generated() >= total_; }
 
   // Claims the next camera rays, up to `capacity`: their first index and count (0 when
   // every ray is claimed). Thread-safe, so generate runs on any number of threads at once.
@@ -60,6 +77,12 @@ class GenerateStage {
   std::vector<std::uint32_t> pixel_order_;  // empty: scanline
   std::uint64_t total_;
   std::atomic<std::uint64_t> next_{0};
+  // With a source of ranges: claims take the lock (one per batch) and draw from `range_`.
+  CameraRaySource ranges_;
+  std::mutex range_mutex_;
+  CameraRayRange range_;
+  std::atomic<std::uint64_t> claimed_{0};
+  std::atomic<bool> ranges_done_{false};
 };
 
 }  // namespace wavetrace

@@ -1,0 +1,178 @@
+// Shared images: a render split into ranges of camera rays and its films summed is the
+// single render's image bit for bit, in one process (ImageShare) and across ranks started by
+// mpirun (image mode); and a rank that fails ends the job with an error naming it.
+#include <chrono>
+#include <cstdint>
+#include <fstream>
+#include <iterator>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "render_support.hpp"
+#include "test_support.hpp"
+#include "wavetrace/distribute/mpi_session.hpp"
+#include "wavetrace/scene/builtin_scenes.hpp"
+
+namespace wavetrace {
+namespace {
+
+const std::vector<std::string> kSettings = {"render.width=40", "render.height=30", "render.spp=3",
+                                            "render.threads=2", "reorder.heuristic=hph", "render.batch_size=256"};
+
+// Two renders of one world each take every other range of 700 camera rays; the second adds
+// its film into the first's. The result is the whole render's image, bit for bit.
+TEST(ImageShare, RangesOfCameraRaysWithTheirFilmsSummedAreTheWholeImage) {
+  const Scene scene = make_builtin_scene("builtin:room:5000");
+  const RenderOutput whole = testing::render_scene(scene, kSettings);
+
+  Config config;
+  for (const std::string& setting : kSettings) config.set(setting);
+  const RenderPlan plan = plan_render(config);
+  const auto accelerator = make_accelerator(scene.mesh, plan.accelerator);
+  const LightSampler lights(scene);
+  const std::unique_ptr<Proxy> proxy = build_proxy(plan, scene, *accelerator);
+  const World world{scene, *accelerator, lights, proxy.get()};
+  const std::uint64_t total = std::uint64_t(plan.image.pixel_count()) * plan.image.samples_per_pixel;
+  constexpr std::uint64_t kRange = 700;
+
+  std::vector<std::int64_t> first_sums;
+  std::uint64_t generated = 0;
+  std::vector<float> image;
+  for (std::uint64_t part = 0; part < 2; ++part) {
+    std::uint64_t next = part * kRange;
+    ImageShare share;
+    share.camera_rays = [&] {
+      if (next >= total) return CameraRayRange{};
+      const CameraRayRange range{next, std::min(kRange, total - next)};
+      next += 2 * kRange;
+      generated += range.count;
+      return range;
+    };
+    share.combine_film = [&](std::vector<std::int64_t>& sums) {
+      if (part == 0) {
+        first_sums = sums;
+      } else {
+        ASSERT_EQ(sums.size(), first_sums.size());
+        for (std::size_t i = 0; i < sums.size(); ++i) sums[i] += first_sums[i];
+      }
+    };
+    image = render_image(plan, world, resolve_camera(plan.camera, scene), {}, share).image;
+  }
+  EXPECT_EQ(generated, total);
+  EXPECT_EQ(image, whole.image);
+  double sum = 0.0;
+  for (float value : image) sum += value;
+  EXPECT_GT(sum, 0.0);
+}
+
+TEST(ImageShare, TheMegakernelCannotShareAnImage) {
+  const Scene scene = make_builtin_scene("builtin:room:5000");
+  Config config;
+  config.set("pipeline.mode=megakernel");
+  config.set("render.width=8");
+  config.set("render.height=6");
+  const RenderPlan plan = plan_render(config);
+  const auto accelerator = make_accelerator(scene.mesh, plan.accelerator);
+  const LightSampler lights(scene);
+  ImageShare share;
+  share.camera_rays = [] { return CameraRayRange{}; };
+  EXPECT_THROW(render_image(plan, World{scene, *accelerator, lights}, resolve_camera(plan.camera, scene), {}, share),
+               ConfigError);
+}
+
+// mpirun as root needs its consent in the environment (CI runs as root).
+std::string mpirun(int ranks) {
+  return fmt::format("OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 timeout 120 mpirun --oversubscribe "
+                     "-np {} ",
+                     ranks);
+}
+
+bool mpi_ready() { return MpiSession::built_with_mpi() && testing::run_shell("command -v mpirun").exit_code == 0; }
+
+std::string read_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+const std::string kRenderArguments =
+    "render builtin:room:20000 --size 40x30 --spp 3 --set reorder.heuristic=hph --set distribute.range_rays=300 ";
+
+TEST(Distribute, ImageModeOnTwoAndThreeRanksIsTheSingleProcessImage) {
+  if (!mpi_ready()) GTEST_SKIP() << "built without MPI, or no mpirun: apt-get install libopenmpi-dev openmpi-bin";
+  const std::string alone = testing::write_temp_file("distribute_alone.exr", "");
+  const std::string alone_stats = testing::write_temp_file("distribute_alone.json", "");
+  const auto single = testing::run_wavetrace(kRenderArguments + "--threads 2 --out " + alone + " --stats " + alone_stats);
+  ASSERT_EQ(single.exit_code, 0) << single.output;
+  const nlohmann::json single_stats = nlohmann::json::parse(std::ifstream(alone_stats));
+  EXPECT_FALSE(single_stats.contains("distribute"));  // started alone: as always
+  std::uint64_t single_traced = 0;
+  for (const auto& stage : single_stats["stages"]) {
+    if (stage["name"] == "trace") single_traced = stage["rays_in"];
+  }
+
+  for (int ranks : {2, 3}) {
+    const std::string image = testing::write_temp_file(fmt::format("distribute_{}.exr", ranks), "");
+    const std::string stats = testing::write_temp_file(fmt::format("distribute_{}.json", ranks), "");
+    const auto shared = testing::run_shell(mpirun(ranks) + WAVETRACE_BINARY + " " + kRenderArguments +
+                                           "--threads 1 --out " + image + " --stats " + stats + " 2>&1");
+    ASSERT_EQ(shared.exit_code, 0) << shared.output;
+    EXPECT_EQ(read_bytes(image), read_bytes(alone)) << ranks << " ranks";
+    const nlohmann::json report = nlohmann::json::parse(std::ifstream(stats))["distribute"];
+    EXPECT_EQ(report["mode"], "image");
+    ASSERT_EQ(report["per_rank"].size(), std::size_t(ranks));
+    std::uint64_t ranges = 0, camera_rays = 0, traced = 0;
+    for (int rank = 0; rank < ranks; ++rank) {
+      const nlohmann::json& own = report["per_rank"][rank];
+      EXPECT_EQ(own["rank"], rank);
+      EXPECT_GT(own["peak_resident_bytes"].get<std::uint64_t>(), 0u);
+      ranges += own["ranges"].get<std::uint64_t>();
+      camera_rays += own["camera_rays"].get<std::uint64_t>();
+      traced += own["rays_traced"].get<std::uint64_t>();
+    }
+    EXPECT_EQ(ranges, (40u * 30 * 3 + 299) / 300);  // every range dealt once
+    EXPECT_EQ(camera_rays, 40u * 30 * 3);
+    EXPECT_EQ(traced, single_traced);
+    EXPECT_EQ(report["rays_traced"], traced);
+  }
+}
+
+// Rank 1 is given a world file that does not exist: it names itself and the cause, and the
+// job ends with exit 1 at once, rank 0 not left waiting at the start of the render.
+TEST(Distribute, ARankThatCannotOpenItsWorldEndsEveryRank) {
+  if (!mpi_ready()) GTEST_SKIP() << "built without MPI, or no mpirun";
+  const std::string image = testing::write_temp_file("distribute_fault.exr", "");
+  const auto start = std::chrono::steady_clock::now();
+  const auto result = testing::run_shell(mpirun(1) + WAVETRACE_BINARY + " render builtin:room:20000 --size 40x30 " +
+                                         "--out " + image + " : -np 1 " + WAVETRACE_BINARY +
+                                         " render /nonexistent/world.wtw --out " + image + " 2>&1");
+  EXPECT_EQ(result.exit_code, 1) << result.output;
+  EXPECT_NE(result.output.find("wavetrace: error: rank 1 of 2"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("/nonexistent/world.wtw: cannot open"), std::string::npos) << result.output;
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(60));
+}
+
+// Rank 1 is killed (SIGKILL) two seconds into a render of several: mpirun ends rank 0 too,
+// and says which rank died of what. Its exit status is mpirun's (128 + 9), not a hang.
+TEST(Distribute, ARankKilledMidRenderEndsTheJob) {
+  if (!mpi_ready()) GTEST_SKIP() << "built without MPI, or no mpirun";
+  const std::string image = testing::write_temp_file("distribute_killed.exr", "");
+  const std::string render = std::string(WAVETRACE_BINARY) +
+                             " render builtin:room:100000 --size 320x240 --spp 256 --threads 1 --out " + image;
+  const auto start = std::chrono::steady_clock::now();
+  const auto result = testing::run_shell(mpirun(1) + render + " : -np 1 bash -c '(sleep 2; kill -9 $$) & exec " +
+                                         render + "' 2>&1");
+  const auto seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_NE(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.exit_code, 124) << "timed out: " << result.output;
+  EXPECT_NE(result.output.find("rank 1"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("signal 9"), std::string::npos) << result.output;
+  EXPECT_LT(seconds, 60.0) << result.output;
+}
+
+}  // namespace
+}  // namespace wavetrace

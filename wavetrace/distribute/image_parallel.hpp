@@ -1,0 +1,44 @@
+// distribute.mode = image: every rank holds the whole world and renders the camera rays rank
+// 0 deals out on demand; the films' fixed-point sums are added on rank 0, so its image is
+// bit for bit the one a single process renders.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "wavetrace/distribute/mpi_session.hpp"
+#include "wavetrace/setup/render_image.hpp"
+
+namespace wavetrace {
+
+// What one rank did, as rank 0 gathers it.
+struct RankReport {
+  int rank = 0;
+  std::string host;
+  std::uint64_t ranges = 0;       // ray ranges it was dealt
+  std::uint64_t camera_rays = 0;  // camera rays it generated
+  std::uint64_t rays_traced = 0;  // rays its trace stage took (camera, bounce, shadow)
+  double render_seconds = 0.0;    // its render, from the common start to its last ray
+  double wait_seconds = 0.0;      // waiting for ranges from rank 0
+  std::uint64_t peak_resident_bytes = 0;  // VmHWM after its render
+};
+
+struct DistributedRender {
+  RenderOutput output;             // rank 0: the whole image; elsewhere this rank's stages, no image
+  std::vector<RankReport> ranks;   // rank 0: every rank's, in rank order; elsewhere empty
+  std::uint64_t range_rays = 0;    // rays a range
+  double wall_seconds = 0.0;       // from the common start until the films were summed
+  std::uint64_t rays_traced() const;
+};
+
+// Collective: every rank calls it with the same plan and an identical world.
+DistributedRender render_image_parallel(const MpiSession& session, const RenderPlan& plan, const World& world,
+                                        const Camera& camera,
+                                        const std::function<void(const Progress&)>& on_progress = {});
+
+// distribute.range_rays, or when 0 the image's rays over 64 ranges a rank, at least 16 batches.
+std::uint64_t range_rays_for(const RenderPlan& plan, int ranks);
+
+}  // namespace wavetrace
