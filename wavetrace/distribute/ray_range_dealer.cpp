@@ -61,14 +61,14 @@ void RayRangeDealer::serve() {
   int told_done = 0;
   while (told_done < session_.ranks() - 1) {
     // A blocking receive would spin a core for the whole render (Open MPI polls): test, and
-    // sleep between tests. A range is many batches, so 100 us late costs nothing.
+    // sleep between tests. A range is many batches, so 1 ms late costs nothing.
     MPI_Request request;
     MPI_Irecv(nullptr, 0, MPI_BYTE, MPI_ANY_SOURCE, kAsk, MPI_COMM_WORLD, &request);
     MPI_Status status;
     for (int arrived = 0;;) {
       MPI_Test(&request, &arrived, &status);
       if (arrived) break;
-      std::this_thread::sleep_for(std::chrono::microseconds(100));
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
     const CameraRayRange range = draw();
     const std::uint64_t answer[2] = {range.first, range.count};
