@@ -141,6 +141,17 @@ TEST(Distribute, ImageModeOnTwoAndThreeRanksIsTheSingleProcessImage) {
   }
 }
 
+// Commands other than render would run once a rank (two builds writing one file): refused.
+TEST(Distribute, OnlyRenderRunsUnderMpirun) {
+  if (!mpi_ready()) GTEST_SKIP() << "built without MPI, or no mpirun";
+  const auto result = testing::run_shell(mpirun(2) + WAVETRACE_BINARY + " build builtin:room:5000 --out " +
+                                         testing::write_temp_file("distribute_build.wtw", "") + " 2>&1");
+  EXPECT_EQ(result.exit_code, 1) << result.output;
+  EXPECT_NE(result.output.find("wavetrace build runs alone: under mpirun (2 ranks) only render is shared"),
+            std::string::npos)
+      << result.output;
+}
+
 // Rank 1 is given a world file that does not exist: it names itself and the cause, and the
 // job ends with exit 1 at once, rank 0 not left waiting at the start of the render.
 TEST(Distribute, ARankThatCannotOpenItsWorldEndsEveryRank) {

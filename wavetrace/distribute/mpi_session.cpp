@@ -18,15 +18,6 @@
 namespace wavetrace {
 namespace {
 
-// The ranks a launcher started, from the variables it sets (Open MPI's mpirun, PMIx, PMI
-// launchers such as srun); 0 when no launcher started this process.
-int launched_ranks() {
-  for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMIX_SIZE", "PMI_SIZE"}) {
-    if (const char* value = std::getenv(name)) return std::max(1, std::atoi(value));
-  }
-  return std::getenv("PMIX_RANK") != nullptr ? 1 : 0;
-}
-
 std::string host_name() {
   char name[256] = {};
   if (gethostname(name, sizeof name - 1) != 0) return "?";
@@ -76,5 +67,13 @@ void MpiSession::abort(int exit_code) const {
 }
 
 bool MpiSession::built_with_mpi() { return WAVETRACE_HAVE_MPI != 0; }
+
+// From the variables launchers set: Open MPI's mpirun, PMIx, PMI (srun and others).
+int MpiSession::launched_ranks() {
+  for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMIX_SIZE", "PMI_SIZE"}) {
+    if (const char* value = std::getenv(name)) return std::max(1, std::atoi(value));
+  }
+  return std::getenv("PMIX_RANK") != nullptr ? 1 : 0;
+}
 
 }  // namespace wavetrace

@@ -26,6 +26,9 @@ class MpiSession {
   [[noreturn]] void abort(int exit_code) const;
 
   static bool built_with_mpi();
+  // The ranks a launcher (mpirun, or one of PMIx or PMI) started this process among; 0 when
+  // none started it. Read from the environment: MPI itself is not started.
+  static int launched_ranks();
 
  private:
   bool started_ = false;
