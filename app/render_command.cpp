@@ -14,6 +14,7 @@
 #include "app/image_output.hpp"
 #include "app/progress_line.hpp"
 #include "app/render_report.hpp"
+#include "wavetrace/distribute/chunk_exchange.hpp"
 #include "wavetrace/distribute/image_parallel.hpp"
 #include "wavetrace/distribute/mpi_session.hpp"
 #include "wavetrace/memory/process_memory.hpp"
@@ -52,14 +53,14 @@ Config build_config(const RenderArguments& args) {
 // Renders through the pipeline and writes the image, the report and the stats.
 // Under mpirun every rank renders its share and only rank 0 writes and reports.
 int finish_render(const RenderArguments& args, const MpiSession& session, const RenderPlan& plan, const Scene& scene,
-                  const World& world, const Camera& camera, RenderPhases measured,
-                  const AccelChoice* choice = nullptr) {
+                  const World& world, const Camera& camera, RenderPhases measured, const AccelChoice* choice,
+                  ChunkExchange* exchange) {
   ProgressLine progress(stderr);
   const bool show_progress = progress.enabled() && session.rank() == 0;
   const auto on_progress =
       show_progress ? [&](const Progress& p) { progress.update(p); } : std::function<void(const Progress&)>();
   std::optional<DistributedRender> distributed;
-  if (session.distributed()) distributed = render_image_parallel(session, plan, world, camera, on_progress);
+  if (session.distributed()) distributed = render_shared(session, plan, world, camera, on_progress, exchange);
   const RenderOutput output = distributed ? std::move(distributed->output) : render_image(plan, world, camera, on_progress);
   if (show_progress) progress.finish();
   if (session.rank() != 0) return 0;
@@ -91,7 +92,7 @@ int render_in_session(const RenderArguments& args, const MpiSession& session) {
   // What was being done, so that running out of memory says where (and not "bad_alloc").
   std::string activity;
   try {
-    const BuiltWorld built(plan, &activity);
+    BuiltWorld built(plan, &activity);
     if (const ResolvedAccelerator* resolved = built.resolution()) {
       if (const std::string line = resolution_summary(*resolved); !line.empty()) fmt::print("{}\n", line);
     }
@@ -103,7 +104,19 @@ int render_in_session(const RenderArguments& args, const MpiSession& session) {
     activity = fmt::format("rendering {}x{} at {} spp", done.image.width, done.image.height, done.image.samples_per_pixel);
     const AccelChoice* choice =
         built.resolution() != nullptr && built.resolution()->choice ? &*built.resolution()->choice : nullptr;
-    return finish_render(args, session, done, built.scene(), built.world(), built.camera(), measured, choice);
+    // Data mode: this rank owns a run of the chunks and asks the others about theirs.
+    std::unique_ptr<ChunkExchange> exchange;
+    if (session.distributed() && done.distribute.mode == DistributeMode::data) {
+      ChunkSet* chunks = built.chunk_set();
+      if (chunks == nullptr) {
+        throw ConfigError(fmt::format("distribute.mode = data needs a chunked world ({} is not): set "
+                                      "accel.chunk_triangles, or render a world file built with chunks",
+                                      built.world().accelerator.name()));
+      }
+      exchange = std::make_unique<ChunkExchange>(session, *chunks);
+    }
+    return finish_render(args, session, done, built.scene(), built.world(), built.camera(), measured, choice,
+                         exchange.get());
   } catch (const std::bad_alloc&) {
     throw std::runtime_error(fmt::format("out of memory {} ({:.2f} GB resident at most, {:.2f} GB available now)",
                                          activity, double(read_resident_memory().peak_bytes) * 1e-9,

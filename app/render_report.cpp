@@ -203,6 +203,17 @@ nlohmann::json distribute_json(const DistributedRender& render, const RenderPlan
                      {"render_seconds", rank.render_seconds},
                      {"wait_seconds", rank.wait_seconds},
                      {"peak_resident_bytes", rank.peak_resident_bytes}});
+    if (plan.distribute.mode == DistributeMode::data) {
+      const ChunkTraffic& traffic = rank.traffic;
+      ranks.back()["exchange"] = {{"chunks_owned", traffic.chunks_owned},
+                                  {"triangles_owned", traffic.triangles_owned},
+                                  {"queries_sent", traffic.queries_sent},
+                                  {"rays_sent", traffic.rays_sent},
+                                  {"bytes_sent", traffic.bytes_sent},
+                                  {"queries_answered", traffic.queries_answered},
+                                  {"rays_answered", traffic.rays_answered},
+                                  {"wait_seconds", traffic.wait_seconds}};
+    }
   }
   return {{"mode", to_string(plan.distribute.mode)},
           {"ranks", render.ranks.size()},
@@ -258,6 +269,14 @@ std::string render_table(const RenderFacts& facts) {
                            "ranges), {:.2f} GB resident at most\n",
                            rank.rank, rank.host, rank.ranges, rank.camera_rays, rank.rays_traced, rank.render_seconds,
                            rank.wait_seconds, double(rank.peak_resident_bytes) * 1e-9);
+      if (facts.plan.distribute.mode == DistributeMode::data) {
+        const ChunkTraffic& traffic = rank.traffic;
+        table += fmt::format("    owns {} chunks ({} triangles); sent {} rays in {} queries ({:.1f} MB with the answers "
+                             "it gave), answered {} rays of others' in {} queries; waited {:.3f} s for answers\n",
+                             traffic.chunks_owned, traffic.triangles_owned, traffic.rays_sent, traffic.queries_sent,
+                             double(traffic.bytes_sent) * 1e-6, traffic.rays_answered, traffic.queries_answered,
+                             traffic.wait_seconds);
+      }
     }
   }
   const std::string isa = facts.accelerator.isa();

@@ -143,6 +143,55 @@ TEST(Distribute, ImageModeOnTwoAndThreeRanksIsTheSingleProcessImage) {
   }
 }
 
+// Data mode: each rank owns a run of the chunks (10 of about 2,048 triangles) and sends the
+// rays due at the others' chunks to their owners; a small flight budget keeps rank 0 from
+// generating every ray before the others ask. The single process's image bit for bit.
+TEST(Distribute, DataModeOnTwoAndThreeRanksIsTheSingleProcessImage) {
+  if (!mpi_ready()) GTEST_SKIP() << "built without MPI, or no mpirun";
+  const std::string arguments =
+      "render builtin:room:20000 --accel hmq:width=8 --set build.chunk_triangles=2048 --size 64x48 --spp 4 "
+      "--set reorder.heuristic=hph --set render.rays_in_flight=2048 --set distribute.range_rays=500 ";
+  const std::string alone = testing::write_temp_file("data_alone.exr", "");
+  const auto single = testing::run_wavetrace(arguments + "--threads 2 --out " + alone);
+  ASSERT_EQ(single.exit_code, 0) << single.output;
+  // Several threads a rank: several rounds in flight, and answers found by their own thread.
+  for (const auto [ranks, threads] : {std::pair{2, 1}, std::pair{3, 1}, std::pair{2, 3}}) {
+    const std::string image = testing::write_temp_file(fmt::format("data_{}x{}.exr", ranks, threads), "");
+    const std::string stats = testing::write_temp_file(fmt::format("data_{}x{}.json", ranks, threads), "");
+    const auto shared = testing::run_shell(mpirun(ranks) + WAVETRACE_BINARY + " " + arguments +
+                                           fmt::format("--set distribute.mode=data --threads {} --out ", threads) +
+                                           image + " --stats " + stats + " 2>&1");
+    ASSERT_EQ(shared.exit_code, 0) << shared.output;
+    EXPECT_EQ(read_bytes(image), read_bytes(alone)) << ranks << " ranks of " << threads << " threads";
+    const nlohmann::json report = nlohmann::json::parse(std::ifstream(stats))["distribute"];
+    EXPECT_EQ(report["mode"], "data");
+    ASSERT_EQ(report["per_rank"].size(), std::size_t(ranks));
+    std::uint64_t chunks = 0, triangles = 0, sent = 0, answered = 0;
+    for (const nlohmann::json& rank : report["per_rank"]) {
+      const nlohmann::json& exchange = rank["exchange"];
+      EXPECT_GT(exchange["chunks_owned"].get<std::uint64_t>(), 0u) << rank.dump();
+      chunks += exchange["chunks_owned"].get<std::uint64_t>();
+      triangles += exchange["triangles_owned"].get<std::uint64_t>();
+      sent += exchange["rays_sent"].get<std::uint64_t>();
+      answered += exchange["rays_answered"].get<std::uint64_t>();
+    }
+    EXPECT_EQ(chunks, 10u);
+    EXPECT_EQ(triangles, 20472u);
+    EXPECT_GT(sent, 0u);
+    EXPECT_EQ(sent, answered);  // every ray sent was answered by its chunk's owner
+  }
+}
+
+TEST(Distribute, DataModeNeedsAChunkedWorld) {
+  if (!mpi_ready()) GTEST_SKIP() << "built without MPI, or no mpirun";
+  const auto result = testing::run_shell(mpirun(2) + WAVETRACE_BINARY +
+                                         " render builtin:room:5000 --accel bvh --size 8x6 --set distribute.mode=data "
+                                         "--out " + testing::write_temp_file("data_unchunked.exr", "") + " 2>&1");
+  EXPECT_EQ(result.exit_code, 1) << result.output;
+  EXPECT_NE(result.output.find("distribute.mode = data needs a chunked world (bvh is not)"), std::string::npos)
+      << result.output;
+}
+
 // Commands other than render would run once a rank (two builds writing one file): refused.
 TEST(Distribute, OnlyRenderRunsUnderMpirun) {
   if (!mpi_ready()) GTEST_SKIP() << "built without MPI, or no mpirun";

@@ -17,6 +17,7 @@
 namespace wavetrace {
 
 class SectionWriter;
+class ChunkSet;
 
 // Bytes by part, as the papers split them.
 struct MemoryReport {
@@ -90,6 +91,9 @@ class Accelerator {
 
   // The byte ranges traversal reads, for the pager; empty where memory cannot be observed.
   virtual std::vector<std::span<const std::byte>> memory_spans() const { return {}; }
+
+  // A chunked world's chunks (for a data-parallel render to own and route); null otherwise.
+  virtual ChunkSet* chunk_set() { return nullptr; }
 };
 
 }  // namespace wavetrace

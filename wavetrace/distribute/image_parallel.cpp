@@ -1,5 +1,6 @@
-// The image-parallel render: a barrier, each rank's render through the dealer, a sum of the
-// films to rank 0, and each rank's report gathered there.
+// A shared render: a barrier, each rank's render through the dealer (and in data mode its
+// exchange, answering the others until all are done), a sum of the films to rank 0, and each
+// rank's report gathered there.
 #include "wavetrace/distribute/image_parallel.hpp"
 
 #include <algorithm>
@@ -26,6 +27,7 @@ struct PackedRankReport {
   std::uint64_t ranges, camera_rays, rays_traced;
   double render_seconds, wait_seconds;
   std::uint64_t peak_resident_bytes;
+  ChunkTraffic traffic;  // plain numbers
 };
 
 PackedRankReport pack(const RankReport& report) {
@@ -38,6 +40,7 @@ PackedRankReport pack(const RankReport& report) {
   packed.render_seconds = report.render_seconds;
   packed.wait_seconds = report.wait_seconds;
   packed.peak_resident_bytes = report.peak_resident_bytes;
+  packed.traffic = report.traffic;
   return packed;
 }
 
@@ -45,7 +48,8 @@ RankReport unpack(const PackedRankReport& packed) {
   return {packed.rank,          std::string(packed.host, strnlen(packed.host, sizeof packed.host)),
           packed.ranges,        packed.camera_rays,
           packed.rays_traced,   packed.render_seconds,
-          packed.wait_seconds,  packed.peak_resident_bytes};
+          packed.wait_seconds,  packed.peak_resident_bytes,
+          packed.traffic};
 }
 
 const StageStats* find_stage(const PipelineRun& run, const std::string& name) {
@@ -67,8 +71,9 @@ std::uint64_t range_rays_for(const RenderPlan& plan, int ranks) {
   return std::max<std::uint64_t>(16 * plan.pipeline.batch_size, total / (64 * std::uint64_t(std::max(ranks, 1))));
 }
 
-DistributedRender render_image_parallel(const MpiSession& session, const RenderPlan& plan, const World& world,
-                                        const Camera& camera, const std::function<void(const Progress&)>& on_progress) {
+DistributedRender render_shared(const MpiSession& session, const RenderPlan& plan, const World& world,
+                                const Camera& camera, const std::function<void(const Progress&)>& on_progress,
+                                ChunkExchange* exchange) {
 #if !WAVETRACE_HAVE_MPI
   if (session.distributed()) throw std::logic_error("a distributed session in a build without MPI");
 #endif
@@ -86,6 +91,9 @@ DistributedRender render_image_parallel(const MpiSession& session, const RenderP
   share.camera_rays = [&dealer] { return dealer.next(); };
   share.combine_film = [&](std::vector<std::int64_t>& sums) {
     own.render_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    // The others may still need this rank's chunks: answer them until all are done (only then
+    // wait for the dealer, whose last answers go to ranks finishing their renders).
+    if (exchange != nullptr) exchange->finish();
     dealer.finish();
 #if WAVETRACE_HAVE_MPI
     if (!session.distributed()) return;
@@ -110,6 +118,7 @@ DistributedRender render_image_parallel(const MpiSession& session, const RenderP
   own.rays_traced = trace != nullptr ? trace->rays_in : 0;
   own.wait_seconds = dealer.wait_seconds();
   own.peak_resident_bytes = read_resident_memory().peak_bytes;
+  if (exchange != nullptr) own.traffic = exchange->traffic();
   if (!session.distributed()) {
     result.ranks = {own};
     return result;

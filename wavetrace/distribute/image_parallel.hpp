@@ -1,6 +1,7 @@
-// distribute.mode = image: every rank holds the whole world and renders the camera rays rank
-// 0 deals out on demand; the films' fixed-point sums are added on rank 0, so its image is
-// bit for bit the one a single process renders.
+// A render shared by ranks: every rank renders the camera rays rank 0 deals out on demand and
+// the films' fixed-point sums are added on rank 0, so its image is bit for bit the one a
+// single process renders. distribute.mode = image: every rank holds the whole world; data:
+// a ChunkExchange routes the rays due at chunks a rank does not own to their owners.
 #pragma once
 
 #include <cstdint>
@@ -8,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "wavetrace/distribute/chunk_exchange.hpp"
 #include "wavetrace/distribute/mpi_session.hpp"
 #include "wavetrace/setup/render_image.hpp"
 
@@ -23,6 +25,7 @@ struct RankReport {
   double render_seconds = 0.0;    // its render, from the common start to its last ray
   double wait_seconds = 0.0;      // waiting for ranges from rank 0
   std::uint64_t peak_resident_bytes = 0;  // VmHWM after its render
+  ChunkTraffic traffic;                   // data mode: its chunks and the rays it sent and answered
 };
 
 struct DistributedRender {
@@ -33,10 +36,11 @@ struct DistributedRender {
   std::uint64_t rays_traced() const;
 };
 
-// Collective: every rank calls it with the same plan and an identical world.
-DistributedRender render_image_parallel(const MpiSession& session, const RenderPlan& plan, const World& world,
-                                        const Camera& camera,
-                                        const std::function<void(const Progress&)>& on_progress = {});
+// Collective: every rank calls it with the same plan and an identical world (data mode: each
+// with its exchange, which routes the world's chunks).
+DistributedRender render_shared(const MpiSession& session, const RenderPlan& plan, const World& world,
+                                const Camera& camera, const std::function<void(const Progress&)>& on_progress = {},
+                                ChunkExchange* exchange = nullptr);
 
 // distribute.range_rays, or when 0 the image's rays over 64 ranges a rank, at least 16 batches.
 std::uint64_t range_rays_for(const RenderPlan& plan, int ranks);

@@ -67,4 +67,9 @@ void BuiltWorld::build_from_scene(std::string& activity) {
   world_.emplace(World{*scene_, *accelerator_, *lights_, proxy_.get()});
 }
 
+ChunkSet* BuiltWorld::chunk_set() {
+  Accelerator* accelerator = loaded_ ? loaded_->accelerator.get() : accelerator_.get();
+  return accelerator != nullptr ? accelerator->chunk_set() : nullptr;
+}
+
 }  // namespace wavetrace

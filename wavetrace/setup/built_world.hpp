@@ -45,6 +45,9 @@ class BuiltWorld {
   // What auto or a pixel bound resolved to; null for a world file.
   const ResolvedAccelerator* resolution() const { return resolved_ ? &*resolved_ : nullptr; }
   const WorldPhases& phases() const { return phases_; }
+  // The chunks of a chunked world (for a data-parallel render to own and route); null for
+  // any other world.
+  ChunkSet* chunk_set();
 
  private:
   void build_from_scene(std::string& activity);

@@ -436,12 +436,14 @@ const std::vector<ConfigKey>& config_schema() {
        "megakernel: side in pixels of the square tiles workers take",
        integer<&P::pipeline, &PipelineOptions::tile_side>},
 
-      {"distribute.mode", T::text, std::string("image"), 0, 0, {"image"},
+      {"distribute.mode", T::text, std::string("image"), 0, 0, {"image", "data"},
        "ranks started by mpirun: image (each rank holds the whole world and renders the camera rays rank 0 hands "
-       "out on demand; the films are summed exactly: the single process's image); alone, the whole image",
+       "out on demand; the films are summed exactly: the single process's image) or data (as image, but each rank "
+       "owns a run of a chunked world's chunks and rays due at others' chunks travel to their owners); alone, the "
+       "whole image",
        choice<parse_distribute_mode, &P::distribute, &DistributePlan::mode>},
       {"distribute.range_rays", T::integer, std::int64_t{0}, 0, std::int64_t{1} << 40, {},
-       "image mode: camera rays rank 0 hands out at a time (0: the image's rays over 64 ranges a rank, at least "
+       "camera rays rank 0 hands out at a time (0: the image's rays over 64 ranges a rank, at least "
        "16 batches)",
        integer<&P::distribute, &DistributePlan::range_rays>},
   };

@@ -24,9 +24,10 @@ std::vector<std::string> stages_for(ReorderHeuristic heuristic) {
 
 DistributeMode parse_distribute_mode(const std::string& text) {
   if (text == "image") return DistributeMode::image;
-  throw std::invalid_argument("unknown distribute mode '" + text + "' (image)");
+  if (text == "data") return DistributeMode::data;
+  throw std::invalid_argument("unknown distribute mode '" + text + "' (image, data)");
 }
 
-std::string to_string(DistributeMode mode) { return mode == DistributeMode::image ? "image" : "?"; }
+std::string to_string(DistributeMode mode) { return mode == DistributeMode::image ? "image" : "data"; }
 
 }  // namespace wavetrace

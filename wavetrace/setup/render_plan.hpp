@@ -31,7 +31,7 @@ struct CameraOverride {
 
 // distribute.*: how the ranks of a render started by mpirun share it (wavetrace/distribute/);
 // a process started alone renders the whole image whatever they say.
-enum class DistributeMode { image };
+enum class DistributeMode { image, data };
 DistributeMode parse_distribute_mode(const std::string& text);
 std::string to_string(DistributeMode mode);
 struct DistributePlan {

@@ -4,6 +4,7 @@
 // its rays as one compacted batch, so sub-accelerators keep their batch (and packet) paths
 // and pay one virtual call per chunk and round, not per ray.
 #include "wavetrace/accel/chunked/chunked_accelerator.hpp"
+#include "wavetrace/accel/chunked/chunk_router.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -87,7 +88,7 @@ struct SavedChunk {
 static_assert(sizeof(SavedChunk) == 40);
 constexpr std::uint32_t kChunkedSavedVersion = 1;
 
-class ChunkedAccelerator final : public Accelerator {
+class ChunkedAccelerator final : public Accelerator, public ChunkSet {
  public:
   ChunkedAccelerator(SectionLoader& in, const ChunkLoader& load_chunk) {
     in.expect_kind(kChunkedKind, kChunkedSavedVersion);
@@ -201,34 +202,49 @@ class ChunkedAccelerator final : public Accelerator {
 
   void intersect_closest(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
     NullProbe probe;
-    trace<false>(rays, hits, range, probe, [](const Accelerator& sub, const RayBatch& r, HitBatch& h, RayRange g) {
-      sub.intersect_closest(r, h, g);
-    });
+    trace<false>(rays, hits, range, probe, ChunkQuery::closest,
+                 [](const Accelerator& sub, const RayBatch& r, HitBatch& h, RayRange g) { sub.intersect_closest(r, h, g); });
   }
   void intersect_any(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
     NullProbe probe;
-    trace<true>(rays, hits, range, probe, [](const Accelerator& sub, const RayBatch& r, HitBatch& h, RayRange g) {
-      sub.intersect_any(r, h, g);
-    });
+    trace<true>(rays, hits, range, probe, ChunkQuery::any,
+                [](const Accelerator& sub, const RayBatch& r, HitBatch& h, RayRange g) { sub.intersect_any(r, h, g); });
   }
   void intersect_coherent(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
     NullProbe probe;
-    trace<false>(rays, hits, range, probe, [](const Accelerator& sub, const RayBatch& r, HitBatch& h, RayRange g) {
-      sub.intersect_coherent(r, h, g);
-    });
+    trace<false>(rays, hits, range, probe, ChunkQuery::coherent,
+                 [](const Accelerator& sub, const RayBatch& r, HitBatch& h, RayRange g) { sub.intersect_coherent(r, h, g); });
   }
   bool probed() const override { return chunks_.front().accelerator->probed(); }
+  // Probed rounds report the reads of the chunks answered here; a router's chunks are read
+  // (and counted) by their owners.
   void intersect_closest_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
                                 RecordingProbe& probe) const override {
-    trace<false>(rays, hits, range, probe, [&](const Accelerator& sub, const RayBatch& r, HitBatch& h, RayRange g) {
-      sub.intersect_closest_probed(r, h, g, probe);
-    });
+    trace<false>(rays, hits, range, probe, ChunkQuery::closest,
+                 [&](const Accelerator& sub, const RayBatch& r, HitBatch& h, RayRange g) {
+                   sub.intersect_closest_probed(r, h, g, probe);
+                 });
   }
   void intersect_any_probed(const RayBatch& rays, HitBatch& hits, RayRange range, RecordingProbe& probe) const override {
-    trace<true>(rays, hits, range, probe, [&](const Accelerator& sub, const RayBatch& r, HitBatch& h, RayRange g) {
-      sub.intersect_any_probed(r, h, g, probe);
-    });
+    trace<true>(rays, hits, range, probe, ChunkQuery::any,
+                [&](const Accelerator& sub, const RayBatch& r, HitBatch& h, RayRange g) {
+                  sub.intersect_any_probed(r, h, g, probe);
+                });
   }
+
+  ChunkSet* chunk_set() override { return this; }
+  std::size_t chunk_count() const override { return chunks_.size(); }
+  std::size_t chunk_triangles(std::size_t chunk) const override { return chunks_[chunk].count; }
+  void query_chunk(std::size_t chunk, ChunkQuery query, const RayBatch& rays, HitBatch& hits,
+                   RayRange range) const override {
+    const Accelerator& sub = *chunks_[chunk].accelerator;
+    switch (query) {
+      case ChunkQuery::closest: sub.intersect_closest(rays, hits, range); break;
+      case ChunkQuery::any: sub.intersect_any(rays, hits, range); break;
+      case ChunkQuery::coherent: sub.intersect_coherent(rays, hits, range); break;
+    }
+  }
+  void route(const ChunkRouter* router) override { router_ = router; }
 
   MemoryReport memory() const override {
     MemoryReport report;
@@ -331,7 +347,7 @@ class ChunkedAccelerator final : public Accelerator {
   }
 
   template <bool kAnyHit, typename Probe, typename Query>
-  void trace(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe, Query&& query) const {
+  void trace(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe, ChunkQuery kind, Query&& query) const {
     if (streamed_to_ != nullptr) throw std::logic_error(kStreamedIsNotTraced);
     thread_local RoundScratch scratch;
     const std::uint32_t n = range.size();
@@ -389,10 +405,23 @@ class ChunkedAccelerator final : public Accelerator {
         sub_rays.kind[slot] = rays.kind[i];
         sub_rays.flags[slot] = ray_flags::alive;
       }
+      // Each ray is due at one chunk a round, so the chunks' answers touch disjoint slots and
+      // may come in any order; a router's travel while the local chunks are asked.
+      const auto local_chunks = [&] {
+        for (std::size_t c = 0; c < chunks_.size(); ++c) {
+          const std::uint32_t begin = scratch.chunk_start[c], end = scratch.chunk_start[c + 1];
+          if (begin == end || (router_ != nullptr && !router_->is_local(c))) continue;
+          query(*chunks_[c].accelerator, sub_rays, sub_hits, RayRange{begin, end});
+        }
+      };
+      if (router_ != nullptr) {
+        router_->answer_elsewhere(kind, sub_rays, sub_hits, scratch.chunk_start, local_chunks);
+      } else {
+        local_chunks();
+      }
       for (std::size_t c = 0; c < chunks_.size(); ++c) {
         const std::uint32_t begin = scratch.chunk_start[c], end = scratch.chunk_start[c + 1];
         if (begin == end) continue;
-        query(*chunks_[c].accelerator, sub_rays, sub_hits, RayRange{begin, end});
         const auto first = static_cast<std::uint32_t>(chunks_[c].first);
         for (std::uint32_t slot = begin; slot < end; ++slot) {
           if (!sub_hits.is_hit(slot)) continue;
@@ -417,6 +446,7 @@ class ChunkedAccelerator final : public Accelerator {
 
   std::vector<Chunk> chunks_;
   StoredArray<BvhNode> top_;
+  const ChunkRouter* router_ = nullptr;  // data-parallel: who answers the chunks not held here
   BuildReport build_;
   const SectionWriter* streamed_to_ = nullptr;  // set when every chunk went to this writer as it was built
   std::string streamed_prefix_;
