@@ -54,13 +54,13 @@ Config build_config(const RenderArguments& args) {
 // Under mpirun every rank renders its share and only rank 0 writes and reports.
 int finish_render(const RenderArguments& args, const MpiSession& session, const RenderPlan& plan, const Scene& scene,
                   const World& world, const Camera& camera, RenderPhases measured, const AccelChoice* choice,
-                  ChunkExchange* exchange) {
+                  const RankSetup& rank_setup) {
   ProgressLine progress(stderr);
   const bool show_progress = progress.enabled() && session.rank() == 0;
   const auto on_progress =
       show_progress ? [&](const Progress& p) { progress.update(p); } : std::function<void(const Progress&)>();
   std::optional<DistributedRender> distributed;
-  if (session.distributed()) distributed = render_shared(session, plan, world, camera, on_progress, exchange);
+  if (session.distributed()) distributed = render_shared(session, plan, world, camera, on_progress, rank_setup);
   const RenderOutput output = distributed ? std::move(distributed->output) : render_image(plan, world, camera, on_progress);
   if (show_progress) progress.finish();
   if (session.rank() != 0) return 0;
@@ -115,8 +115,16 @@ int render_in_session(const RenderArguments& args, const MpiSession& session) {
       }
       exchange = std::make_unique<ChunkExchange>(session, *chunks);
     }
+    RankSetup rank_setup{exchange.get()};
+    if (exchange) {
+      // The load's checks read every chunk: give those pages back, so that the rank holds the
+      // chunks it answers for, and measure the render's peak apart from the load's.
+      rank_setup.load_peak_resident_bytes = read_resident_memory().peak_bytes;
+      built.drop_resident_world_pages();
+      reset_peak_resident_memory();
+    }
     return finish_render(args, session, done, built.scene(), built.world(), built.camera(), measured, choice,
-                         exchange.get());
+                         rank_setup);
   } catch (const std::bad_alloc&) {
     throw std::runtime_error(fmt::format("out of memory {} ({:.2f} GB resident at most, {:.2f} GB available now)",
                                          activity, double(read_resident_memory().peak_bytes) * 1e-9,

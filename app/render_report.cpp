@@ -205,6 +205,7 @@ nlohmann::json distribute_json(const DistributedRender& render, const RenderPlan
                      {"peak_resident_bytes", rank.peak_resident_bytes}});
     if (plan.distribute.mode == DistributeMode::data) {
       const ChunkTraffic& traffic = rank.traffic;
+      ranks.back()["load_peak_resident_bytes"] = rank.load_peak_resident_bytes;
       ranks.back()["exchange"] = {{"chunks_owned", traffic.chunks_owned},
                                   {"triangles_owned", traffic.triangles_owned},
                                   {"queries_sent", traffic.queries_sent},
@@ -272,10 +273,11 @@ std::string render_table(const RenderFacts& facts) {
       if (facts.plan.distribute.mode == DistributeMode::data) {
         const ChunkTraffic& traffic = rank.traffic;
         table += fmt::format("    owns {} chunks ({} triangles); sent {} rays in {} queries ({:.1f} MB with the answers "
-                             "it gave), answered {} rays of others' in {} queries; waited {:.3f} s for answers\n",
+                             "it gave), answered {} rays of others' in {} queries; waited {:.3f} s for answers; "
+                             "{:.2f} GB resident at most while loading (every chunk checked)\n",
                              traffic.chunks_owned, traffic.triangles_owned, traffic.rays_sent, traffic.queries_sent,
                              double(traffic.bytes_sent) * 1e-6, traffic.rays_answered, traffic.queries_answered,
-                             traffic.wait_seconds);
+                             traffic.wait_seconds, double(rank.load_peak_resident_bytes) * 1e-9);
       }
     }
   }

@@ -2,8 +2,10 @@
 # Image-parallel renders against one process (issue 34's goal: 2 ranks x 1 thread at >= 0.95x
 # the rays/s of one process x 2 threads): the same world, camera and settings, alternately
 # alone and under mpirun, REPEAT times each; a table of medians and the ratio.
+# Data mode (goal: each rank's peak resident <= 60% of one process's, rays/s >= 0.8x) needs a
+# chunked world: RUNS="alone:1:2 image:2:1 data:2:1 data:4:1".
 # Usage: bench/distribute_suite.sh SCENE OUT_DIR   (SCENE: a saved world .wtw, or builtin:...)
-# Settings (environment): SIZE (640x480), SPP (8), HEURISTIC (hph), REPEAT (3),
+# Settings (environment): SIZE (640x480), SPP (8), DEPTH (5), HEURISTIC (hph), REPEAT (3),
 #   RUNS ("alone:1:2 image:2:1"): MODE:RANKS:THREADS each, alone = without mpirun.
 set -euo pipefail
 scene=${1:?usage: bench/distribute_suite.sh SCENE OUT_DIR}
@@ -11,7 +13,8 @@ out=${2:-out/distribute}
 mkdir -p "$out"
 wavetrace=${WAVETRACE:-build/wavetrace}
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1  # mpirun as root (CI, this machine)
-common=(render "$scene" --size "${SIZE:-640x480}" --spp "${SPP:-8}" --set "reorder.heuristic=${HEURISTIC:-hph}")
+common=(render "$scene" --size "${SIZE:-640x480}" --spp "${SPP:-8}" --set "reorder.heuristic=${HEURISTIC:-hph}"
+        --set "render.max_depth=${DEPTH:-5}")
 
 { lscpu | grep "Model name" | tr -s " "; grep -o 'avx512[a-z_0-9]*' /proc/cpuinfo | sort -u | tr '\n' ' '; echo; } > "$out/cpu.txt"
 cat "$out/cpu.txt"
@@ -32,18 +35,21 @@ python3 - "$out" ${RUNS:-alone:1:2 image:2:1} <<'PY'
 import glob, json, statistics, sys, filecmp
 out, runs = sys.argv[1], sys.argv[2:]
 rows, base = [], None
-print("| run | ranks x threads | render s (median) | rays traced | Mrays/s (median) | vs alone | peak resident GB a rank (most) | image |")
-print("| --- | --- | ---: | ---: | ---: | ---: | ---: | --- |")
+print("| run | ranks x threads | render s (median) | rays traced | Mrays/s (median) | vs alone | peak resident GB a rank (most) | of alone's | while loading GB | bytes sent a ray | image |")
+print("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |")
+alone_peak = None
 for run in runs:
     mode, ranks, threads = run.split(":")
     files = sorted(glob.glob(f"{out}/{mode}_{ranks}x{threads}_*.json"))
-    seconds, rates, peaks, traced = [], [], [], 0
+    seconds, rates, peaks, loads, sent, traced = [], [], [], [], [], 0
     for path in files:
         stats = json.load(open(path))
         if "distribute" in stats:
             d = stats["distribute"]
             seconds.append(d["wall_seconds"]); traced = d["rays_traced"]
             peaks.append(max(r["peak_resident_bytes"] for r in d["per_rank"]) * 1e-9)
+            loads.append(max(r.get("load_peak_resident_bytes", 0) for r in d["per_rank"]) * 1e-9)
+            sent.append(sum(r.get("exchange", {}).get("bytes_sent", 0) for r in d["per_rank"]) / d["rays_traced"])
         else:
             seconds.append(stats["render"]["seconds"])
             traced = next(s["rays_in"] for s in stats["stages"] if s["name"] == "trace")
@@ -53,6 +59,9 @@ for run in runs:
     base = base or rate
     first = f"{out}/{runs[0].split(':')[0]}_{runs[0].split(':')[1]}x{runs[0].split(':')[2]}_1.exr"
     identical = all(filecmp.cmp(p.replace(".json", ".exr"), first, shallow=False) for p in files)
+    alone_peak = alone_peak or max(peaks)
     print(f"| {mode} | {ranks} x {threads} | {statistics.median(seconds):.3f} | {traced:,} | {rate:.3f} | "
-          f"{rate / base:.3f} | {max(peaks):.2f} | {'identical' if identical else 'DIFFERS'} |")
+          f"{rate / base:.3f} | {max(peaks):.2f} | {max(peaks) / alone_peak:.0%} | "
+          f"{max(loads) if loads and max(loads) > 0 else float('nan'):.2f} | "
+          f"{statistics.median(sent) if sent else 0:.1f} | {'identical' if identical else 'DIFFERS'} |")
 PY

@@ -26,7 +26,7 @@ struct PackedRankReport {
   char host[64];
   std::uint64_t ranges, camera_rays, rays_traced;
   double render_seconds, wait_seconds;
-  std::uint64_t peak_resident_bytes;
+  std::uint64_t peak_resident_bytes, load_peak_resident_bytes;
   ChunkTraffic traffic;  // plain numbers
 };
 
@@ -40,6 +40,7 @@ PackedRankReport pack(const RankReport& report) {
   packed.render_seconds = report.render_seconds;
   packed.wait_seconds = report.wait_seconds;
   packed.peak_resident_bytes = report.peak_resident_bytes;
+  packed.load_peak_resident_bytes = report.load_peak_resident_bytes;
   packed.traffic = report.traffic;
   return packed;
 }
@@ -49,7 +50,7 @@ RankReport unpack(const PackedRankReport& packed) {
           packed.ranges,        packed.camera_rays,
           packed.rays_traced,   packed.render_seconds,
           packed.wait_seconds,  packed.peak_resident_bytes,
-          packed.traffic};
+          packed.load_peak_resident_bytes, packed.traffic};
 }
 
 const StageStats* find_stage(const PipelineRun& run, const std::string& name) {
@@ -73,7 +74,8 @@ std::uint64_t range_rays_for(const RenderPlan& plan, int ranks) {
 
 DistributedRender render_shared(const MpiSession& session, const RenderPlan& plan, const World& world,
                                 const Camera& camera, const std::function<void(const Progress&)>& on_progress,
-                                ChunkExchange* exchange) {
+                                const RankSetup& setup) {
+  ChunkExchange* const exchange = setup.exchange;
 #if !WAVETRACE_HAVE_MPI
   if (session.distributed()) throw std::logic_error("a distributed session in a build without MPI");
 #endif
@@ -118,6 +120,7 @@ DistributedRender render_shared(const MpiSession& session, const RenderPlan& pla
   own.rays_traced = trace != nullptr ? trace->rays_in : 0;
   own.wait_seconds = dealer.wait_seconds();
   own.peak_resident_bytes = read_resident_memory().peak_bytes;
+  own.load_peak_resident_bytes = setup.load_peak_resident_bytes;
   if (exchange != nullptr) own.traffic = exchange->traffic();
   if (!session.distributed()) {
     result.ranks = {own};

@@ -24,7 +24,10 @@ struct RankReport {
   std::uint64_t rays_traced = 0;  // rays its trace stage took (camera, bounce, shadow)
   double render_seconds = 0.0;    // its render, from the common start to its last ray
   double wait_seconds = 0.0;      // waiting for ranges from rank 0
-  std::uint64_t peak_resident_bytes = 0;  // VmHWM after its render
+  std::uint64_t peak_resident_bytes = 0;  // VmHWM after its render (data mode: since the load, see below)
+  // Data mode: VmHWM at the end of the load, whose checks read every chunk; its world's pages
+  // are then given back and the peak window restarted, so peak_resident_bytes is the render's.
+  std::uint64_t load_peak_resident_bytes = 0;
   ChunkTraffic traffic;                   // data mode: its chunks and the rays it sent and answered
 };
 
@@ -38,9 +41,13 @@ struct DistributedRender {
 
 // Collective: every rank calls it with the same plan and an identical world (data mode: each
 // with its exchange, which routes the world's chunks).
+struct RankSetup {
+  ChunkExchange* exchange = nullptr;  // data mode
+  std::uint64_t load_peak_resident_bytes = 0;
+};
 DistributedRender render_shared(const MpiSession& session, const RenderPlan& plan, const World& world,
                                 const Camera& camera, const std::function<void(const Progress&)>& on_progress = {},
-                                ChunkExchange* exchange = nullptr);
+                                const RankSetup& setup = {});
 
 // distribute.range_rays, or when 0 the image's rays over 64 ranges a rank, at least 16 batches.
 std::uint64_t range_rays_for(const RenderPlan& plan, int ranks);

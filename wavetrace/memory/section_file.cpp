@@ -49,9 +49,9 @@ bool read_exactly(int fd, void* data, std::size_t bytes, std::uint64_t offset) {
   return true;
 }
 
-// The checksum of a section read with O_DIRECT through a small buffer: verifying a paged
-// world neither fills the page cache nor holds more than the buffer.
-std::uint64_t checksum_direct(int fd, std::uint64_t offset, std::uint64_t size, std::byte* buffer, std::size_t buffer_bytes) {
+// The checksum of a section read through a small buffer (4 KiB-aligned for an O_DIRECT `fd`:
+// verifying a paged world neither fills the page cache nor holds more than the buffer).
+std::uint64_t checksum_by_reads(int fd, std::uint64_t offset, std::uint64_t size, std::byte* buffer, std::size_t buffer_bytes) {
   XXH3_state_t* state = XXH3_createState();
   XXH3_64bits_reset(state);
   for (std::uint64_t done = 0; done < size;) {
@@ -155,7 +155,7 @@ std::shared_ptr<const SectionFile> SectionFile::open(const std::string& path, co
     std::unique_ptr<std::byte, decltype(&std::free)> buffer(static_cast<std::byte*>(std::aligned_alloc(4096, kBufferBytes)),
                                                            &std::free);
     for (std::size_t i = 0; i < table.size(); ++i) {
-      sums[i] = checksum_direct(direct.get(), table[i].offset, table[i].size, buffer.get(), kBufferBytes);
+      sums[i] = checksum_by_reads(direct.get(), table[i].offset, table[i].size, buffer.get(), kBufferBytes);
     }
     try {
       const std::size_t budget_bytes =
@@ -172,8 +172,13 @@ std::shared_ptr<const SectionFile> SectionFile::open(const std::string& path, co
     if (mapping == MAP_FAILED) file->fail({}, fmt::format("cannot be mapped: {}", std::strerror(errno)));
     file->mapping_ = mapping;
     file->base_ = static_cast<const std::byte*>(mapping);
+    // Read, not through the mapping: checking a page must not make it resident in this
+    // process, which then holds only what its render touches (a data-parallel rank its own
+    // chunks; docs/distributed.md). The page cache keeps what was read for the mapping.
     tbb::parallel_for(std::size_t{0}, table.size(), [&](std::size_t i) {
-      sums[i] = XXH3_64bits(file->base_ + table[i].offset, table[i].size);
+      constexpr std::size_t kBufferBytes = std::size_t{1} << 20;
+      const std::unique_ptr<std::byte[]> buffer(new std::byte[kBufferBytes]);
+      sums[i] = checksum_by_reads(fd.get(), table[i].offset, table[i].size, buffer.get(), kBufferBytes);
     });
   }
   for (std::size_t i = 0; i < table.size(); ++i) {
@@ -238,6 +243,10 @@ std::span<const std::byte> SectionFile::checked(std::string_view name, std::size
     fail(name, fmt::format("holds {}-byte elements where {}-byte ones were expected", info->element_bytes, element_bytes));
   }
   return {base_ + info->offset, static_cast<std::size_t>(info->size)};
+}
+
+void SectionFile::drop_resident_pages() const {
+  if (mapping_ != nullptr) ::madvise(mapping_, file_bytes_, MADV_DONTNEED);
 }
 
 }  // namespace wavetrace

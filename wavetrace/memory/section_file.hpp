@@ -46,6 +46,9 @@ class SectionFile {
   const std::vector<SectionInfo>& sections() const { return sections_; }
   bool has(std::string_view name) const;
   double verify_seconds() const { return verify_seconds_; }
+  // A mapped file: gives back the pages this process has touched (they stay in the page
+  // cache), so that from now on it holds only what it reads again. No-op when paged.
+  void drop_resident_pages() const;
   // The real pager, when the file is paged; null when it is mapped.
   FilePager* pager() const { return pager_.get(); }
 

@@ -72,4 +72,8 @@ ChunkSet* BuiltWorld::chunk_set() {
   return accelerator != nullptr ? accelerator->chunk_set() : nullptr;
 }
 
+void BuiltWorld::drop_resident_world_pages() const {
+  if (loaded_) loaded_->file->drop_resident_pages();
+}
+
 }  // namespace wavetrace

@@ -48,6 +48,9 @@ class BuiltWorld {
   // The chunks of a chunked world (for a data-parallel render to own and route); null for
   // any other world.
   ChunkSet* chunk_set();
+  // A mapped world file gives back the pages its load touched (checking every chunk reads
+  // them all): a data-parallel rank then holds only the chunks it answers for.
+  void drop_resident_world_pages() const;
 
  private:
   void build_from_scene(std::string& activity);
