@@ -192,6 +192,18 @@ TEST(Distribute, DataModeNeedsAChunkedWorld) {
       << result.output;
 }
 
+// Ranks started with different arguments (here: scenes) would sum unrelated films: refused on
+// every rank before anything is rendered.
+TEST(Distribute, RanksWithDifferentWorldsAreRefused) {
+  if (!mpi_ready()) GTEST_SKIP() << "built without MPI, or no mpirun";
+  const std::string image = testing::write_temp_file("distribute_mismatch.exr", "");
+  const auto result = testing::run_shell(mpirun(1) + WAVETRACE_BINARY + " render builtin:room:20000 --size 16x12 --out " +
+                                         image + " : -np 1 " + WAVETRACE_BINARY +
+                                         " render builtin:room:30000 --size 16x12 --out " + image + " 2>&1");
+  EXPECT_EQ(result.exit_code, 1) << result.output;
+  EXPECT_NE(result.output.find("the ranks do not render the same world and image"), std::string::npos) << result.output;
+}
+
 // Commands other than render would run once a rank (two builds writing one file): refused.
 TEST(Distribute, OnlyRenderRunsUnderMpirun) {
   if (!mpi_ready()) GTEST_SKIP() << "built without MPI, or no mpirun";

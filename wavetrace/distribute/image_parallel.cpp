@@ -7,6 +7,9 @@
 #include <chrono>
 #include <cstring>
 #include <stdexcept>
+#include <string>
+
+#include <fmt/format.h>
 
 #include "wavetrace/distribute/ray_range_dealer.hpp"
 #include "wavetrace/memory/process_memory.hpp"
@@ -58,6 +61,17 @@ const StageStats* find_stage(const PipelineRun& run, const std::string& name) {
   return found == run.stages.end() ? nullptr : &*found;
 }
 
+// What must be the same on every rank for their films to add up to one image.
+std::uint64_t render_fingerprint(const RenderPlan& plan, const World& world) {
+  // The structure's bytes tell its chunking and settings apart too.
+  const std::string facts = fmt::format(
+      "{} {} {} {} {}x{} {} spp seed {} depth {} roulette {} {} {} {}", world.scene.name, world.scene.triangle_count,
+      world.accelerator.name(), world.accelerator.memory().total(), plan.image.width, plan.image.height, plan.image.samples_per_pixel, plan.image.seed, plan.rules.max_depth,
+      plan.rules.russian_roulette_depth, to_string(plan.reorder.heuristic), to_string(plan.distribute.mode),
+      plan.stages.size());
+  return std::hash<std::string>{}(facts);
+}
+
 }  // namespace
 
 std::uint64_t DistributedRender::rays_traced() const {
@@ -83,8 +97,17 @@ DistributedRender render_shared(const MpiSession& session, const RenderPlan& pla
   result.range_rays = range_rays_for(plan, session.ranks());
   const std::uint64_t total = std::uint64_t(plan.image.pixel_count()) * plan.image.samples_per_pixel;
 #if WAVETRACE_HAVE_MPI
-  // Every rank has its world before the clock starts: the measured time is the render's.
-  if (session.distributed()) MPI_Barrier(MPI_COMM_WORLD);
+  // Every rank has its world before the clock starts (the measured time is the render's), and
+  // all hold the same one: ranks started with different arguments would sum unrelated films.
+  if (session.distributed()) {
+    const std::uint64_t own = render_fingerprint(plan, world);
+    std::uint64_t least[2] = {own, ~own};  // the least of ~x is ~(the most of x)
+    MPI_Allreduce(MPI_IN_PLACE, least, 2, MPI_UINT64_T, MPI_MIN, MPI_COMM_WORLD);
+    if (least[0] != ~least[1]) {
+      throw std::runtime_error("the ranks do not render the same world and image (the scene, its structure or the "
+                               "image settings differ between them): start every rank with the same arguments");
+    }
+  }
 #endif
   const Clock::time_point start = Clock::now();
   RayRangeDealer dealer(session, total, result.range_rays);
