@@ -29,15 +29,7 @@ const std::vector<std::string> kSettings = {"render.width=40", "render.height=30
 TEST(ImageShare, RangesOfCameraRaysWithTheirFilmsSummedAreTheWholeImage) {
   const Scene scene = make_builtin_scene("builtin:room:5000");
   const RenderOutput whole = testing::render_scene(scene, kSettings);
-
-  Config config;
-  for (const std::string& setting : kSettings) config.set(setting);
-  const RenderPlan plan = plan_render(config);
-  const auto accelerator = make_accelerator(scene.mesh, plan.accelerator);
-  const LightSampler lights(scene);
-  const std::unique_ptr<Proxy> proxy = build_proxy(plan, scene, *accelerator);
-  const World world{scene, *accelerator, lights, proxy.get()};
-  const std::uint64_t total = std::uint64_t(plan.image.pixel_count()) * plan.image.samples_per_pixel;
+  const std::uint64_t total = 40 * 30 * 3;  // kSettings: 40x30 at 3 spp
   constexpr std::uint64_t kRange = 700;
 
   std::vector<std::int64_t> first_sums;
@@ -61,7 +53,7 @@ TEST(ImageShare, RangesOfCameraRaysWithTheirFilmsSummedAreTheWholeImage) {
         for (std::size_t i = 0; i < sums.size(); ++i) sums[i] += first_sums[i];
       }
     };
-    image = render_image(plan, world, resolve_camera(plan.camera, scene), {}, share).image;
+    image = testing::render_scene(scene, kSettings, share).image;
   }
   EXPECT_EQ(generated, total);
   EXPECT_EQ(image, whole.image);
@@ -72,16 +64,9 @@ TEST(ImageShare, RangesOfCameraRaysWithTheirFilmsSummedAreTheWholeImage) {
 
 TEST(ImageShare, TheMegakernelCannotShareAnImage) {
   const Scene scene = make_builtin_scene("builtin:room:5000");
-  Config config;
-  config.set("pipeline.mode=megakernel");
-  config.set("render.width=8");
-  config.set("render.height=6");
-  const RenderPlan plan = plan_render(config);
-  const auto accelerator = make_accelerator(scene.mesh, plan.accelerator);
-  const LightSampler lights(scene);
   ImageShare share;
   share.camera_rays = [] { return CameraRayRange{}; };
-  EXPECT_THROW(render_image(plan, World{scene, *accelerator, lights}, resolve_camera(plan.camera, scene), {}, share),
+  EXPECT_THROW(testing::render_scene(scene, {"pipeline.mode=megakernel", "render.width=8", "render.height=6"}, share),
                ConfigError);
 }
 
