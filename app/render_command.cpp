@@ -93,7 +93,7 @@ int render_in_session(const RenderArguments& args, const MpiSession& session) {
   std::string activity;
   try {
     BuiltWorld built(plan, &activity);
-    if (const ResolvedAccelerator* resolved = built.resolution()) {
+    if (const ResolvedAccelerator* resolved = built.resolution(); resolved != nullptr && session.rank() == 0) {
       if (const std::string line = resolution_summary(*resolved); !line.empty()) fmt::print("{}\n", line);
     }
     RenderPhases measured;
@@ -109,8 +109,8 @@ int render_in_session(const RenderArguments& args, const MpiSession& session) {
     if (session.distributed() && done.distribute.mode == DistributeMode::data) {
       ChunkSet* chunks = built.chunk_set();
       if (chunks == nullptr) {
-        throw ConfigError(fmt::format("distribute.mode = data needs a chunked world ({} is not): set "
-                                      "accel.chunk_triangles, or render a world file built with chunks",
+        throw ConfigError(fmt::format("distribute.mode = data needs a chunked world ({} is not): a scene of more "
+                                      "than build.chunk_triangles, or a world file built with chunks",
                                       built.world().accelerator.name()));
       }
       exchange = std::make_unique<ChunkExchange>(session, *chunks);

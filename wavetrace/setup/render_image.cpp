@@ -36,13 +36,13 @@ void check_spill_space(const RenderPlan& plan) {
 RenderOutput render_image(const RenderPlan& plan, const World& world, const Camera& camera,
                           const std::function<void(const Progress&)>& on_progress, const ImageShare& share) {
   check_spill_space(plan);
-  const int workers = worker_count(plan.pipeline);
-  Film film(plan.image.width, plan.image.height, plan.film_per_thread ? std::uint32_t(workers) : 0);
-  GenerateStage generate(camera, plan.image, plan.pixel_order, share.camera_rays);
   if (share.camera_rays && plan.pipeline.mode == PipelineMode::megakernel) {
     throw ConfigError("pipeline.mode = megakernel walks the image's pixels itself: a shared image (a distributed "
                       "render) needs the wavefront pipeline");
   }
+  const int workers = worker_count(plan.pipeline);
+  Film film(plan.image.width, plan.image.height, plan.film_per_thread ? std::uint32_t(workers) : 0);
+  GenerateStage generate(camera, plan.image, plan.pixel_order, share.camera_rays);
   std::optional<MemoryObservation> observation;
   RenderOutput output;
   if (plan.memory.enabled()) {
