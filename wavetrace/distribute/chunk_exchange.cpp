@@ -209,6 +209,11 @@ void ChunkExchange::answer_elsewhere(ChunkQuery query, const RayBatch& rays, Hit
 #endif
 }
 
+void ChunkExchange::meanwhile() const {
+  while (answer_one_query()) {
+  }
+}
+
 bool ChunkExchange::answer_one_query() const {
 #if WAVETRACE_HAVE_MPI
   int arrived = 0;

@@ -41,6 +41,7 @@ class ChunkExchange final : public ChunkRouter {
   bool is_local(std::size_t chunk) const override { return owner_[chunk] == session_.rank(); }
   void answer_elsewhere(ChunkQuery query, const RayBatch& rays, HitBatch& hits, std::span<const std::uint32_t> chunk_start,
                         const std::function<void()>& local_work) const override;
+  void meanwhile() const override;  // answers every query waiting here
 
   // After this rank's render: answers the others' rays until every rank has finished its own.
   void finish();

@@ -28,6 +28,9 @@ class ChunkRouter {
   virtual void answer_elsewhere(ChunkQuery query, const RayBatch& rays, HitBatch& hits,
                                 std::span<const std::uint32_t> chunk_start,
                                 const std::function<void()>& local_work) const = 0;
+  // Called between the local chunks' queries of a round: a chance to answer the rays others
+  // wait for without keeping them waiting a whole round.
+  virtual void meanwhile() const {}
 };
 
 // The chunks of a chunked world, for the processes that own and answer them.

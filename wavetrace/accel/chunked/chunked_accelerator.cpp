@@ -412,6 +412,7 @@ class ChunkedAccelerator final : public Accelerator, public ChunkSet {
           const std::uint32_t begin = scratch.chunk_start[c], end = scratch.chunk_start[c + 1];
           if (begin == end || (router_ != nullptr && !router_->is_local(c))) continue;
           query(*chunks_[c].accelerator, sub_rays, sub_hits, RayRange{begin, end});
+          if (router_ != nullptr) router_->meanwhile();
         }
       };
       if (router_ != nullptr) {
