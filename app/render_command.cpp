@@ -15,7 +15,7 @@
 #include "app/progress_line.hpp"
 #include "app/render_report.hpp"
 #include "wavetrace/distribute/chunk_exchange.hpp"
-#include "wavetrace/distribute/image_parallel.hpp"
+#include "wavetrace/distribute/shared_render.hpp"
 #include "wavetrace/distribute/mpi_session.hpp"
 #include "wavetrace/memory/process_memory.hpp"
 #include "wavetrace/scene/lights.hpp"

@@ -6,7 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "wavetrace/accel/accelerator.hpp"
-#include "wavetrace/distribute/image_parallel.hpp"
+#include "wavetrace/distribute/shared_render.hpp"
 #include "wavetrace/scene/scene.hpp"
 #include "wavetrace/setup/render_setup.hpp"
 

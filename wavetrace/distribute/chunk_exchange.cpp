@@ -147,12 +147,8 @@ void ChunkExchange::answer_elsewhere(ChunkQuery query, const RayBatch& rays, Hit
                                 rays.direction_z, rays.tmin, rays.tmax}) {
       for (std::size_t g = 0; g < groups.size(); g += 2) out.put(column + chunk_start[groups[g]], groups[g + 1]);
     }
-    for (std::size_t g = 0; g < groups.size(); g += 2) {
-      for (std::uint32_t slot = chunk_start[groups[g]]; slot < chunk_start[groups[g]] + groups[g + 1]; ++slot) {
-        const auto kind = static_cast<std::uint8_t>(rays.kind[slot]);
-        out.put(&kind, 1);
-      }
-    }
+    static_assert(sizeof(RayKind) == 1);
+    for (std::size_t g = 0; g < groups.size(); g += 2) out.put(rays.kind + chunk_start[groups[g]], groups[g + 1]);
     send(std::move(message), owner, kQuery);
     queries_sent_.fetch_add(1, std::memory_order_relaxed);
     rays_sent_.fetch_add(count, std::memory_order_relaxed);
@@ -238,12 +234,8 @@ bool ChunkExchange::answer_one_query() const {
                         rays.direction_z, rays.tmin, rays.tmax}) {
     in.get(column, count);
   }
-  for (std::uint32_t i = 0; i < count; ++i) {
-    std::uint8_t kind = 0;
-    in.get(&kind, 1);
-    rays.kind[i] = static_cast<RayKind>(kind);
-    rays.flags[i] = ray_flags::alive;
-  }
+  in.get(rays.kind, count);
+  std::fill(rays.flags, rays.flags + count, ray_flags::alive);
   rays.count = count;
   std::uint32_t begin = 0;
   for (std::size_t g = 0; g < groups.size(); g += 2) {

@@ -1,7 +1,7 @@
 // A shared render: a barrier, each rank's render through the dealer (and in data mode its
 // exchange, answering the others until all are done), a sum of the films to rank 0, and each
 // rank's report gathered there.
-#include "wavetrace/distribute/image_parallel.hpp"
+#include "wavetrace/distribute/shared_render.hpp"
 
 #include <algorithm>
 #include <chrono>
