@@ -171,17 +171,9 @@ TEST(Cli, InfoCountsDroppedDegenerates) {
 namespace wavetrace {
 namespace {
 
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kAddressSanitizer = true;
-#elif defined(__has_feature)
-constexpr bool kAddressSanitizer = __has_feature(address_sanitizer);
-#else
-constexpr bool kAddressSanitizer = false;
-#endif
-
 TEST(Cli, OutOfMemoryIsReportedWithWhatWasBeingBuilt) {
   // AddressSanitizer reserves terabytes of shadow memory, which no address-space limit allows.
-  if (kAddressSanitizer) GTEST_SKIP() << "an address-space limit cannot hold AddressSanitizer's shadow";
+  if (testing::kAddressSanitizer) GTEST_SKIP() << "an address-space limit cannot hold AddressSanitizer's shadow";
   // 300 MB of address space: the scene loads, its BVH build runs out.
   const auto [exit_code, output] = testing::run_wavetrace(
       "render builtin:sphere:2M --accel bvh --size 8x8 --spp 1 --threads 1 --out " +

@@ -215,6 +215,23 @@ TEST(Distribute, ARankThatCannotOpenItsWorldEndsEveryRank) {
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(60));
 }
 
+// Rank 1 runs out of memory making its world (400 MB of address space): it says so, naming
+// itself and what it was doing, and the job ends with exit 1.
+TEST(Distribute, ARankOutOfMemoryEndsEveryRank) {
+  if (!mpi_ready()) GTEST_SKIP() << "built without MPI, or no mpirun";
+  if (testing::kAddressSanitizer) GTEST_SKIP() << "an address-space limit cannot hold AddressSanitizer's shadow";
+  const std::string image = testing::write_temp_file("distribute_oom.exr", "");
+  const std::string render = std::string(WAVETRACE_BINARY) +
+                             " render builtin:sphere:2M --accel bvh --size 8x8 --spp 1 --threads 1 --out " + image;
+  const auto result =
+      testing::run_shell(mpirun(1) + render + " : -np 1 bash -c 'ulimit -v 400000; exec " + render + "' 2>&1");
+  EXPECT_EQ(result.exit_code, 1) << result.output;
+  EXPECT_NE(result.output.find("wavetrace: error: rank 1 of 2"), std::string::npos) << result.output;
+  // Loading or building, by how much address space MPI took first (its shared memory grows
+  // with the machine's cores).
+  EXPECT_NE(result.output.find("): out of memory "), std::string::npos) << result.output;
+}
+
 // Rank 1 is killed (SIGKILL) two seconds into a render of several: mpirun ends rank 0 too,
 // and says which rank died of what. Its exit status is mpirun's (128 + 9), not a hang.
 TEST(Distribute, ARankKilledMidRenderEndsTheJob) {

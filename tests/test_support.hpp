@@ -16,6 +16,16 @@
 
 namespace wavetrace::testing {
 
+// AddressSanitizer reserves terabytes of shadow memory: tests that limit the address space
+// (ulimit -v) cannot run under it.
+#if defined(__SANITIZE_ADDRESS__)
+inline constexpr bool kAddressSanitizer = true;
+#elif defined(__has_feature)
+inline constexpr bool kAddressSanitizer = __has_feature(address_sanitizer);
+#else
+inline constexpr bool kAddressSanitizer = false;
+#endif
+
 // The volume a closed mesh encloses: positive when its faces point outward.
 inline double signed_volume(const TriangleMesh& mesh) {
   double volume = 0.0;

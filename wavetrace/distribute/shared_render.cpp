@@ -64,11 +64,12 @@ const StageStats* find_stage(const PipelineRun& run, const std::string& name) {
 // What must be the same on every rank for their films to add up to one image.
 std::uint64_t render_fingerprint(const RenderPlan& plan, const World& world) {
   // The structure's bytes tell its chunking and settings apart too.
-  const std::string facts = fmt::format(
-      "{} {} {} {} {}x{} {} spp seed {} depth {} roulette {} {} {} {}", world.scene.name, world.scene.triangle_count,
-      world.accelerator.name(), world.accelerator.memory().total(), plan.image.width, plan.image.height, plan.image.samples_per_pixel, plan.image.seed, plan.rules.max_depth,
-      plan.rules.russian_roulette_depth, to_string(plan.reorder.heuristic), to_string(plan.distribute.mode),
-      plan.stages.size());
+  const std::string facts =
+      fmt::format("{} {} {} {} {}x{} {} spp seed {} depth {} roulette {} {} {} {}", world.scene.name,
+                  world.scene.triangle_count, world.accelerator.name(), world.accelerator.memory().total(),
+                  plan.image.width, plan.image.height, plan.image.samples_per_pixel, plan.image.seed,
+                  plan.rules.max_depth, plan.rules.russian_roulette_depth, to_string(plan.reorder.heuristic),
+                  to_string(plan.distribute.mode), plan.stages.size());
   return std::hash<std::string>{}(facts);
 }
 
