@@ -11,6 +11,7 @@
 
 #include "wavetrace/accel/chunked/chunked_accelerator.hpp"
 #include "wavetrace/accel/registry.hpp"
+#include "wavetrace/bench/json_fields.hpp"
 #include "app/command_options.hpp"
 #include "app/commands.hpp"
 #include "wavetrace/memory/process_memory.hpp"
@@ -113,6 +114,11 @@ int run_build(const BuildArguments& args) {
                  : "saved in place");
   fmt::print("scene {:.2f} s, build {:.2f} s, save {:.2f} s; peak resident {:.2f} GB\n", info.scene_seconds,
              info.build_seconds, save_seconds, double(peak) * 1e-9);
+  if (const BuildPhases phases = accelerator->build().phases; !phases.empty()) {
+    std::string line;
+    for (const auto& [name, seconds] : phases.entries()) line += fmt::format("{}{} {:.2f}", line.empty() ? "" : ", ", name, seconds);
+    fmt::print("build phases (s; chunk.* summed over chunks): {}\n", line);
+  }
   fmt::print("wrote {}: {:.3f} GB, {:.2f} bytes/triangle (in memory: {:.2f}){}\n", args.out, double(file_bytes) * 1e-9,
              double(file_bytes) / triangles, double(accelerator->memory().total()) / triangles,
              proxy ? fmt::format("; proxy of {} triangles", proxy->report().triangles) : std::string());
@@ -122,6 +128,7 @@ int run_build(const BuildArguments& args) {
                                   {"accel", type},
                                   {"scene_seconds", info.scene_seconds},
                                   {"build_seconds", info.build_seconds},
+                                  {"build_phases", build_phases_json(accelerator->build().phases)},
                                   {"save_seconds", save_seconds},
                                   {"peak_rss_bytes", peak},
                                   {"file_bytes", file_bytes},

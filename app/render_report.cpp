@@ -170,6 +170,7 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
         {"parts", {{"hierarchy", memory.hierarchy}, {"geometry", memory.geometry}, {"other", memory.other}}},
         {"build_seconds", build.seconds},
         {"build_peak_accounted_bytes", build.peak_bytes},
+        {"build_phases", build_phases_json(build.phases)},
         {"build_notes", facts.accelerator.build_notes()},
         {"auto", facts.accel_choice ? to_json(*facts.accel_choice) : nlohmann::json(nullptr)}}},
       {"stages", stages},

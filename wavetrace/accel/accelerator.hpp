@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "wavetrace/accel/build_phases.hpp"
 #include "wavetrace/kernels/kernel_isa.hpp"
 #include "wavetrace/memory/memory_probe.hpp"
 #include "wavetrace/memory/ray_batch.hpp"
@@ -30,6 +31,7 @@ struct MemoryReport {
 struct BuildReport {
   double seconds = 0.0;
   std::size_t peak_bytes = 0;  // highest memory the build held at once, result included
+  BuildPhases phases;          // where the seconds went (empty where a build does not say)
 };
 
 class Accelerator {

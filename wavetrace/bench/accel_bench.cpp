@@ -277,6 +277,7 @@ nlohmann::json to_json(const AccelBenchReport& report) {
                        {"parts", {{"hierarchy", r.memory.hierarchy}, {"geometry", r.memory.geometry}, {"other", r.memory.other}}},
                        {"build_seconds", r.build.seconds},
                        {"build_peak_accounted_bytes", r.build.peak_bytes},
+                       {"build_phases", build_phases_json(r.build.phases)},
                        {"build_peak_rss_above_start_bytes", r.build_peak_rss_above_start_bytes},
                        {"build_notes", r.build_notes},
                        {"isa", r.isa},

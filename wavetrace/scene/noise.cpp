@@ -10,25 +10,21 @@ namespace {
 
 float fade(float t) { return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f); }
 
+// One of the 12 cube-edge directions, as in improved Perlin noise, by table: a switch on the
+// hash mispredicted about half its jumps and made the noise a quarter of a room's build. A
+// component of 0 adds a signed zero, which changes no sum of the fractal (it starts at +0).
+struct EdgeGradient {
+  float x, y, z;
+};
+constexpr EdgeGradient kEdgeGradients[12] = {{1, 1, 0}, {-1, 1, 0}, {1, -1, 0}, {-1, -1, 0}, {1, 0, 1},  {-1, 0, 1},
+                                             {1, 0, -1}, {-1, 0, -1}, {0, 1, 1}, {0, -1, 1}, {0, 1, -1}, {0, -1, -1}};
+
 float lattice_gradient_dot(int x, int y, int z, std::uint32_t seed, const glm::vec3& offset) {
   const std::uint64_t key = (std::uint64_t(std::uint32_t(x)) * 0x9E3779B1u) ^
                             (std::uint64_t(std::uint32_t(y)) << 21) ^ (std::uint64_t(std::uint32_t(z)) << 42) ^
                             (std::uint64_t(seed) << 13);
-  // One of the 12 cube-edge directions, as in improved Perlin noise.
-  switch (mix64(key) % 12) {
-    case 0: return offset.x + offset.y;
-    case 1: return -offset.x + offset.y;
-    case 2: return offset.x - offset.y;
-    case 3: return -offset.x - offset.y;
-    case 4: return offset.x + offset.z;
-    case 5: return -offset.x + offset.z;
-    case 6: return offset.x - offset.z;
-    case 7: return -offset.x - offset.z;
-    case 8: return offset.y + offset.z;
-    case 9: return -offset.y + offset.z;
-    case 10: return offset.y - offset.z;
-    default: return -offset.y - offset.z;
-  }
+  const EdgeGradient& g = kEdgeGradients[mix64(key) % 12];
+  return g.x * offset.x + g.y * offset.y + g.z * offset.z;
 }
 
 float lerp(float a, float b, float t) { return a + (b - a) * t; }

@@ -39,26 +39,7 @@ class BvhAccelerator final : public ProbedAccelerator<BvhAccelerator> {
     save_bvh(out, prefix, geometry_, "bvh.nodes", nodes_, "bvh.leaf_triangles", leaf_triangles_, build_);
   }
 
-  BvhAccelerator(const TriangleMesh& mesh, const BvhOptions& options)
-      : geometry_(mesh, options.triangle_order) {
-    const auto start = std::chrono::steady_clock::now();
-    const BuildTree tree = build_bvh_tree(geometry_, options);
-
-    // Leaf triangles are stored in node order too, so a leaf's slots follow its node's position.
-    LargeArray<std::uint32_t> leaf_triangles(geometry_.triangle_count());
-    LargeArray<BvhNode> nodes;
-    std::uint32_t slot = 0;
-    flatten_tree(tree, node_order(tree, options.layout), nodes, [&](const BuildNode& leaf) {
-      const std::uint32_t first = slot;
-      for (std::uint32_t k = 0; k < leaf.count; ++k) leaf_triangles[slot++] = tree.primitive_order[leaf.first + k];
-      return first;
-    });
-    adopt_leaf_order(options, geometry_, leaf_triangles);
-    nodes_ = StoredArray<BvhNode>(std::move(nodes));
-    leaf_triangles_ = StoredArray<std::uint32_t>(std::move(leaf_triangles));
-    build_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    build_.peak_bytes = bvh_build_peak_bytes(tree, geometry_, memory().total());
-  }
+  BvhAccelerator(const TriangleMesh& mesh, const BvhOptions& options) : BvhAccelerator(mesh, options, PhaseClock{}) {}
 
   std::string name() const override { return "bvh"; }
 
@@ -77,6 +58,32 @@ class BvhAccelerator final : public ProbedAccelerator<BvhAccelerator> {
   }
 
  private:
+  // The clock starts before the face set is made (a member), so that its copy is timed too.
+  BvhAccelerator(const TriangleMesh& mesh, const BvhOptions& options, PhaseClock clock)
+      : geometry_(mesh, options.triangle_order) {
+    const auto start = std::chrono::steady_clock::now();
+    build_.phases.add("face_set", clock.lap());
+    const BuildTree tree = build_bvh_tree(geometry_, options, build_.phases);
+    clock.lap();
+
+    // Leaf triangles are stored in node order too, so a leaf's slots follow its node's position.
+    LargeArray<std::uint32_t> leaf_triangles(geometry_.triangle_count());
+    LargeArray<BvhNode> nodes;
+    std::uint32_t slot = 0;
+    flatten_tree(tree, node_order(tree, options.layout), nodes, [&](const BuildNode& leaf) {
+      const std::uint32_t first = slot;
+      for (std::uint32_t k = 0; k < leaf.count; ++k) leaf_triangles[slot++] = tree.primitive_order[leaf.first + k];
+      return first;
+    });
+    adopt_leaf_order(options, geometry_, leaf_triangles);
+    nodes_ = StoredArray<BvhNode>(std::move(nodes));
+    leaf_triangles_ = StoredArray<std::uint32_t>(std::move(leaf_triangles));
+    clock.lap(build_.phases, "flatten");
+    build_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() +
+                     build_.phases.seconds("face_set");
+    build_.peak_bytes = bvh_build_peak_bytes(tree, geometry_, memory().total());
+  }
+
   template <bool kAnyHit, KernelIsa kIsa, typename Probe>
   void traverse(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
     for_each_ray(rays, hits, range, [&](const SingleRay& ray, std::uint32_t i) {

@@ -18,9 +18,12 @@
 
 namespace wavetrace {
 
-// The SAH tree over the face set's triangles; its peak_bytes include the bounds array.
-inline BuildTree build_bvh_tree(const IndexedFaceSet& geometry, const BvhOptions& options) {
+// The SAH tree over the face set's triangles; its peak_bytes include the bounds array. Adds
+// the phases "bounds" and "sah".
+inline BuildTree build_bvh_tree(const IndexedFaceSet& geometry, const BvhOptions& options, BuildPhases& phases) {
+  PhaseClock clock;
   const LargeArray<Bounds3> bounds = geometry.triangle_bounds();
+  clock.lap(phases, "bounds");
   SahOptions sah;
   sah.max_leaf_size = options.max_leaf_size;
   sah.bins = options.bins;
@@ -28,6 +31,7 @@ inline BuildTree build_bvh_tree(const IndexedFaceSet& geometry, const BvhOptions
   sah.block_size = options.width == 8 ? TriangleBlock::kLanes : 1;
   BuildTree tree = build_sah_tree(bounds, sah);
   tree.peak_bytes += bounds.size() * sizeof(Bounds3);
+  clock.lap(phases, "sah");
   return tree;
 }
 

@@ -1,11 +1,21 @@
 // Top-down binned SAH (Wald 2007): centroids are binned along each axis, the cheapest
 // plane by surface area heuristic splits the range in place. Large ranges bin in parallel
 // and subtrees build as parallel tasks; node slots come from an atomic counter, so the
-// tree's shape does not depend on the thread count (only node numbering does).
+// tree's shape does not depend on the thread count (only node numbering does). Boxes are
+// binned four floats at a time, as Wald's SIMD binning does, and the partition finds the
+// children's centroid bounds as it moves them, so a node costs two passes over its range.
 #include "wavetrace/accel/bvh/sah_builder.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
+#include <bit>
+#include <cstddef>
+#include <limits>
+#include <memory>
+#include <new>
+
+#include <immintrin.h>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -33,21 +43,42 @@ float half_area(const Bounds3& bounds) {
   return e.x * e.y + e.y * e.z + e.z * e.x;
 }
 
-struct Bin {
-  Bounds3 bounds;
-  std::uint32_t count;
+// A box as two SSE registers: lower (x, y, z, -) and upper (x, y, z, -); lane 3 is not read.
+struct BinBox {
+  __m128 lower, upper;
+  // Bounds3::extend's own comparisons: glm::min(a, b) is b < a ? b : a, which is
+  // _mm_min_ps(b, a), and glm::max(a, b) is _mm_max_ps(b, a), so that boxes, even to the sign
+  // of a zero, come out as the scalar build's did.
+  void extend(__m128 other_lower, __m128 other_upper) {
+    lower = _mm_min_ps(other_lower, lower);
+    upper = _mm_max_ps(other_upper, upper);
+  }
+  Bounds3 bounds() const {
+    alignas(16) float l[4], u[4];
+    _mm_store_ps(l, lower);
+    _mm_store_ps(u, upper);
+    return Bounds3{glm::vec3(l[0], l[1], l[2]), glm::vec3(u[0], u[1], u[2])};
+  }
 };
+
+inline BinBox empty_bin_box() {
+  return {_mm_set1_ps(std::numeric_limits<float>::infinity()), _mm_set1_ps(-std::numeric_limits<float>::infinity())};
+}
 
 // Bins of the three axes. Only the first `used` bins per axis are initialized: a node
 // is binned once, and clearing all kMaxBins bins would cost more than binning a small node.
 struct Binning {
   explicit Binning(std::uint32_t used) : used(used) {
-    for (auto& axis : bins) {
-      for (std::uint32_t i = 0; i < used; ++i) axis[i] = {Bounds3{}, 0};
+    for (int axis = 0; axis < 3; ++axis) {
+      for (std::uint32_t i = 0; i < used; ++i) {
+        boxes[axis][i] = empty_bin_box();
+        counts[axis][i] = 0;
+      }
     }
   }
   std::uint32_t used;
-  std::array<std::array<Bin, kMaxBins>, 3> bins;
+  std::array<std::array<BinBox, kMaxBins>, 3> boxes;
+  std::array<std::array<std::uint32_t, kMaxBins>, 3> counts;
 };
 
 struct Split {
@@ -64,7 +95,23 @@ struct PrimitiveReference {
   std::uint32_t id;
   std::uint32_t unused;
   glm::vec3 centroid() const { return (bounds.lower + bounds.upper) * 0.5f; }
+  // The box's corners as SSE registers: 16-byte loads at bytes 0 and 12 (lane 3 is upper.x
+  // and the id, never read); the centroid as centroid() computes it, lane by lane.
+  __m128 lower4() const { return _mm_loadu_ps(&bounds.lower.x); }
+  __m128 upper4() const { return _mm_loadu_ps(&bounds.upper.x); }
 };
+static_assert(sizeof(PrimitiveReference) == 32 && offsetof(PrimitiveReference, bounds) == 0);
+
+inline __m128 centroid4(__m128 lower, __m128 upper) { return _mm_mul_ps(_mm_add_ps(lower, upper), _mm_set1_ps(0.5f)); }
+
+// The bins of a centroid along the three axes: (centroid - lower) * scale truncated toward
+// zero, clamped to [0, bins - 1]; binning and partitioning both use it. Lane 3 is garbage.
+inline __m128i bins_of(__m128 centroid, __m128 lower, __m128 scale, __m128i last_bin) {
+  const __m128i bin = _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(centroid, lower), scale));
+  return _mm_min_epi32(_mm_max_epi32(bin, _mm_setzero_si128()), last_bin);
+}
+
+inline __m128 load3(const glm::vec3& v) { return _mm_setr_ps(v.x, v.y, v.z, 0.0f); }
 
 class Builder {
  public:
@@ -76,17 +123,19 @@ class Builder {
     tbb::parallel_for(std::size_t{0}, count, [&](std::size_t i) {
       references_[i] = {primitive_bounds[i], static_cast<std::uint32_t>(i), 0};
     });
-    tree_.nodes.resize(2 * count - 1);
-    tree_.peak_bytes = references_.size() * sizeof(PrimitiveReference) + count * sizeof(std::uint32_t) +
-                       tree_.nodes.size() * sizeof(BuildNode);
+    slots_.reset(static_cast<BuildNode*>(allocate_large_array((2 * count - 1) * sizeof(BuildNode))));
   }
 
   void build() {
     const auto count = static_cast<std::uint32_t>(references_.size());
     const Bounds3 root_bounds = bounds_of_range(0, count);
     next_node_.store(1);
-    build_node(0, 0, count, root_bounds, 1);
-    tree_.nodes.resize(next_node_.load());
+    build_node(0, 0, count, root_bounds, centroid_bounds(0, count), 1);
+    const std::uint32_t used = next_node_.load();
+    tree_.nodes.assign(slots_.get(), slots_.get() + used);
+    slots_.reset();
+    tree_.peak_bytes = references_.size() * sizeof(PrimitiveReference) + count * sizeof(std::uint32_t) +
+                       2 * std::size_t{used} * sizeof(BuildNode);
     tree_.primitive_order.resize(count);
     tbb::parallel_for(std::uint32_t{0}, count, [&](std::uint32_t i) { tree_.primitive_order[i] = references_[i].id; });
   }
@@ -120,34 +169,37 @@ class Builder {
         });
   }
 
-  // The bin of a centroid along an axis; the same formula is used to partition.
-  std::uint32_t bin_of(float centroid, float lower, float scale) const {
-    const auto bin = static_cast<std::int64_t>((centroid - lower) * scale);
-    return static_cast<std::uint32_t>(std::clamp<std::int64_t>(bin, 0, options_.bins - 1));
+  void fill_bins(std::uint32_t begin, std::uint32_t end, const Bounds3& centroids, const glm::vec3& scale,
+                 Binning& binning) const {
+    const __m128 lower = load3(centroids.lower), scales = load3(scale);
+    const __m128i last_bin = _mm_set1_epi32(static_cast<int>(options_.bins - 1));
+    for (std::uint32_t i = begin; i != end; ++i) {
+      const PrimitiveReference& reference = references_[i];
+      const __m128 box_lower = reference.lower4(), box_upper = reference.upper4();
+      alignas(16) std::int32_t bin[4];
+      _mm_store_si128(reinterpret_cast<__m128i*>(bin), bins_of(centroid4(box_lower, box_upper), lower, scales, last_bin));
+      for (int axis = 0; axis < 3; ++axis) {
+        binning.boxes[axis][bin[axis]].extend(box_lower, box_upper);
+        ++binning.counts[axis][bin[axis]];
+      }
+    }
   }
 
-  Binning bin_range(std::uint32_t first, std::uint32_t count, const Bounds3& centroids, const glm::vec3& scale) const {
-    const auto fill = [&](std::uint32_t begin, std::uint32_t end, Binning binning) {
-      for (std::uint32_t i = begin; i != end; ++i) {
-        const PrimitiveReference& reference = references_[i];
-        const glm::vec3 c = reference.centroid();
-        for (int axis = 0; axis < 3; ++axis) {
-          Bin& bin = binning.bins[axis][bin_of(c[axis], centroids.lower[axis], scale[axis])];
-          bin.bounds.extend(reference.bounds);
-          ++bin.count;
-        }
-      }
-      return binning;
-    };
-    if (count < kParallelBinningThreshold) return fill(first, first + count, Binning(options_.bins));
-    return tbb::parallel_reduce(
-        tbb::blocked_range<std::uint32_t>(first, first + count, 1 << 14), Binning(options_.bins),
-        [&](const tbb::blocked_range<std::uint32_t>& range, Binning b) { return fill(range.begin(), range.end(), b); },
+  // Into `binning`, fresh: a small node's bins are filled in place, never copied (7 KB).
+  void bin_range(std::uint32_t first, std::uint32_t count, const Bounds3& centroids, const glm::vec3& scale,
+                 Binning& binning) const {
+    if (count < kParallelBinningThreshold) return fill_bins(first, first + count, centroids, scale, binning);
+    binning = tbb::parallel_reduce(
+        tbb::blocked_range<std::uint32_t>(first, first + count, 1 << 14), binning,
+        [&](const tbb::blocked_range<std::uint32_t>& range, Binning b) {
+          fill_bins(range.begin(), range.end(), centroids, scale, b);
+          return b;
+        },
         [&](Binning a, const Binning& b) {
           for (int axis = 0; axis < 3; ++axis) {
             for (std::uint32_t i = 0; i < options_.bins; ++i) {
-              a.bins[axis][i].bounds.extend(b.bins[axis][i].bounds);
-              a.bins[axis][i].count += b.bins[axis][i].count;
+              a.boxes[axis][i].extend(b.boxes[axis][i].lower, b.boxes[axis][i].upper);
+              a.counts[axis][i] += b.counts[axis][i];
             }
           }
           return a;
@@ -163,20 +215,22 @@ class Builder {
     std::uint32_t right_count[kMaxBins];
     for (int axis = 0; axis < 3; ++axis) {
       if (!(centroids.upper[axis] > centroids.lower[axis])) continue;
-      const auto& row = binning.bins[axis];
+      std::array<Bounds3, kMaxBins> row;
+      for (std::uint32_t i = 0; i < bins; ++i) row[i] = binning.boxes[axis][i].bounds();
+      const auto& counts = binning.counts[axis];
       Bounds3 accumulated;
       std::uint32_t count = 0;
       for (std::uint32_t i = bins - 1; i > 0; --i) {
-        accumulated.extend(row[i].bounds);
-        count += row[i].count;
+        accumulated.extend(row[i]);
+        count += counts[i];
         right_area[i - 1] = half_area(accumulated);
         right_count[i - 1] = count;
       }
       accumulated = Bounds3{};
       count = 0;
       for (std::uint32_t i = 0; i + 1 < bins; ++i) {
-        accumulated.extend(row[i].bounds);
-        count += row[i].count;
+        accumulated.extend(row[i]);
+        count += counts[i];
         if (count == 0 || right_count[i] == 0) continue;
         const float cost = half_area(accumulated) * blocks(count) + right_area[i] * blocks(right_count[i]);
         if (cost < best.cost) {
@@ -187,33 +241,78 @@ class Builder {
       }
     }
     if (best.axis >= 0) {
-      const auto& row = binning.bins[best.axis];
-      for (std::uint32_t i = 0; i < bins; ++i) (i <= best.bin ? best.left_bounds : best.right_bounds).extend(row[i].bounds);
+      const auto& row = binning.boxes[best.axis];
+      for (std::uint32_t i = 0; i < bins; ++i) (i <= best.bin ? best.left_bounds : best.right_bounds).extend(row[i].bounds());
     }
     return best;
   }
 
+  // The SAH sweep asks this for every bin: a shift where the block size is a power of two.
   float blocks(std::uint32_t count) const {
+    if (block_shift_ >= 0) return float((count + options_.block_size - 1) >> block_shift_);
     return float((count + options_.block_size - 1) / options_.block_size);
   }
 
   void make_leaf(std::uint32_t node, std::uint32_t first, std::uint32_t count, const Bounds3& bounds) {
-    BuildNode& leaf = tree_.nodes[node];
-    leaf.bounds = bounds;
-    leaf.first = first;
-    leaf.count = count;
+    new (&slots_[node]) BuildNode{bounds, 0, 0, first, count};
+  }
+
+  // std::partition's own moves (libstdc++'s bidirectional __partition, so the tree is the one
+  // it built), gathering each side's centroid bounds on the way: every reference is tested
+  // once, and a side's bounds are those of the references that end on it.
+  std::uint32_t partition_range(std::uint32_t first, std::uint32_t count, int axis, std::uint32_t split_bin,
+                                const Bounds3& centroids, const glm::vec3& scale, Bounds3& left_centroids,
+                                Bounds3& right_centroids) {
+    const __m128 lower = load3(centroids.lower), scales = load3(scale);
+    const __m128i last_bin = _mm_set1_epi32(static_cast<int>(options_.bins - 1));
+    BinBox left = empty_bin_box(), right = empty_bin_box();
+    // Tests a reference, and adds its centroid to the side it goes to.
+    const auto goes_left = [&](const PrimitiveReference& reference) {
+      const __m128 c = centroid4(reference.lower4(), reference.upper4());
+      alignas(16) std::int32_t bin[4];
+      _mm_store_si128(reinterpret_cast<__m128i*>(bin), bins_of(c, lower, scales, last_bin));
+      const bool is_left = std::uint32_t(bin[axis]) <= split_bin;
+      (is_left ? left : right).extend(c, c);
+      return is_left;
+    };
+    PrimitiveReference* begin = references_.data() + first;
+    PrimitiveReference* end = begin + count;
+    const auto finish = [&] {
+      left_centroids = left.bounds();
+      right_centroids = right.bounds();
+      return static_cast<std::uint32_t>(begin - references_.data());
+    };
+    while (true) {
+      while (true) {
+        if (begin == end) return finish();
+        if (!goes_left(*begin)) break;
+        ++begin;
+      }
+      --end;
+      while (true) {
+        if (begin == end) return finish();
+        if (goes_left(*end)) break;
+        --end;
+      }
+      std::swap(*begin, *end);
+      ++begin;
+    }
   }
 
   void build_node(std::uint32_t node, std::uint32_t first, std::uint32_t count, const Bounds3& bounds,
-                  std::uint32_t depth) {
+                  const Bounds3& centroids, std::uint32_t depth) {
     if (count == 1) return make_leaf(node, first, count, bounds);
-    const Bounds3 centroids = centroid_bounds(first, count);
     glm::vec3 scale;
     for (int axis = 0; axis < 3; ++axis) {
       const float extent = centroids.upper[axis] - centroids.lower[axis];
       scale[axis] = extent > 0.0f ? float(options_.bins) * (1.0f - 1e-6f) / extent : 0.0f;
     }
-    const Split split = depth < kFreeDepth ? best_split(bin_range(first, count, centroids, scale), centroids) : Split{};
+    Split split;
+    if (depth < kFreeDepth) {
+      Binning binning(options_.bins);
+      bin_range(first, count, centroids, scale, binning);
+      split = best_split(binning, centroids);
+    }
     const float leaf_cost = options_.intersection_cost * blocks(count);
     const float split_cost = options_.traversal_cost + options_.intersection_cost * split.cost / half_area(bounds);
     if (count <= options_.max_leaf_size && (split.axis < 0 || leaf_cost <= split_cost)) {
@@ -222,16 +321,9 @@ class Builder {
     }
 
     std::uint32_t middle;
-    Bounds3 left_bounds, right_bounds;
-    PrimitiveReference* references = references_.data();
+    Bounds3 left_bounds, right_bounds, left_centroids, right_centroids;
     if (split.axis >= 0) {
-      const int axis = split.axis;
-      middle = static_cast<std::uint32_t>(
-          std::partition(references + first, references + first + count,
-                         [&](const PrimitiveReference& r) {
-                           return bin_of(r.centroid()[axis], centroids.lower[axis], scale[axis]) <= split.bin;
-                         }) -
-          references);
+      middle = partition_range(first, count, split.axis, split.bin, centroids, scale, left_centroids, right_centroids);
       left_bounds = split.left_bounds;
       right_bounds = split.right_bounds;
     } else {
@@ -239,28 +331,36 @@ class Builder {
       middle = first + count / 2;
       left_bounds = bounds_of_range(first, middle - first);
       right_bounds = bounds_of_range(middle, first + count - middle);
+      left_centroids = centroid_bounds(first, middle - first);
+      right_centroids = centroid_bounds(middle, first + count - middle);
     }
 
     const std::uint32_t left = next_node_.fetch_add(2);
-    BuildNode& inner = tree_.nodes[node];
-    inner.bounds = bounds;
-    inner.left = left;
-    inner.right = left + 1;
+    new (&slots_[node]) BuildNode{bounds, left, left + 1, 0, 0};
     const std::uint32_t left_count = middle - first, right_count = first + count - middle;
     if (count >= kParallelSubtreeThreshold) {
       tbb::task_group group;
-      group.run([&] { build_node(left, first, left_count, left_bounds, depth + 1); });
-      build_node(left + 1, middle, right_count, right_bounds, depth + 1);
+      group.run([&] { build_node(left, first, left_count, left_bounds, left_centroids, depth + 1); });
+      build_node(left + 1, middle, right_count, right_bounds, right_centroids, depth + 1);
       group.wait();
     } else {
-      build_node(left, first, left_count, left_bounds, depth + 1);
-      build_node(left + 1, middle, right_count, right_bounds, depth + 1);
+      build_node(left, first, left_count, left_bounds, left_centroids, depth + 1);
+      build_node(left + 1, middle, right_count, right_bounds, right_centroids, depth + 1);
     }
   }
 
   SahOptions options_;
+  int block_shift_ = std::has_single_bit(options_.block_size) ? std::countr_zero(options_.block_size) : -1;
   BuildTree& tree_;
   LargeArray<PrimitiveReference> references_;
+  // Slots for the worst case, 2n - 1 nodes, as raw memory: a tree takes about one node per two
+  // primitives or fewer, and the pages no node is written to are never touched (a first touch
+  // of a page costs a VM dearly: it was a third of a build's time). The nodes made are copied
+  // to the tree at the end.
+  struct FreeSlots {
+    void operator()(BuildNode* slots) const { std::free(slots); }
+  };
+  std::unique_ptr<BuildNode[], FreeSlots> slots_;
   std::atomic<std::uint32_t> next_node_{0};
 };
 

@@ -44,6 +44,7 @@ class EmbreeAccelerator final : public Accelerator {
  public:
   EmbreeAccelerator(const TriangleMesh& mesh, const EmbreeOptions& options) : mesh_(mesh), options_(options) {
     const auto start = std::chrono::steady_clock::now();
+    PhaseClock clock;
     // Embree's TBB scheduler holds threads=N as a process-wide tbb::global_control of
     // min(N, cores) for the device's life, and TBB obeys the smallest such limit: any N would
     // cap every arena of ours at the cores, and `--threads 8` on 2 cores ran on 2. N is
@@ -55,6 +56,7 @@ class EmbreeAccelerator final : public Accelerator {
     if (device_ == nullptr) throw std::runtime_error("embree: could not create a device");
     rtcSetDeviceMemoryMonitorFunction(device_, &MemoryMonitor::callback, &monitor_);
 
+    clock.lap(build_.phases, "device");
     scene_ = rtcNewScene(device_);
     RTCSceneFlags flags = RTC_SCENE_FLAG_NONE;
     if (options.mode == EmbreeMode::compact) flags = RTC_SCENE_FLAG_COMPACT;
@@ -77,8 +79,10 @@ class EmbreeAccelerator final : public Accelerator {
     rtcCommitGeometry(geometry);
     rtcAttachGeometry(scene_, geometry);
     rtcReleaseGeometry(geometry);
+    clock.lap(build_.phases, "geometry");
     rtcCommitScene(scene_);
     raise_embree_error(device_, "building the scene");
+    clock.lap(build_.phases, "commit");
     build_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     build_.peak_bytes = static_cast<std::size_t>(monitor_.peak.load()) + mesh_bytes();
   }

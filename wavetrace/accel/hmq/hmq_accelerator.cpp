@@ -229,6 +229,8 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
   HmqAccelerator(const TriangleMesh& mesh, const HmqOptions& options) {
     const auto start = Clock::now();
     SnappedTree snapped = build_snapped_tree(mesh, options);
+    build_.phases = snapped.phases;
+    PhaseClock clock;
     grid_ = snapped.grid;
     const BuildTree& tree = snapped.tree;
     const QuantizedMesh& quantized = snapped.quantized;
@@ -281,6 +283,7 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
       top[slot].first = block;
       top[slot].count = BvhNode::kLeafFlag | static_cast<std::uint32_t>(roots.size());
     }
+    clock.lap(build_.phases, "blocks");
     top_ = StoredArray<BvhNode>(LargeArray<BvhNode>(top.begin(), top.end()));
     blocks.resize(blocks.size() + 8, std::byte{0});  // read slack for unaligned 8-byte stream loads
     parts.hierarchy += 8;

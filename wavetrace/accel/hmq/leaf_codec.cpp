@@ -3,6 +3,7 @@
 #include "wavetrace/accel/hmq/leaf_codec.hpp"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <stdexcept>
 
@@ -18,51 +19,59 @@ struct LeafStrip {
 
 // Greedy strips without swaps over at most 14 triangles: start at the triangle with the
 // fewest unused neighbours, leave it through its most constrained neighbour, go straight.
+// Neighbours are masks over the leaf's triangles, each edge's found once a leaf (asking the
+// mesh again for every candidate was a quarter of an hmq build); the lowest unused
+// neighbour is taken, as the scan over the leaf's triangles took it.
 std::vector<LeafStrip> strips_of_leaf(const TriangleMesh& mesh, std::span<const std::uint32_t> triangles) {
   const std::size_t count = triangles.size();
-  auto shares_edge = [&](std::uint32_t t, std::uint32_t a, std::uint32_t b) {
-    const glm::uvec3& c = mesh.triangles[t];
-    int found = 0;
-    for (int k = 0; k < 3; ++k) found += c[k] == a || c[k] == b;
-    return found == 2 && a != b;
-  };
-  std::vector<bool> used(count, false);
-  auto unused_across = [&](std::uint32_t a, std::uint32_t b, std::size_t except) -> std::size_t {
+  std::array<glm::uvec3, kMaxLeafTriangles> corners;
+  for (std::size_t i = 0; i < count; ++i) corners[i] = mesh.triangles[triangles[i]];
+  // The leaf's triangles sharing the edge (a, b): two of their corners are a or b.
+  const auto across = [&](std::uint32_t a, std::uint32_t b) {
+    std::uint32_t mask = 0;
+    if (a == b) return mask;
     for (std::size_t j = 0; j < count; ++j) {
-      if (!used[j] && j != except && shares_edge(triangles[j], a, b)) return j;
+      int found = 0;
+      for (int k = 0; k < 3; ++k) found += corners[j][k] == a || corners[j][k] == b;
+      if (found == 2) mask |= 1u << j;
     }
-    return count;
+    return mask;
   };
-  auto unused_degree = [&](std::size_t i) {
-    const glm::uvec3& c = mesh.triangles[triangles[i]];
+  std::array<std::array<std::uint32_t, 3>, kMaxLeafTriangles> edge_neighbours;  // triangle i itself left out
+  for (std::size_t i = 0; i < count; ++i) {
+    for (int e = 0; e < 3; ++e) edge_neighbours[i][e] = across(corners[i][e], corners[i][(e + 1) % 3]) & ~(1u << i);
+  }
+  std::uint32_t used = 0;
+  const auto lowest = [&](std::uint32_t mask) { return mask == 0 ? count : std::size_t(std::countr_zero(mask)); };
+  const auto unused_degree = [&](std::size_t i) {
     int degree = 0;
-    for (int e = 0; e < 3; ++e) degree += unused_across(c[e], c[(e + 1) % 3], i) != count;
+    for (int e = 0; e < 3; ++e) degree += (edge_neighbours[i][e] & ~used) != 0;
     return degree;
   };
   std::vector<LeafStrip> strips;
   for (std::size_t remaining = count; remaining > 0;) {
     std::size_t start = count;
     for (std::size_t i = 0; i < count; ++i) {
-      if (!used[i] && (start == count || unused_degree(i) < unused_degree(start))) start = i;
+      if ((used >> i & 1u) == 0 && (start == count || unused_degree(i) < unused_degree(start))) start = i;
     }
-    used[start] = true;
+    used |= 1u << start;
     --remaining;
-    const glm::uvec3& c = mesh.triangles[triangles[start]];
+    const glm::uvec3& c = corners[start];
     int edge = -1;
     std::size_t best = count;
     for (int e = 0; e < 3; ++e) {
-      const std::size_t next = unused_across(c[e], c[(e + 1) % 3], start);
+      const std::size_t next = lowest(edge_neighbours[start][e] & ~used);
       if (next != count && (best == count || unused_degree(next) < unused_degree(best))) best = next, edge = e;
     }
     if (edge < 0) edge = 0;
     LeafStrip strip{{c[(edge + 2) % 3], c[edge], c[(edge + 1) % 3]}, {triangles[start]}};
     while (remaining > 0) {
       const std::size_t size = strip.vertices.size();
-      const std::size_t next = unused_across(strip.vertices[size - 2], strip.vertices[size - 1], count);
+      const std::size_t next = lowest(across(strip.vertices[size - 2], strip.vertices[size - 1]) & ~used);
       if (next == count) break;
-      used[next] = true;
+      used |= 1u << next;
       --remaining;
-      const glm::uvec3& n = mesh.triangles[triangles[next]];
+      const glm::uvec3& n = corners[next];
       for (int k = 0; k < 3; ++k) {
         if (n[k] != strip.vertices[size - 2] && n[k] != strip.vertices[size - 1]) {
           strip.vertices.push_back(n[k]);

@@ -34,6 +34,7 @@ SnappedTree build_snapped_tree(const TriangleMesh& mesh, const HmqOptions& optio
   check_options(options);
   if (mesh.triangle_count() == 0) throw std::invalid_argument("hmq: the mesh has no triangles");
   SnappedTree snapped;
+  PhaseClock clock;
   const Bounds3 grid_box = options.grid_bounds.value_or(mesh.bounds());
   snapped.grid = options.epsilon > 0.0 ? grid_from_epsilon(grid_box, options.epsilon) : grid_from_bits(grid_box, options.bits);
   const GlobalGrid& grid = snapped.grid;
@@ -47,6 +48,7 @@ SnappedTree build_snapped_tree(const TriangleMesh& mesh, const HmqOptions& optio
     for (int k = 0; k < 3; ++k) box.extend(grid.point(quantized.lines[mesh.triangles[t][k]]));
     bounds[t] = box;
   });
+  clock.lap(snapped.phases, "snap");
   SahOptions sah;
   sah.max_leaf_size = options.leaf_size;
   sah.bins = options.bins;
@@ -56,6 +58,7 @@ SnappedTree build_snapped_tree(const TriangleMesh& mesh, const HmqOptions& optio
   // leaf sizes 4, 8, 12 on Lucy).
   sah.traversal_cost = 0.5f * float(options.leaf_size);
   snapped.tree = build_sah_tree(bounds, sah);
+  clock.lap(snapped.phases, "sah");
   snapped.peak_bytes = snapped.tree.peak_bytes + bounds.size() * sizeof(Bounds3);
   return snapped;
 }

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 
+#include "wavetrace/accel/build_phases.hpp"
 #include "wavetrace/accel/bvh/sah_builder.hpp"
 #include "wavetrace/accel/hmq/global_grid.hpp"
 #include "wavetrace/accel/hmq/hmq_options.hpp"
@@ -22,6 +23,7 @@ struct SnappedTree {
   QuantizedMesh quantized;
   BuildTree tree;
   std::size_t peak_bytes = 0;  // the tree build's working memory at its peak, bounds included
+  BuildPhases phases;          // "snap" (vertices and triangle boxes), "sah"
 };
 
 // Throws std::invalid_argument for options outside their ranges or an empty mesh.

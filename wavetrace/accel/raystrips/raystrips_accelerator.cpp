@@ -227,6 +227,7 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
     if (mesh.triangle_count() == 0) throw std::invalid_argument("raystrips: the mesh has no triangles");
     triangles_ = mesh.triangle_count();
     const auto start = Clock::now();
+    PhaseClock clock;
 
     // 1. SAH cut into sub-meshes.
     LargeArray<Bounds3> triangle_bounds(mesh.triangle_count());
@@ -235,6 +236,7 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
       for (int k = 0; k < 3; ++k) bounds.extend(mesh.positions[mesh.triangles[t][k]]);
       triangle_bounds[t] = bounds;
     });
+    clock.lap(build_.phases, "bounds");
     SahOptions sah;
     sah.max_leaf_size = 4;
     sah.bins = options.bins;
@@ -242,6 +244,7 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
     std::size_t peak = cut_tree.peak_bytes + triangle_bounds.size() * sizeof(Bounds3);
     triangle_bounds = {};
     const auto submeshes = cut_submeshes(cut_tree, options.submesh_triangles);
+    clock.lap(build_.phases, "sah");
     stats_.sah_seconds = seconds_since(start);
 
     // 2. Stripify each sub-mesh.
@@ -257,6 +260,7 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
       for (auto& strip : group) strips.push_back(std::move(strip));
     }
     per_submesh = {};
+    clock.lap(build_.phases, "stripify");
     stats_.stripify_seconds = seconds_since(stripify_start);
 
     // 3. The top BVH over the strips, and the strips in its leaf order.
@@ -298,6 +302,7 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
         if (top.nodes[built].leaf()) store_leaf(top.nodes[built], top.nodes[built].bounds);
       }
     }
+    clock.lap(build_.phases, "top");
     // Vertices renumbered by first use in storage order, so a strip's indices lie close together.
     std::vector<std::uint32_t> vertex_id(mesh.vertex_count(), kNoTriangle);
     std::uint32_t next_vertex = 0;
@@ -311,6 +316,7 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
       if (vertex_id[v] != kNoTriangle) positions[vertex_id[v]] = mesh.positions[v];
     }
 
+    clock.lap(build_.phases, "vertices");
     std::vector<StripEncoding> encodings(strips.size());
     std::vector<std::size_t> offset(strips.size() + 1, 0);
     for (std::size_t i = 0; i < strip_order.size(); ++i) {
@@ -349,6 +355,7 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
     }
     strip_bytes_ = StoredArray<std::byte>(std::move(strip_bytes));
     positions_ = StoredArray<glm::vec3>(std::move(positions));
+    clock.lap(build_.phases, "encode");
     stats_.encode_seconds = seconds_since(encode_start);
     collect_stats(strips, encodings, strip_order);
     build_.seconds = seconds_since(start);
