@@ -2,6 +2,9 @@
 // with a one-line error naming the problem.
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -62,6 +65,37 @@ TEST(Cli, RenderReportsResidentMemoryByPhaseFromTheOs) {
   EXPECT_GT(after_load, 0u);
   EXPECT_GT(after_build, after_load) << "the accelerator is resident after the build";
   EXPECT_GE(peak, std::max({after_load, after_build, after_render}));
+}
+
+// Where a build's time goes: each accelerator names its phases; a chunked build's own phases
+// are wall seconds within its build time, its chunks' ("chunk.*") add up every chunk.
+TEST(Cli, BuildStatsNameEachPhaseOfTheBuild) {
+  const std::string dir = temp_dir();
+  const std::map<std::string, std::vector<std::string>> phases = {
+      {"hmq:width=8", {"chunk.snap", "chunk.sah", "chunk.nodes", "chunk.leaves"}},
+      {"hmq", {"chunk.snap", "chunk.sah", "chunk.blocks"}},
+      {"bvh:width=8", {"chunk.face_set", "chunk.bounds", "chunk.sah", "chunk.collapse", "chunk.blocks"}},
+      {"raystrips:width=8", {"chunk.sah", "chunk.stripify", "chunk.top", "chunk.encode"}}};
+  for (const auto& [accel, chunk_phases] : phases) {
+    const auto result = run_wavetrace("build builtin:room:20k --accel " + accel + " --set build.chunk_triangles=4096 --out " +
+                                      dir + "/phases.wtw --stats " + dir + "/phases.json");
+    ASSERT_EQ(result.exit_code, 0) << result.output;
+    EXPECT_NE(result.output.find("build phases"), std::string::npos) << result.output;
+    std::ifstream file(dir + "/phases.json");
+    const nlohmann::json stats = nlohmann::json::parse(file);
+    const nlohmann::json& measured = stats.at("build_phases");
+    double own = 0.0;
+    for (const char* phase : {"plan", "extract", "chunks", "write", "release", "top"}) {
+      ASSERT_TRUE(measured.contains(phase)) << accel << " " << phase << " " << measured.dump();
+      own += measured[phase].get<double>();
+    }
+    EXPECT_LE(own, stats.at("build_seconds").get<double>()) << accel << " " << measured.dump();
+    for (const std::string& phase : chunk_phases) {
+      ASSERT_TRUE(measured.contains(phase)) << accel << " " << phase << " " << measured.dump();
+      EXPECT_GT(measured[phase].get<double>(), 0.0) << accel << " " << phase;
+    }
+    for (const auto& [phase, seconds] : measured.items()) EXPECT_GE(seconds.get<double>(), 0.0) << accel << " " << phase;
+  }
 }
 
 TEST(Cli, ExportedPlyRendersStreamedInChunksAsTheBuiltinDoes) {

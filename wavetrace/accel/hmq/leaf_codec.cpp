@@ -12,9 +12,38 @@ namespace {
 
 std::uint32_t bits_for(std::uint32_t largest) { return largest == 0 ? 0 : std::bit_width(largest); }
 
-struct LeafStrip {
-  std::vector<std::uint32_t> vertices;   // mesh vertex ids, length + 2
-  std::vector<std::uint32_t> triangles;  // mesh triangle ids
+// A leaf's short lists, on the stack: a leaf has at most 14 triangles and 42 strip slots, and
+// with vectors the encoder made a dozen heap allocations a leaf (an eighth of an hmq build).
+template <typename T, std::size_t kCapacity>
+class LeafList {
+ public:
+  void push_back(T value) { items_[size_++] = value; }
+  void clear() { size_ = 0; }
+  std::size_t size() const { return size_; }
+  bool empty() const { return size_ == 0; }
+  T& operator[](std::size_t i) { return items_[i]; }
+  const T& operator[](std::size_t i) const { return items_[i]; }
+  T* begin() { return items_.data(); }
+  T* end() { return items_.data() + size_; }
+  const T* begin() const { return items_.data(); }
+  const T* end() const { return items_.data() + size_; }
+  const T* data() const { return items_.data(); }
+  operator std::span<const T>() const { return {items_.data(), size_}; }
+
+ private:
+  std::array<T, kCapacity> items_;
+  std::size_t size_ = 0;
+};
+
+constexpr std::size_t kMaxLeafSlots = 3 * kMaxLeafTriangles;  // a strip of n triangles has n + 2 slots
+using TriangleList = LeafList<std::uint32_t, kMaxLeafTriangles>;
+using SlotList = LeafList<std::uint32_t, kMaxLeafSlots>;
+
+// The leaf's strips, longest first (ties in the order they were made), laid end to end.
+struct LeafStrips {
+  TriangleList lengths;   // triangles of each strip
+  SlotList slot_vertex;   // mesh vertex ids, length + 2 a strip
+  TriangleList triangles; // mesh triangle ids, strip after strip
 };
 
 // Greedy strips without swaps over at most 14 triangles: start at the triangle with the
@@ -22,7 +51,7 @@ struct LeafStrip {
 // Neighbours are masks over the leaf's triangles, each edge's found once a leaf (asking the
 // mesh again for every candidate was a quarter of an hmq build); the lowest unused
 // neighbour is taken, as the scan over the leaf's triangles took it.
-std::vector<LeafStrip> strips_of_leaf(const TriangleMesh& mesh, std::span<const std::uint32_t> triangles) {
+LeafStrips strips_of_leaf(const TriangleMesh& mesh, std::span<const std::uint32_t> triangles) {
   const std::size_t count = triangles.size();
   std::array<glm::uvec3, kMaxLeafTriangles> corners;
   for (std::size_t i = 0; i < count; ++i) corners[i] = mesh.triangles[triangles[i]];
@@ -48,7 +77,8 @@ std::vector<LeafStrip> strips_of_leaf(const TriangleMesh& mesh, std::span<const 
     for (int e = 0; e < 3; ++e) degree += (edge_neighbours[i][e] & ~used) != 0;
     return degree;
   };
-  std::vector<LeafStrip> strips;
+  LeafStrips made;  // in the order made
+  TriangleList first_slot, first_triangle;
   for (std::size_t remaining = count; remaining > 0;) {
     std::size_t start = count;
     for (std::size_t i = 0; i < count; ++i) {
@@ -64,26 +94,47 @@ std::vector<LeafStrip> strips_of_leaf(const TriangleMesh& mesh, std::span<const 
       if (next != count && (best == count || unused_degree(next) < unused_degree(best))) best = next, edge = e;
     }
     if (edge < 0) edge = 0;
-    LeafStrip strip{{c[(edge + 2) % 3], c[edge], c[(edge + 1) % 3]}, {triangles[start]}};
+    first_slot.push_back(static_cast<std::uint32_t>(made.slot_vertex.size()));
+    first_triangle.push_back(static_cast<std::uint32_t>(made.triangles.size()));
+    SlotList& slots = made.slot_vertex;
+    slots.push_back(c[(edge + 2) % 3]);
+    slots.push_back(c[edge]);
+    slots.push_back(c[(edge + 1) % 3]);
+    made.triangles.push_back(triangles[start]);
+    std::uint32_t length = 1;
     while (remaining > 0) {
-      const std::size_t size = strip.vertices.size();
-      const std::size_t next = lowest(across(strip.vertices[size - 2], strip.vertices[size - 1]) & ~used);
+      const std::size_t size = slots.size();
+      const std::size_t next = lowest(across(slots[size - 2], slots[size - 1]) & ~used);
       if (next == count) break;
       used |= 1u << next;
       --remaining;
       const glm::uvec3& n = corners[next];
       for (int k = 0; k < 3; ++k) {
-        if (n[k] != strip.vertices[size - 2] && n[k] != strip.vertices[size - 1]) {
-          strip.vertices.push_back(n[k]);
+        if (n[k] != slots[size - 2] && n[k] != slots[size - 1]) {
+          slots.push_back(n[k]);
           break;
         }
       }
-      strip.triangles.push_back(triangles[next]);
+      made.triangles.push_back(triangles[next]);
+      ++length;
     }
-    strips.push_back(std::move(strip));
+    made.lengths.push_back(length);
   }
-  std::stable_sort(strips.begin(), strips.end(),
-                   [](const LeafStrip& a, const LeafStrip& b) { return a.triangles.size() > b.triangles.size(); });
+  // Longest first, stably (an insertion sort: at most 14 strips).
+  TriangleList order;
+  for (std::uint32_t strip = 0; strip < made.lengths.size(); ++strip) {
+    std::size_t at = order.size();
+    order.push_back(strip);
+    for (; at > 0 && made.lengths[order[at - 1]] < made.lengths[strip]; --at) order[at] = order[at - 1];
+    order[at] = strip;
+  }
+  LeafStrips strips;
+  for (const std::uint32_t strip : order) {
+    const std::uint32_t length = made.lengths[strip];
+    strips.lengths.push_back(length);
+    for (std::uint32_t k = 0; k < length + 2; ++k) strips.slot_vertex.push_back(made.slot_vertex[first_slot[strip] + k]);
+    for (std::uint32_t k = 0; k < length; ++k) strips.triangles.push_back(made.triangles[first_triangle[strip] + k]);
+  }
   return strips;
 }
 
@@ -95,27 +146,23 @@ void encode_leaf(const QuantizedMesh& quantized, std::span<const std::uint32_t> 
     throw std::invalid_argument("hmq: a leaf holds 1 .. 14 triangles");
   }
   const TriangleMesh& mesh = *quantized.mesh;
-  const std::vector<LeafStrip> strips = strips_of_leaf(mesh, triangles);
-  std::vector<std::uint32_t> lengths, slot_vertex, leaf_triangles;
-  for (const LeafStrip& strip : strips) {
-    lengths.push_back(static_cast<std::uint32_t>(strip.triangles.size()));
-    slot_vertex.insert(slot_vertex.end(), strip.vertices.begin(), strip.vertices.end());
-    leaf_triangles.insert(leaf_triangles.end(), strip.triangles.begin(), strip.triangles.end());
-  }
+  const LeafStrips strips = strips_of_leaf(mesh, triangles);
+  const SlotList& slot_vertex = strips.slot_vertex;
+  const TriangleList& leaf_triangles = strips.triangles;
   const StripTable& table = StripTable::instance();
-  const std::uint32_t entry = table.find(lengths);
+  const std::uint32_t entry = table.find(strips.lengths);
   const StripLayoutEntry& layout = table.entry(entry);
 
   // Unique vertices in first-use order, for the indexed form.
-  std::vector<std::uint32_t> unique, slot_index;
+  SlotList unique, slot_index;
   for (const std::uint32_t vertex : slot_vertex) {
     const auto found = std::find(unique.begin(), unique.end(), vertex);
     slot_index.push_back(static_cast<std::uint32_t>(found - unique.begin()));
     if (found == unique.end()) unique.push_back(vertex);
   }
   // Offsets from the nearer plane of the leaf's grid box, per axis (the min-max trick).
-  auto offsets = [&](const std::vector<std::uint32_t>& vertices, int axis, std::uint32_t& bits) {
-    std::vector<std::uint32_t> values;
+  auto offsets = [&](const SlotList& vertices, int axis, std::uint32_t& bits, SlotList& values) {
+    values.clear();
     std::uint32_t largest = 0;
     for (const std::uint32_t vertex : vertices) {
       const int line = quantized.lines[vertex][axis];
@@ -127,14 +174,11 @@ void encode_leaf(const QuantizedMesh& quantized, std::span<const std::uint32_t> 
       values.push_back(offset << 1 | (upper ? 1u : 0u));
     }
     bits = bits_for(largest);
-    return values;
   };
   const std::uint32_t index_bits = bits_for(static_cast<std::uint32_t>(unique.size() - 1));
   std::uint32_t axis_bits[3];
-  std::vector<std::uint32_t> streams[3];
-  for (int axis = 0; axis < 3; ++axis) {
-    streams[axis] = offsets(unique, axis, axis_bits[axis]);
-  }
+  SlotList streams[3];
+  for (int axis = 0; axis < 3; ++axis) offsets(unique, axis, axis_bits[axis], streams[axis]);
   std::size_t indexed_bytes = stream_bytes(index_bits, layout.slots), strip_bytes = 0;
   for (int axis = 0; axis < 3; ++axis) {
     indexed_bytes += stream_bytes(axis_bits[axis] + 1, static_cast<std::uint32_t>(unique.size()));
@@ -142,12 +186,12 @@ void encode_leaf(const QuantizedMesh& quantized, std::span<const std::uint32_t> 
   }
   const bool indexed = indexed_bytes < strip_bytes;
   if (!indexed) {
-    for (int axis = 0; axis < 3; ++axis) streams[axis] = offsets(slot_vertex, axis, axis_bits[axis]);
+    for (int axis = 0; axis < 3; ++axis) offsets(slot_vertex, axis, axis_bits[axis], streams[axis]);
   }
   const std::uint32_t vertex_count = indexed ? static_cast<std::uint32_t>(unique.size()) : layout.slots;
 
   std::uint32_t id_base = *std::min_element(leaf_triangles.begin(), leaf_triangles.end());
-  std::vector<std::uint32_t> id_delta, corners;
+  TriangleList id_delta, corners;
   std::uint32_t largest_delta = 0;
   for (std::uint32_t k = 0; k < leaf_triangles.size(); ++k) {
     const std::uint32_t triangle = leaf_triangles[k];
