@@ -3,7 +3,9 @@
 #include "wavetrace/scene/shape_generator.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -35,6 +37,48 @@ void fill_materials(const ShapeGenerator& shape, std::size_t first, TriangleMesh
                     [&](std::size_t t) { mesh.material_of_triangle[t] = shape.material(first + t); });
 }
 
+// A dense shape's range: its keys lie in [0, vertex_count), so a table over the keys' span
+// marks the used ones and numbers them in key order by a prefix sum, as sorting the keys,
+// dropping repeats and searching each corner did (a third of a room's chunked build). Only
+// where the span is at most kDenseSpanPerKey times the keys (a table of 16 bytes a key or
+// less); false, and nothing done, where it is not (a chunk of a shape far larger than it:
+// an icosphere's corner and edge vertices are numbered before every face's).
+constexpr std::size_t kDenseSpanPerKey = 4;
+
+bool renumber_dense_keys(const ShapeGenerator& shape, const LargeArray<std::uint64_t>& keys, const glm::vec3& offset,
+                         TriangleMesh& mesh) {
+  const auto [lowest, highest] = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, keys.size(), 1 << 14),
+      std::pair(std::numeric_limits<std::uint64_t>::max(), std::uint64_t{0}),
+      [&](const tbb::blocked_range<std::size_t>& range, std::pair<std::uint64_t, std::uint64_t> span) {
+        for (std::size_t k = range.begin(); k != range.end(); ++k) {
+          span.first = std::min(span.first, keys[k]);
+          span.second = std::max(span.second, keys[k]);
+        }
+        return span;
+      },
+      [](auto a, const auto& b) { return std::pair(std::min(a.first, b.first), std::max(a.second, b.second)); });
+  const std::size_t span = highest - lowest + 1;  // at most the shape's vertex count
+  if (span > kDenseSpanPerKey * keys.size()) return false;
+  LargeArray<std::uint32_t> number(span, 0);
+  tbb::parallel_for(std::size_t{0}, keys.size(), [&](std::size_t k) {
+    std::atomic_ref<std::uint32_t>(number[keys[k] - lowest]).store(1, std::memory_order_relaxed);
+  });
+  std::uint32_t used = 0;
+  for (std::uint32_t& slot : number) {  // marked slots become their vertex's number, plus one
+    if (slot != 0) slot = ++used;
+  }
+  mesh.positions.resize(used);
+  tbb::parallel_for(std::size_t{0}, span, [&](std::size_t k) {
+    if (number[k] != 0) mesh.positions[number[k] - 1] = shape.position(lowest + k) + offset;
+  });
+  tbb::parallel_for(std::size_t{0}, mesh.triangles.size(), [&](std::size_t t) {
+    mesh.triangles[t] = glm::uvec3(number[keys[3 * t] - lowest] - 1, number[keys[3 * t + 1] - lowest] - 1,
+                                   number[keys[3 * t + 2] - lowest] - 1);
+  });
+  return true;
+}
+
 }  // namespace
 
 TriangleMesh generate_range(const ShapeGenerator& shape, std::size_t first, std::size_t count, const glm::vec3& offset) {
@@ -64,6 +108,10 @@ TriangleMesh generate_range(const ShapeGenerator& shape, std::size_t first, std:
   }
   LargeArray<std::uint64_t> keys(3 * count);
   for_each_block(first, count, [&](std::size_t begin, std::size_t size) { shape.corners(begin, size, keys.data() + 3 * (begin - first)); });
+  if (shape.vertex_count() > 0 && renumber_dense_keys(shape, keys, offset, mesh)) {
+    fill_materials(shape, first, mesh);
+    return mesh;
+  }
   LargeArray<std::uint64_t> vertices(keys.size());
   std::copy(keys.begin(), keys.end(), vertices.begin());
   tbb::parallel_sort(vertices.begin(), vertices.end());

@@ -176,8 +176,8 @@ class Builder {
     for (std::uint32_t i = begin; i != end; ++i) {
       const PrimitiveReference& reference = references_[i];
       const __m128 box_lower = reference.lower4(), box_upper = reference.upper4();
-      alignas(16) std::int32_t bin[4];
-      _mm_store_si128(reinterpret_cast<__m128i*>(bin), bins_of(centroid4(box_lower, box_upper), lower, scales, last_bin));
+      const __m128i bins = bins_of(centroid4(box_lower, box_upper), lower, scales, last_bin);
+      const int bin[3] = {_mm_cvtsi128_si32(bins), _mm_extract_epi32(bins, 1), _mm_extract_epi32(bins, 2)};
       for (int axis = 0; axis < 3; ++axis) {
         binning.boxes[axis][bin[axis]].extend(box_lower, box_upper);
         ++binning.counts[axis][bin[axis]];
