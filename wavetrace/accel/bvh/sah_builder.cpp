@@ -206,37 +206,71 @@ class Builder {
         });
   }
 
-  // The cheapest plane over all axes; only areas and counts are kept during the sweep
-  // (no per-bin boxes to initialize), the chosen split's two boxes are merged afterwards.
+  // The cheapest plane over all axes. The three axes' sweeps run side by side, an axis a lane
+  // (most nodes are small, and this sweep, done one axis and one float at a time, was a
+  // quarter of a build); each lane computes what the scalar sweep did, operation for
+  // operation, so the same plane wins: the first cheapest in axis, then bin, order.
   Split best_split(const Binning& binning, const Bounds3& centroids) const {
-    Split best;
     const std::uint32_t bins = options_.bins;
-    float right_area[kMaxBins];
-    std::uint32_t right_count[kMaxBins];
+    struct Lanes {  // a box per axis: lane a holds the box of axis a's bin
+      __m128 lx, ly, lz, ux, uy, uz;
+      void extend(const Lanes& o) {
+        lx = _mm_min_ps(o.lx, lx), ly = _mm_min_ps(o.ly, ly), lz = _mm_min_ps(o.lz, lz);
+        ux = _mm_max_ps(o.ux, ux), uy = _mm_max_ps(o.uy, uy), uz = _mm_max_ps(o.uz, uz);
+      }
+      __m128 half_area() const {  // as half_area(): 0 for an empty box
+        const __m128 ex = _mm_sub_ps(ux, lx), ey = _mm_sub_ps(uy, ly), ez = _mm_sub_ps(uz, lz);
+        const __m128 area = _mm_add_ps(_mm_add_ps(_mm_mul_ps(ex, ey), _mm_mul_ps(ey, ez)), _mm_mul_ps(ez, ex));
+        return _mm_andnot_ps(_mm_cmpgt_ps(lx, ux), area);
+      }
+    };
+    Lanes lanes[kMaxBins];  // transposed once for both sweeps
+    for (std::uint32_t i = 0; i < bins; ++i) {
+      __m128 l0 = binning.boxes[0][i].lower, l1 = binning.boxes[1][i].lower, l2 = binning.boxes[2][i].lower;
+      __m128 u0 = binning.boxes[0][i].upper, u1 = binning.boxes[1][i].upper, u2 = binning.boxes[2][i].upper;
+      __m128 l3 = _mm_setzero_ps(), u3 = _mm_setzero_ps();
+      _MM_TRANSPOSE4_PS(l0, l1, l2, l3);
+      _MM_TRANSPOSE4_PS(u0, u1, u2, u3);
+      lanes[i] = Lanes{l0, l1, l2, u0, u1, u2};
+    }
+    const auto bin_counts = [&](std::uint32_t i) {
+      return _mm_setr_epi32(static_cast<int>(binning.counts[0][i]), static_cast<int>(binning.counts[1][i]),
+                            static_cast<int>(binning.counts[2][i]), 0);
+    };
+    const __m128 infinity = _mm_set1_ps(std::numeric_limits<float>::infinity());
+    const __m128 minus_infinity = _mm_set1_ps(-std::numeric_limits<float>::infinity());
+    const Lanes empty{infinity, infinity, infinity, minus_infinity, minus_infinity, minus_infinity};
+    __m128 right_area[kMaxBins];
+    __m128i right_count[kMaxBins];
+    Lanes accumulated = empty;
+    __m128i count = _mm_setzero_si128();
+    for (std::uint32_t i = bins - 1; i > 0; --i) {
+      accumulated.extend(lanes[i]);
+      count = _mm_add_epi32(count, bin_counts(i));
+      right_area[i - 1] = accumulated.half_area();
+      right_count[i - 1] = count;
+    }
+    alignas(16) float cost[kMaxBins][4];
+    alignas(16) std::uint32_t left_count[kMaxBins][4], right_counts[kMaxBins][4];
+    accumulated = empty;
+    count = _mm_setzero_si128();
+    for (std::uint32_t i = 0; i + 1 < bins; ++i) {
+      accumulated.extend(lanes[i]);
+      count = _mm_add_epi32(count, bin_counts(i));
+      _mm_store_ps(cost[i], _mm_add_ps(_mm_mul_ps(accumulated.half_area(), blocks(count)),
+                                       _mm_mul_ps(right_area[i], blocks(right_count[i]))));
+      _mm_store_si128(reinterpret_cast<__m128i*>(left_count[i]), count);
+      _mm_store_si128(reinterpret_cast<__m128i*>(right_counts[i]), right_count[i]);
+    }
+    Split best;
     for (int axis = 0; axis < 3; ++axis) {
       if (!(centroids.upper[axis] > centroids.lower[axis])) continue;
-      std::array<Bounds3, kMaxBins> row;
-      for (std::uint32_t i = 0; i < bins; ++i) row[i] = binning.boxes[axis][i].bounds();
-      const auto& counts = binning.counts[axis];
-      Bounds3 accumulated;
-      std::uint32_t count = 0;
-      for (std::uint32_t i = bins - 1; i > 0; --i) {
-        accumulated.extend(row[i]);
-        count += counts[i];
-        right_area[i - 1] = half_area(accumulated);
-        right_count[i - 1] = count;
-      }
-      accumulated = Bounds3{};
-      count = 0;
       for (std::uint32_t i = 0; i + 1 < bins; ++i) {
-        accumulated.extend(row[i]);
-        count += counts[i];
-        if (count == 0 || right_count[i] == 0) continue;
-        const float cost = half_area(accumulated) * blocks(count) + right_area[i] * blocks(right_count[i]);
-        if (cost < best.cost) {
+        if (left_count[i][axis] == 0 || right_counts[i][axis] == 0) continue;
+        if (cost[i][axis] < best.cost) {
           best.axis = axis;
           best.bin = i;
-          best.cost = cost;
+          best.cost = cost[i][axis];
         }
       }
     }
@@ -245,6 +279,17 @@ class Builder {
       for (std::uint32_t i = 0; i < bins; ++i) (i <= best.bin ? best.left_bounds : best.right_bounds).extend(row[i].bounds());
     }
     return best;
+  }
+
+  // blocks() of each lane's count (counts stay below 2^31: twice them fits 32 bits).
+  __m128 blocks(__m128i count) const {
+    if (block_shift_ >= 0) {
+      const __m128i rounded = _mm_add_epi32(count, _mm_set1_epi32(static_cast<int>(options_.block_size - 1)));
+      return _mm_cvtepi32_ps(_mm_srl_epi32(rounded, _mm_cvtsi32_si128(block_shift_)));
+    }
+    alignas(16) std::uint32_t lanes[4];
+    _mm_store_si128(reinterpret_cast<__m128i*>(lanes), count);
+    return _mm_setr_ps(blocks(lanes[0]), blocks(lanes[1]), blocks(lanes[2]), blocks(lanes[3]));
   }
 
   // The SAH sweep asks this for every bin: a shift where the block size is a power of two.
