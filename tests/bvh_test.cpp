@@ -1,6 +1,7 @@
 // The BVH baseline: builder invariants, agreement with Embree on the same rays, any-hit
 // against closest-hit, identical hits for every layout, and no leaks.
 #include <algorithm>
+#include <functional>
 #include <limits>
 
 #include <gtest/gtest.h>
@@ -59,6 +60,51 @@ TEST(SahBuilder, EveryPrimitiveOnceLeavesSmallBoundsNested) {
     EXPECT_EQ(tree.nodes.size(), 2 * leaves - 1);
     EXPECT_LE(tree.depth(), kMaxTreeDepth);
   }
+}
+
+// cut_size stops the tree at ranges of that size: the same splits above them as a full build
+// (so Ray-Strips cuts the same sub-meshes), every range of at most cut_size a leaf.
+TEST(SahBuilder, CutSizeStopsAtTheRangesAFullBuildWouldCutThere) {
+  const Scene scene = make_builtin_scene("builtin:sphere:20k");
+  const std::vector<Bounds3> bounds = triangle_bounds(scene.mesh);
+  constexpr std::uint32_t kCut = 256;
+  SahOptions full;
+  const BuildTree whole = build_sah_tree(bounds, full);
+  SahOptions stopped = full;
+  stopped.cut_size = kCut;
+  const BuildTree cut = build_sah_tree(bounds, stopped);
+  // The ranges at the first node of at most kCut primitives, as sets, on each tree.
+  const auto pieces = [](const BuildTree& tree) {
+    std::vector<std::vector<std::uint32_t>> found;
+    std::function<std::vector<std::uint32_t>(std::uint32_t)> members = [&](std::uint32_t node) {
+      const BuildNode& n = tree.nodes[node];
+      if (n.leaf()) return std::vector<std::uint32_t>(tree.primitive_order.begin() + n.first,
+                                                      tree.primitive_order.begin() + n.first + n.count);
+      std::vector<std::uint32_t> all = members(n.left);
+      const std::vector<std::uint32_t> right = members(n.right);
+      all.insert(all.end(), right.begin(), right.end());
+      return all;
+    };
+    std::function<void(std::uint32_t)> visit = [&](std::uint32_t node) {
+      std::vector<std::uint32_t> all = members(node);
+      if (all.size() <= kCut || tree.nodes[node].leaf()) {
+        std::sort(all.begin(), all.end());
+        found.push_back(all);
+        return;
+      }
+      visit(tree.nodes[node].left);
+      visit(tree.nodes[node].right);
+    };
+    visit(0);
+    return found;
+  };
+  const auto expected = pieces(whole);
+  EXPECT_EQ(pieces(cut), expected);
+  EXPECT_GT(expected.size(), 20u);
+  for (const BuildNode& node : cut.nodes) {
+    if (node.leaf()) EXPECT_LE(node.count, kCut);
+  }
+  EXPECT_LT(cut.nodes.size(), whole.nodes.size() / 10);
 }
 
 TEST(SahBuilder, CoincidentCentroidsStillSplitAndBadOptionsAreErrors) {

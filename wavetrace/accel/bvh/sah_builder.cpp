@@ -346,7 +346,7 @@ class Builder {
 
   void build_node(std::uint32_t node, std::uint32_t first, std::uint32_t count, const Bounds3& bounds,
                   const Bounds3& centroids, std::uint32_t depth) {
-    if (count == 1) return make_leaf(node, first, count, bounds);
+    if (count == 1 || count <= options_.cut_size) return make_leaf(node, first, count, bounds);
     glm::vec3 scale;
     for (int axis = 0; axis < 3; ++axis) {
       const float extent = centroids.upper[axis] - centroids.lower[axis];

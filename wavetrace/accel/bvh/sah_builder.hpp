@@ -24,6 +24,10 @@ struct SahOptions {
   // tests, as Embree's builders do for their triangle4 leaves, so a leaf of three costs what
   // one of four does and the SAH fills blocks instead of making leaves of one or two.
   std::uint32_t block_size = 1;
+  // > 0: a range of at most this many primitives is made a leaf without being split, whatever
+  // max_leaf_size says: for a caller that only cuts the tree into pieces of this size (the
+  // sub-meshes of Ray-Strips), the levels below them were half its build.
+  std::uint32_t cut_size = 0;
 };
 
 // A node of the built tree. Inner nodes have two children; leaves own the primitive

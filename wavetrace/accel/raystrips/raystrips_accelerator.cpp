@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <limits>
 #include <numeric>
 #include <stdexcept>
 #include <type_traits>
@@ -29,6 +30,7 @@
 #include "wavetrace/accel/raystrips/strip_encode.hpp"
 #include "wavetrace/accel/raystrips/strip_packet.hpp"
 #include "wavetrace/accel/raystrips/strip_traversal.hpp"
+#include "wavetrace/kernels/morton.hpp"
 #include "wavetrace/kernels/checked_narrowing.hpp"
 #include "wavetrace/memory/cache_aligned_allocator.hpp"
 #include "wavetrace/kernels/nearest_hit.hpp"
@@ -240,10 +242,29 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
     SahOptions sah;
     sah.max_leaf_size = 4;
     sah.bins = options.bins;
-    const BuildTree cut_tree = build_sah_tree(triangle_bounds, sah);
+    sah.cut_size = options.submesh_triangles;
+    BuildTree cut_tree = build_sah_tree(triangle_bounds, sah);
+    sah.cut_size = 0;
     std::size_t peak = cut_tree.peak_bytes + triangle_bounds.size() * sizeof(Bounds3);
-    triangle_bounds = {};
     const auto submeshes = cut_submeshes(cut_tree, options.submesh_triangles);
+    // The tree stops at the sub-meshes: each one's triangles go in Morton order of their
+    // centroids in its box, the spatial order the SAH's levels below gave them (the stripifier
+    // starts its strips in triangle order, and strips came out 4% shorter in build order).
+    tbb::parallel_for(std::size_t{0}, submeshes.size(), [&](std::size_t s) {
+      const auto [first, count] = submeshes[s];
+      std::uint32_t* order = cut_tree.primitive_order.data() + first;
+      Bounds3 box;
+      for (std::uint32_t k = 0; k < count; ++k) box.extend(triangle_bounds[order[k]].center());
+      const glm::vec3 extent = glm::max(box.extent(), glm::vec3(std::numeric_limits<float>::min()));
+      std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(count);
+      for (std::uint32_t k = 0; k < count; ++k) {
+        const glm::vec3 cell = (triangle_bounds[order[k]].center() - box.lower) / extent * 1023.0f;
+        keyed[k] = {morton3d_encode(std::uint64_t(cell.x), std::uint64_t(cell.y), std::uint64_t(cell.z)), order[k]};
+      }
+      std::sort(keyed.begin(), keyed.end());
+      for (std::uint32_t k = 0; k < count; ++k) order[k] = keyed[k].second;
+    });
+    triangle_bounds = {};
     clock.lap(build_.phases, "sah");
     stats_.sah_seconds = seconds_since(start);
 
