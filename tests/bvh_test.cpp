@@ -122,7 +122,8 @@ TEST(SahBuilder, CoincidentCentroidsStillSplitAndBadOptionsAreErrors) {
   SahOptions bad;
   bad.max_leaf_size = 17;
   EXPECT_THROW(build_sah_tree(same, bad), std::invalid_argument);
-  EXPECT_THROW(build_sah_tree({}, SahOptions{}), std::invalid_argument);
+  EXPECT_THROW(build_sah_tree(std::span<const Bounds3>{}, SahOptions{}), std::invalid_argument);
+  EXPECT_THROW(build_sah_tree(LargeArray<SahReference>{}, SahOptions{}), std::invalid_argument);
 }
 
 struct Agreement {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <span>
+#include <utility>
 
 #include "wavetrace/accel/accelerator.hpp"
 #include "wavetrace/accel/bvh/bvh_options.hpp"
@@ -18,19 +19,18 @@
 
 namespace wavetrace {
 
-// The SAH tree over the face set's triangles; its peak_bytes include the bounds array. Adds
+// The SAH tree over the face set's triangles; its peak_bytes include the references. Adds
 // the phases "bounds" and "sah".
 inline BuildTree build_bvh_tree(const IndexedFaceSet& geometry, const BvhOptions& options, BuildPhases& phases) {
   PhaseClock clock;
-  const LargeArray<Bounds3> bounds = geometry.triangle_bounds();
+  LargeArray<SahReference> references = geometry.triangle_references();
   clock.lap(phases, "bounds");
   SahOptions sah;
   sah.max_leaf_size = options.max_leaf_size;
   sah.bins = options.bins;
   // The 8-wide tree's leaves are blocks of four (triangle_block.hpp).
   sah.block_size = options.width == 8 ? TriangleBlock::kLanes : 1;
-  BuildTree tree = build_sah_tree(bounds, sah);
-  tree.peak_bytes += bounds.size() * sizeof(Bounds3);
+  BuildTree tree = build_sah_tree(std::move(references), sah);
   clock.lap(phases, "sah");
   return tree;
 }

@@ -109,17 +109,17 @@ IndexedFaceSet::IndexedFaceSet(SectionLoader& in) {
   if (bad != end) in.fail("faces.triangles", "names a vertex that does not exist");
 }
 
-LargeArray<Bounds3> IndexedFaceSet::triangle_bounds() const {
-  LargeArray<Bounds3> bounds(triangle_count_);
+LargeArray<SahReference> IndexedFaceSet::triangle_references() const {
+  LargeArray<SahReference> references(triangle_count_);
   tbb::parallel_for(std::size_t{0}, triangle_count_, [&](std::size_t t) {
     const glm::uvec3& tri = triangles_[t];
     Bounds3 b;
     b.extend(positions_[tri.x]);
     b.extend(positions_[tri.y]);
     b.extend(positions_[tri.z]);
-    bounds[t] = b;
+    references[t] = {b, static_cast<std::uint32_t>(t), 0};
   });
-  return bounds;
+  return references;
 }
 
 std::vector<std::span<const std::byte>> IndexedFaceSet::spans() const {

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "wavetrace/accel/bvh/sah_builder.hpp"
 #include "wavetrace/memory/cache_aligned_allocator.hpp"
 #include "wavetrace/memory/stored_array.hpp"
 #include "wavetrace/scene/triangle_mesh.hpp"
@@ -51,7 +52,8 @@ class IndexedFaceSet {
     return input_id_.empty() ? nullptr : input_id_.data() + slot;
   }
 
-  LargeArray<Bounds3> triangle_bounds() const;  // parallel
+  // The SAH builder's references: slot t's box and id t (parallel).
+  LargeArray<SahReference> triangle_references() const;
   std::size_t geometry_bytes() const { return vertex_count_ * sizeof(glm::vec3) + triangle_count_ * sizeof(glm::uvec3); }
   std::size_t id_map_bytes() const { return input_id_.size() * sizeof(std::uint32_t); }
   std::size_t build_scratch_bytes() const { return build_scratch_bytes_; }

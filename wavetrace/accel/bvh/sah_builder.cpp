@@ -14,6 +14,7 @@
 #include <limits>
 #include <memory>
 #include <new>
+#include <utility>
 
 #include <immintrin.h>
 #include <stdexcept>
@@ -88,19 +89,14 @@ struct Split {
   Bounds3 left_bounds, right_bounds;
 };
 
-// A primitive as the builder moves it: its box and its id, 32 bytes, partitioned in
-// place so that binning streams through memory instead of gathering through an index.
-struct PrimitiveReference {
-  Bounds3 bounds;
-  std::uint32_t id;
-  std::uint32_t unused;
-  glm::vec3 centroid() const { return (bounds.lower + bounds.upper) * 0.5f; }
-  // The box's corners as SSE registers: 16-byte loads at bytes 0 and 12 (lane 3 is upper.x
-  // and the id, never read); the centroid as centroid() computes it, lane by lane.
-  __m128 lower4() const { return _mm_loadu_ps(&bounds.lower.x); }
-  __m128 upper4() const { return _mm_loadu_ps(&bounds.upper.x); }
-};
-static_assert(sizeof(PrimitiveReference) == 32 && offsetof(PrimitiveReference, bounds) == 0);
+// The builder's references as SSE registers: 16-byte loads at bytes 0 and 12 of the box
+// (lane 3 is upper.x and the id, never read); the centroid as (lower + upper) * 0.5, lane
+// by lane.
+inline __m128 lower4(const SahReference& reference) { return _mm_loadu_ps(&reference.bounds.lower.x); }
+inline __m128 upper4(const SahReference& reference) { return _mm_loadu_ps(&reference.bounds.upper.x); }
+inline glm::vec3 centroid_of(const SahReference& reference) {
+  return (reference.bounds.lower + reference.bounds.upper) * 0.5f;
+}
 
 inline __m128 centroid4(__m128 lower, __m128 upper) { return _mm_mul_ps(_mm_add_ps(lower, upper), _mm_set1_ps(0.5f)); }
 
@@ -115,14 +111,9 @@ inline __m128 load3(const glm::vec3& v) { return _mm_setr_ps(v.x, v.y, v.z, 0.0f
 
 class Builder {
  public:
-  Builder(std::span<const Bounds3> primitive_bounds, const SahOptions& options, BuildTree& tree)
-      : options_(options), tree_(tree), references_(primitive_bounds.size()) {
-    const std::size_t count = primitive_bounds.size();
-    // Node and primitive ids are 32-bit, and a tree of n leaves has 2n - 1 nodes.
-    checked_uint32(2 * std::uint64_t(count), "SAH build: twice the primitive count; build in chunks (build.chunk_triangles)");
-    tbb::parallel_for(std::size_t{0}, count, [&](std::size_t i) {
-      references_[i] = {primitive_bounds[i], static_cast<std::uint32_t>(i), 0};
-    });
+  Builder(LargeArray<SahReference> references, const SahOptions& options, BuildTree& tree)
+      : options_(options), tree_(tree), references_(std::move(references)) {
+    const std::size_t count = references_.size();
     slots_.reset(static_cast<BuildNode*>(allocate_large_array((2 * count - 1) * sizeof(BuildNode))));
   }
 
@@ -134,7 +125,7 @@ class Builder {
     const std::uint32_t used = next_node_.load();
     tree_.nodes.assign(slots_.get(), slots_.get() + used);
     slots_.reset();
-    tree_.peak_bytes = references_.size() * sizeof(PrimitiveReference) + count * sizeof(std::uint32_t) +
+    tree_.peak_bytes = references_.size() * sizeof(SahReference) + count * sizeof(std::uint32_t) +
                        2 * std::size_t{used} * sizeof(BuildNode);
     tree_.primitive_order.resize(count);
     tbb::parallel_for(std::uint32_t{0}, count, [&](std::uint32_t i) { tree_.primitive_order[i] = references_[i].id; });
@@ -156,7 +147,7 @@ class Builder {
 
   Bounds3 centroid_bounds(std::uint32_t first, std::uint32_t count) const {
     const auto reduce = [&](std::uint32_t begin, std::uint32_t end, Bounds3 b) {
-      for (std::uint32_t i = begin; i != end; ++i) b.extend(references_[i].centroid());
+      for (std::uint32_t i = begin; i != end; ++i) b.extend(centroid_of(references_[i]));
       return b;
     };
     if (count < kParallelBinningThreshold) return reduce(first, first + count, Bounds3{});
@@ -174,8 +165,8 @@ class Builder {
     const __m128 lower = load3(centroids.lower), scales = load3(scale);
     const __m128i last_bin = _mm_set1_epi32(static_cast<int>(options_.bins - 1));
     for (std::uint32_t i = begin; i != end; ++i) {
-      const PrimitiveReference& reference = references_[i];
-      const __m128 box_lower = reference.lower4(), box_upper = reference.upper4();
+      const SahReference& reference = references_[i];
+      const __m128 box_lower = lower4(reference), box_upper = upper4(reference);
       const __m128i bins = bins_of(centroid4(box_lower, box_upper), lower, scales, last_bin);
       const int bin[3] = {_mm_cvtsi128_si32(bins), _mm_extract_epi32(bins, 1), _mm_extract_epi32(bins, 2)};
       for (int axis = 0; axis < 3; ++axis) {
@@ -312,16 +303,16 @@ class Builder {
     const __m128i last_bin = _mm_set1_epi32(static_cast<int>(options_.bins - 1));
     BinBox left = empty_bin_box(), right = empty_bin_box();
     // Tests a reference, and adds its centroid to the side it goes to.
-    const auto goes_left = [&](const PrimitiveReference& reference) {
-      const __m128 c = centroid4(reference.lower4(), reference.upper4());
+    const auto goes_left = [&](const SahReference& reference) {
+      const __m128 c = centroid4(lower4(reference), upper4(reference));
       alignas(16) std::int32_t bin[4];
       _mm_store_si128(reinterpret_cast<__m128i*>(bin), bins_of(c, lower, scales, last_bin));
       const bool is_left = std::uint32_t(bin[axis]) <= split_bin;
       (is_left ? left : right).extend(c, c);
       return is_left;
     };
-    PrimitiveReference* begin = references_.data() + first;
-    PrimitiveReference* end = begin + count;
+    SahReference* begin = references_.data() + first;
+    SahReference* end = begin + count;
     const auto finish = [&] {
       left_centroids = left.bounds();
       right_centroids = right.bounds();
@@ -397,7 +388,7 @@ class Builder {
   SahOptions options_;
   int block_shift_ = std::has_single_bit(options_.block_size) ? std::countr_zero(options_.block_size) : -1;
   BuildTree& tree_;
-  LargeArray<PrimitiveReference> references_;
+  LargeArray<SahReference> references_;
   // Slots for the worst case, 2n - 1 nodes, as raw memory: a tree takes about one node per two
   // primitives or fewer, and the pages no node is written to are never touched (a first touch
   // of a page costs a VM dearly: it was a third of a build's time). The nodes made are copied
@@ -421,6 +412,20 @@ std::uint32_t BuildTree::depth() const { return nodes.empty() ? 0 : subtree_dept
 
 BuildTree build_sah_tree(std::span<const Bounds3> primitive_bounds, const SahOptions& options) {
   if (primitive_bounds.empty()) throw std::invalid_argument("SAH builder: no primitives");
+  checked_uint32(2 * std::uint64_t(primitive_bounds.size()),
+                 "SAH build: twice the primitive count; build in chunks (build.chunk_triangles)");
+  LargeArray<SahReference> references(primitive_bounds.size());
+  tbb::parallel_for(std::size_t{0}, primitive_bounds.size(), [&](std::size_t i) {
+    references[i] = {primitive_bounds[i], static_cast<std::uint32_t>(i), 0};
+  });
+  return build_sah_tree(std::move(references), options);
+}
+
+BuildTree build_sah_tree(LargeArray<SahReference> references, const SahOptions& options) {
+  if (references.empty()) throw std::invalid_argument("SAH builder: no primitives");
+  // Node and primitive ids are 32-bit, and a tree of n leaves has 2n - 1 nodes.
+  checked_uint32(2 * std::uint64_t(references.size()),
+                 "SAH build: twice the primitive count; build in chunks (build.chunk_triangles)");
   if (options.block_size < 1) throw std::invalid_argument("SAH builder: block size 0");
   if (options.max_leaf_size < 1 || options.max_leaf_size > 16) {
     throw std::invalid_argument(fmt::format("SAH builder: max leaf size {} is outside 1..16", options.max_leaf_size));
@@ -429,7 +434,7 @@ BuildTree build_sah_tree(std::span<const Bounds3> primitive_bounds, const SahOpt
     throw std::invalid_argument(fmt::format("SAH builder: {} bins is outside 2..{}", options.bins, kMaxBins));
   }
   BuildTree tree;
-  Builder builder(primitive_bounds, options, tree);
+  Builder builder(std::move(references), options, tree);
   builder.build();
   return tree;
 }

@@ -46,7 +46,24 @@ struct BuildTree {
   std::uint32_t depth() const;                 // levels from the root to the deepest leaf, root = 1
 };
 
+// A primitive as the builder moves it: its box and its id, 32 bytes, partitioned in place so
+// that binning streams through memory instead of gathering through an index.
+//   offset  size  field
+//        0    24  box: float lower x, y, z, upper x, y, z
+//       24     4  id: the primitive's index in the input, uint32
+//       28     4  unused (zero)
+struct SahReference {
+  Bounds3 bounds;
+  std::uint32_t id;
+  std::uint32_t unused;
+};
+static_assert(sizeof(SahReference) == 32);
+
 // Throws std::invalid_argument for an empty input or max_leaf_size outside 1..16.
 BuildTree build_sah_tree(std::span<const Bounds3> primitive_bounds, const SahOptions& options);
+// The same build over references the caller filled (reference i: primitive i's box, id i):
+// no array of boxes is held beside the builder's own (24 bytes a primitive less, and pages a
+// build need not touch).
+BuildTree build_sah_tree(LargeArray<SahReference> references, const SahOptions& options);
 
 }  // namespace wavetrace
