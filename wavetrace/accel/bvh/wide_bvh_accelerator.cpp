@@ -249,7 +249,14 @@ class WideBvhAccelerator final : public ProbedAccelerator<WideBvhAccelerator> {
   // Copies each leaf's triangles into blocks, leaves in node order, and points the leaf lanes
   // at them. `leaf_index` maps leaf slots to face-set slots (empty: the same).
   LargeArray<TriangleBlock> block_leaves(const LargeArray<std::uint32_t>& leaf_index) {
+    // Counted first: grown by doubling, the blocks (most of a bvh8's bytes) were copied and
+    // their pages touched twice over.
+    std::size_t block_count = 0;
+    for (const WideBvhNode& node : build_nodes_) {
+      for (int k = 0; k < kWidth; ++k) block_count += (node.count[k] + TriangleBlock::kLanes - 1) / TriangleBlock::kLanes;
+    }
     LargeArray<TriangleBlock> blocks;
+    blocks.reserve(block_count);
     const glm::vec3* positions = geometry_.positions();
     for (WideBvhNode& node : build_nodes_) {
       for (int k = 0; k < kWidth; ++k) {
