@@ -102,7 +102,9 @@ TEST(SahBuilder, CutSizeStopsAtTheRangesAFullBuildWouldCutThere) {
   EXPECT_EQ(pieces(cut), expected);
   EXPECT_GT(expected.size(), 20u);
   for (const BuildNode& node : cut.nodes) {
-    if (node.leaf()) EXPECT_LE(node.count, kCut);
+    if (node.leaf()) {
+      EXPECT_LE(node.count, kCut);
+    }
   }
   EXPECT_LT(cut.nodes.size(), whole.nodes.size() / 10);
 }

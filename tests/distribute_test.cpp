@@ -140,7 +140,7 @@ TEST(Distribute, DataModeOnTwoAndThreeRanksIsTheSingleProcessImage) {
   const auto single = testing::run_wavetrace(arguments + "--threads 2 --out " + alone);
   ASSERT_EQ(single.exit_code, 0) << single.output;
   // Several threads a rank: several rounds in flight, and answers found by their own thread.
-  for (const auto [ranks, threads] : {std::pair{2, 1}, std::pair{3, 1}, std::pair{2, 3}}) {
+  for (const auto& [ranks, threads] : {std::pair{2, 1}, std::pair{3, 1}, std::pair{2, 3}}) {
     const std::string image = testing::write_temp_file(fmt::format("data_{}x{}.exr", ranks, threads), "");
     const std::string stats = testing::write_temp_file(fmt::format("data_{}x{}.json", ranks, threads), "");
     const auto shared = testing::run_shell(mpirun(ranks) + WAVETRACE_BINARY + " " + arguments +

@@ -49,9 +49,12 @@ class PhaseClock {
   }
   // Times the phase and adds it under `name`.
   void lap(BuildPhases& phases, std::string_view name) { phases.add(name, lap()); }
+  // Seconds since the clock was made.
+  double elapsed() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
 
  private:
-  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+  std::chrono::steady_clock::time_point last_ = start_;
 };
 
 }  // namespace wavetrace

@@ -61,10 +61,7 @@ class BvhAccelerator final : public ProbedAccelerator<BvhAccelerator> {
   // The clock starts before the face set is made (a member), so that its copy is timed too.
   BvhAccelerator(const TriangleMesh& mesh, const BvhOptions& options, PhaseClock clock)
       : geometry_(mesh, options.triangle_order) {
-    const auto start = std::chrono::steady_clock::now();
-    build_.phases.add("face_set", clock.lap());
-    const BuildTree tree = build_bvh_tree(geometry_, options, build_.phases);
-    clock.lap();
+    const BuildTree tree = build_bvh_tree_timed(geometry_, options, clock, build_);
 
     // Leaf triangles are stored in node order too, so a leaf's slots follow its node's position.
     LargeArray<std::uint32_t> leaf_triangles(geometry_.triangle_count());
@@ -79,8 +76,7 @@ class BvhAccelerator final : public ProbedAccelerator<BvhAccelerator> {
     nodes_ = StoredArray<BvhNode>(std::move(nodes));
     leaf_triangles_ = StoredArray<std::uint32_t>(std::move(leaf_triangles));
     clock.lap(build_.phases, "flatten");
-    build_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() +
-                     build_.phases.seconds("face_set");
+    build_.seconds = clock.elapsed();
     build_.peak_bytes = bvh_build_peak_bytes(tree, geometry_, memory().total());
   }
 

@@ -35,6 +35,16 @@ inline BuildTree build_bvh_tree(const IndexedFaceSet& geometry, const BvhOptions
   return tree;
 }
 
+// A BVH build's first phases: `clock` started before the face set (a member of the
+// accelerator) was made, so its copy is "face_set"; then build_bvh_tree's.
+inline BuildTree build_bvh_tree_timed(const IndexedFaceSet& geometry, const BvhOptions& options, PhaseClock& clock,
+                                      BuildReport& build) {
+  build.phases.add("face_set", clock.lap());
+  BuildTree tree = build_bvh_tree(geometry, options, build.phases);
+  clock.lap();
+  return tree;
+}
+
 // With leaf order, re-stores the face set as the leaves list it and drops the leaf index.
 inline void adopt_leaf_order(const BvhOptions& options, IndexedFaceSet& geometry, LargeArray<std::uint32_t>& leaf_index) {
   if (options.triangle_order != TriangleOrder::leaf) return;

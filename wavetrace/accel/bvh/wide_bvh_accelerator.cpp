@@ -197,10 +197,7 @@ class WideBvhAccelerator final : public ProbedAccelerator<WideBvhAccelerator> {
   // The clock starts before the face set is made (a member), so that its copy is timed too.
   WideBvhAccelerator(const TriangleMesh& mesh, const BvhOptions& options, PhaseClock clock)
       : geometry_(mesh, options.triangle_order) {
-    const auto start = std::chrono::steady_clock::now();
-    build_.phases.add("face_set", clock.lap());
-    const BuildTree tree = build_bvh_tree(geometry_, options, build_.phases);
-    clock.lap();
+    const BuildTree tree = build_bvh_tree_timed(geometry_, options, clock, build_);
     LargeArray<std::uint32_t> leaf_triangles;
     leaf_triangles.reserve(geometry_.triangle_count());
     build_nodes_.reserve(tree.nodes.size() / 4 + 1);
@@ -211,8 +208,7 @@ class WideBvhAccelerator final : public ProbedAccelerator<WideBvhAccelerator> {
     nodes_ = StoredArray<WideBvhNode>(std::move(build_nodes_));
     blocks_ = StoredArray<TriangleBlock>(std::move(blocks));
     clock.lap(build_.phases, "blocks");
-    build_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() +
-                     build_.phases.seconds("face_set");
+    build_.seconds = clock.elapsed();
     build_.peak_bytes = bvh_build_peak_bytes(tree, geometry_, memory().total());
   }
 
