@@ -47,7 +47,8 @@ constexpr std::size_t kDenseSpanPerKey = 4;
 
 bool renumber_dense_keys(const ShapeGenerator& shape, const LargeArray<std::uint64_t>& keys, const glm::vec3& offset,
                          TriangleMesh& mesh) {
-  const auto [lowest, highest] = tbb::parallel_reduce(
+  // Not a structured binding: lambdas below capture the two, which clang 14 refuses.
+  const std::pair<std::uint64_t, std::uint64_t> key_span = tbb::parallel_reduce(
       tbb::blocked_range<std::size_t>(0, keys.size(), 1 << 14),
       std::pair(std::numeric_limits<std::uint64_t>::max(), std::uint64_t{0}),
       [&](const tbb::blocked_range<std::size_t>& range, std::pair<std::uint64_t, std::uint64_t> span) {
@@ -58,6 +59,7 @@ bool renumber_dense_keys(const ShapeGenerator& shape, const LargeArray<std::uint
         return span;
       },
       [](auto a, const auto& b) { return std::pair(std::min(a.first, b.first), std::max(a.second, b.second)); });
+  const std::uint64_t lowest = key_span.first, highest = key_span.second;
   const std::size_t span = highest - lowest + 1;  // at most the shape's vertex count
   if (span > kDenseSpanPerKey * keys.size()) return false;
   LargeArray<std::uint32_t> number(span, 0);
