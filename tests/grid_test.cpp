@@ -1,7 +1,11 @@
 // The one-level hashed grid: agreement with Embree (robust) on closed, soup, scanned,
 // open and sparse scenes, axis-parallel rays on cell faces, any hit, no leaks, the
 // resolution guard, and its memory report.
+#include <algorithm>
+#include <cstring>
+
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include "wavetrace/scene/load_scene.hpp"
 #include "wavetrace/accel/grid/array_grid.hpp"
@@ -186,6 +190,49 @@ TEST(Grid, MacrocellLevelsCoverTheGridAndCostLittle) {
   EXPECT_GT(mlgrid->memory().hierarchy, grid->memory().hierarchy);
   EXPECT_LT(mlgrid->memory().hierarchy, grid->memory().hierarchy * 11 / 10);  // a bit per 216 cells and up
   EXPECT_THROW(parse_accelerator_spec("mlgrid:macrocell_factor=1", Config{}), ConfigError);
+}
+
+// The build's slab tasks own their cells: the arrays must not depend on how many threads ran
+// them, and each cell's list must ascend (the layout's promise) without a sort.
+TEST(Grid, BuildIsTheSameOnAnyThreadCountAndEveryListAscends) {
+  const Scene scene = make_builtin_scene("builtin:room:30k");  // walls, strands and small triangles
+  for (const std::uint32_t macrocells : {0u, 6u}) {
+    HashedGridOptions options;
+    options.macrocell_factor = macrocells;
+    std::vector<std::vector<std::byte>> arrays_by_threads[2];
+    for (const int threads : {1, 2}) {
+      tbb::task_arena arena(threads);
+      arena.execute([&] {
+        const auto grid = make_hashed_grid_accelerator(scene.mesh, options);
+        double phase_seconds = 0.0;
+        for (const char* phase : {"slabs", "mark", "displace", "count", "prefix", "allocate", "insert", "macrocells"}) {
+          EXPECT_GE(grid->build().phases.seconds(phase), 0.0);
+          phase_seconds += grid->build().phases.seconds(phase);
+        }
+        EXPECT_EQ(grid->build().phases.entries().size(), 9u);  // and "bounds"
+        EXPECT_LE(phase_seconds, grid->build().seconds);
+        for (const auto span : grid->memory_spans()) arrays_by_threads[threads - 1].emplace_back(span.begin(), span.end());
+      });
+    }
+    ASSERT_EQ(arrays_by_threads[0], arrays_by_threads[1]) << "macrocell factor " << macrocells;
+    // Spans: D, O, H, L, then the mesh (and macrocell levels).
+    const auto as_words = [](const std::vector<std::byte>& bytes) {
+      std::vector<std::uint32_t> words(bytes.size() / 4);
+      std::memcpy(words.data(), bytes.data(), words.size() * 4);
+      return words;
+    };
+    const std::vector<std::uint32_t> starts = as_words(arrays_by_threads[0][2]), items = as_words(arrays_by_threads[0][3]);
+    ASSERT_EQ(starts.back(), items.size());
+    std::size_t cells_with_items = 0;
+    for (std::size_t slot = 0; slot + 1 < starts.size(); ++slot) {
+      ASSERT_LE(starts[slot], starts[slot + 1]);
+      ASSERT_TRUE(std::is_sorted(items.begin() + starts[slot], items.begin() + starts[slot + 1])) << "slot " << slot;
+      ASSERT_EQ(std::adjacent_find(items.begin() + starts[slot], items.begin() + starts[slot + 1]),
+                items.begin() + starts[slot + 1]) << "a triangle twice in slot " << slot;
+      cells_with_items += starts[slot + 1] > starts[slot];
+    }
+    EXPECT_GT(cells_with_items, scene.mesh.triangle_count() / 4);
+  }
 }
 
 TEST(ArrayGrid, NestsCrowdedCellsAndItsGuardStopsRefinement) {

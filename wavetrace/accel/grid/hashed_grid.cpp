@@ -1,12 +1,12 @@
-// Counting construction of the hashed grid (D bits, first-fit row displacement for O, counts
-// and prefix sums for H, reverse insertion for L) and 3D-DDA traversal that stops once the
+// Counting construction of the hashed grid (triangles bucketed by slabs of z layers, D bits,
+// first-fit row displacement for O, counts and prefix sums for H, insertion in triangle order
+// for L, each slab's cells filled by one task) and 3D-DDA traversal that stops once the
 // nearest hit found lies before the next cell.
 #include "wavetrace/accel/grid/hashed_grid.hpp"
 
 #include <algorithm>
 #include <atomic>
 #include <bit>
-#include <chrono>
 #include <cmath>
 #include <limits>
 
@@ -37,14 +37,22 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
 
  public:
   HashedGridAccelerator(const TriangleMesh& mesh, const HashedGridOptions& options) : mesh_(mesh) {
-    const auto start = std::chrono::steady_clock::now();
+    PhaseClock clock;
     choose_resolution(options);
+    clock.lap(build_.phases, "bounds");
+    bucket_by_slab();
+    clock.lap(build_.phases, "slabs");
     mark_cells();
+    clock.lap(build_.phases, "mark");
     displace_rows();
-    fill_lists();
+    clock.lap(build_.phases, "displace");
+    fill_lists(clock);
+    const std::size_t slab_bytes = slab_triangles_.size() * sizeof(std::uint32_t);
+    slab_triangles_ = {};
     build_macrocells(options.macrocell_factor);
-    build_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    build_.peak_bytes = memory().total() + row_scratch_bytes_ + slot_count_ * sizeof(std::uint32_t);  // + fill cursors
+    clock.lap(build_.phases, "macrocells");
+    build_.seconds = clock.elapsed();
+    build_.peak_bytes = memory().total() + row_scratch_bytes_ + slab_bytes;  // an upper bound: the slabs go first
   }
 
   std::string name() const override { return macrocell_factor_ > 0 ? "mlgrid" : "grid"; }
@@ -117,18 +125,77 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
     return (std::size_t(z) * cells_.y + y) * cells_.x + x;
   }
 
+  // Triangles bucketed by slabs of z layers, each slab's list ascending: a slab task then owns
+  // every cell (D bit, H slot, L range) of its layers, so the passes below need no atomic
+  // per cell entry, and each cell's list fills in ascending order without a sort. A stable
+  // counting sort in parallel: counts per (block of triangles, slab), then each block writes
+  // its triangles at its own offsets.
+  void bucket_by_slab() {
+    const std::size_t triangles = mesh_.triangle_count();
+    slab_layers_ = std::max<std::uint32_t>(1, (cells_.z + kTargetSlabs - 1) / kTargetSlabs);
+    const std::size_t slabs = (cells_.z + slab_layers_ - 1) / slab_layers_;
+    const std::size_t block_size = std::max<std::size_t>(4096, (triangles + kTriangleBlocks - 1) / kTriangleBlocks);
+    const std::size_t blocks = (triangles + block_size - 1) / block_size;
+    std::vector<std::size_t> counts(blocks * slabs, 0);  // [block][slab], then each one's offset
+    const auto slabs_of = [&](std::size_t t) {
+      const CellRange r = range_of(t);
+      return std::pair(r.lower.z / slab_layers_, r.upper.z / slab_layers_);
+    };
+    tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t block) {
+      std::size_t* block_counts = counts.data() + block * slabs;
+      for (std::size_t t = block * block_size, end = std::min(triangles, t + block_size); t < end; ++t) {
+        const auto [first, last] = slabs_of(t);
+        for (std::uint32_t slab = first; slab <= last; ++slab) ++block_counts[slab];
+      }
+    });
+    slab_starts_.assign(slabs + 1, 0);
+    std::size_t total = 0;
+    for (std::size_t slab = 0; slab < slabs; ++slab) {
+      slab_starts_[slab] = total;
+      for (std::size_t block = 0; block < blocks; ++block) {
+        const std::size_t count = counts[block * slabs + slab];
+        counts[block * slabs + slab] = total;
+        total += count;
+      }
+    }
+    slab_starts_[slabs] = total;
+    slab_triangles_.resize(total);
+    tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t block) {
+      std::size_t* cursor = counts.data() + block * slabs;
+      for (std::size_t t = block * block_size, end = std::min(triangles, t + block_size); t < end; ++t) {
+        const auto [first, last] = slabs_of(t);
+        for (std::uint32_t slab = first; slab <= last; ++slab) slab_triangles_[cursor[slab]++] = std::uint32_t(t);
+      }
+    });
+  }
+
+  // Calls row_run(y, z, x_lower, x_upper) for each row of cells every triangle of a slab
+  // overlaps, its layers only, triangles in ascending order; slabs in parallel.
+  template <typename RowRun>
+  void for_each_slab_row_run(RowRun&& row_run) const {
+    tbb::parallel_for(std::size_t{0}, slab_starts_.size() - 1, [&](std::size_t slab) {
+      const std::uint32_t z_first = std::uint32_t(slab) * slab_layers_;
+      const std::uint32_t z_last = std::min(cells_.z - 1, z_first + slab_layers_ - 1);
+      for (std::size_t k = slab_starts_[slab]; k < slab_starts_[slab + 1]; ++k) {
+        const CellRange r = range_of(slab_triangles_[k]);
+        for (std::uint32_t z = std::max(r.lower.z, z_first); z <= std::min(r.upper.z, z_last); ++z) {
+          for (std::uint32_t y = r.lower.y; y <= r.upper.y; ++y) row_run(slab_triangles_[k], y, z, r.lower.x, r.upper.x);
+        }
+      }
+    });
+  }
+
   void mark_cells() {
     const std::size_t cell_count = std::size_t(cells_.x) * cells_.y * cells_.z;
     domain_.assign((cell_count + 63) / 64, 0);
-    tbb::parallel_for(std::size_t{0}, mesh_.triangle_count(), [&](std::size_t t) {
-      const CellRange r = range_of(t);
-      for (std::uint32_t z = r.lower.z; z <= r.upper.z; ++z) {
-        for (std::uint32_t y = r.lower.y; y <= r.upper.y; ++y) {
-          for (std::uint32_t x = r.lower.x; x <= r.upper.x; ++x) {
-            const std::size_t d = cell_index(x, y, z);
-            std::atomic_ref<std::uint64_t>(domain_[d / 64]).fetch_or(std::uint64_t{1} << (d % 64), std::memory_order_relaxed);
-          }
-        }
+    // A row run's bits a word at a time; atomic since a word may straddle two slabs' layers.
+    for_each_slab_row_run([&](std::uint32_t, std::uint32_t y, std::uint32_t z, std::uint32_t x_lower, std::uint32_t x_upper) {
+      const std::size_t first = cell_index(x_lower, y, z), last = cell_index(x_upper, y, z);
+      for (std::size_t word = first / 64; word <= last / 64; ++word) {
+        std::uint64_t bits = ~std::uint64_t{0};
+        if (word == first / 64) bits &= ~std::uint64_t{0} << (first % 64);
+        if (word == last / 64) bits &= ~std::uint64_t{0} >> (63 - last % 64);
+        std::atomic_ref<std::uint64_t>(domain_[word]).fetch_or(bits, std::memory_order_relaxed);
       }
     });
   }
@@ -173,20 +240,16 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
     return offsets_[std::size_t(z) * cells_.y + y] + x;
   }
 
-  // Counts per slot and prefix sums (H[slot] = where its list starts), then the lists.
-  void fill_lists() {
+  // Counts per slot, exclusive prefix sums, then the lists: each slot belongs to one cell and
+  // each cell to one slab task, so counts and cursors are plain; H itself is the cursor (after
+  // the fill, H[slot] holds where slot + 1 starts, and one shift restores it).
+  void fill_lists(PhaseClock& clock) {
     starts_.assign(slot_count_ + 1, 0);
-    tbb::parallel_for(std::size_t{0}, mesh_.triangle_count(), [&](std::size_t t) {
-      const CellRange r = range_of(t);
-      for (std::uint32_t z = r.lower.z; z <= r.upper.z; ++z) {
-        for (std::uint32_t y = r.lower.y; y <= r.upper.y; ++y) {
-          for (std::uint32_t x = r.lower.x; x <= r.upper.x; ++x) {
-            std::atomic_ref<std::uint32_t>(starts_[slot_of(x, y, z)]).fetch_add(1, std::memory_order_relaxed);
-          }
-        }
-      }
+    for_each_slab_row_run([&](std::uint32_t, std::uint32_t y, std::uint32_t z, std::uint32_t x_lower, std::uint32_t x_upper) {
+      std::uint32_t* row = starts_.data() + slot_of(0, y, z);
+      for (std::uint32_t x = x_lower; x <= x_upper; ++x) ++row[x];
     });
-    // Exclusive prefix sums: H[slot] becomes the start of its list, H[NH] the total.
+    clock.lap(build_.phases, "count");
     std::uint64_t total = 0;
     for (std::uint32_t& start : starts_) {
       const std::uint32_t count = start;
@@ -196,24 +259,16 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
     if (total > std::numeric_limits<std::uint32_t>::max()) {
       throw std::runtime_error("grid: more than 2^32 cell entries; lower accel.grid.density");
     }
-    items_.resize(total);
-    // The paper inserts serially in reverse (L[--H[j]] = i) to leave each list ascending;
-    // in parallel, claim slots with atomic cursors, then sort each (short) list.
-    std::vector<std::uint32_t> cursor(starts_.begin(), starts_.end() - 1);
-    tbb::parallel_for(std::size_t{0}, mesh_.triangle_count(), [&](std::size_t t) {
-      const CellRange r = range_of(t);
-      for (std::uint32_t z = r.lower.z; z <= r.upper.z; ++z) {
-        for (std::uint32_t y = r.lower.y; y <= r.upper.y; ++y) {
-          for (std::uint32_t x = r.lower.x; x <= r.upper.x; ++x) {
-            items_[std::atomic_ref<std::uint32_t>(cursor[slot_of(x, y, z)]).fetch_add(1, std::memory_order_relaxed)] =
-                std::uint32_t(t);
-          }
-        }
-      }
+    clock.lap(build_.phases, "prefix");
+    items_.resize(total);  // its first touch: on this VM a visible share of the build (measurements.md)
+    clock.lap(build_.phases, "allocate");
+    for_each_slab_row_run([&](std::uint32_t t, std::uint32_t y, std::uint32_t z, std::uint32_t x_lower, std::uint32_t x_upper) {
+      std::uint32_t* row = starts_.data() + slot_of(0, y, z);
+      for (std::uint32_t x = x_lower; x <= x_upper; ++x) items_[row[x]++] = t;
     });
-    tbb::parallel_for(std::size_t{0}, slot_count_, [&](std::size_t slot) {
-      std::sort(items_.begin() + starts_[slot], items_.begin() + starts_[slot + 1]);
-    });
+    std::move_backward(starts_.begin(), starts_.end() - 1, starts_.end());
+    starts_[0] = 0;
+    clock.lap(build_.phases, "insert");
   }
 
   // Macrocells (Wald et al. 2006, as the paper uses them): level k is a bit per block of
@@ -328,6 +383,13 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
   std::size_t max_cells_ = 0;
   std::size_t slot_count_ = 0;
   std::size_t row_scratch_bytes_ = 0;
+  // About this many slabs of z layers: enough for both cores to balance dense and empty ones,
+  // few enough that a triangle's box rarely crosses more than two.
+  static constexpr std::uint32_t kTargetSlabs = 256;
+  static constexpr std::size_t kTriangleBlocks = 64;
+  std::uint32_t slab_layers_ = 1;
+  std::vector<std::size_t> slab_starts_;      // slab s lists slab_triangles_[starts[s] .. starts[s + 1])
+  LargeArray<std::uint32_t> slab_triangles_;  // build temporary, freed once the lists are filled
   struct MacrocellLevel {
     std::uint32_t span = 1;  // fine cells per block side
     glm::uvec3 cells{1};
