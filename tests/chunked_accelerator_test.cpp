@@ -3,7 +3,12 @@
 // only its own memory when probed.
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <sstream>
+#include <thread>
+
+#include <tbb/task_arena.h>
 
 #include <limits>
 
@@ -118,6 +123,31 @@ TEST(ChunkedWorld, ProbedAnswersAsUnprobedAndReadsOnlyItsWorld) {
   }
   EXPECT_GT(pager.counters(0).accesses, 4000u);
   EXPECT_EQ(pager.outside_accesses(), 0u);
+}
+
+// build.chunks_at_once caps the chunks in flight: each build lingers so that two threads
+// would overlap, and the most seen at once must stay within the cap.
+TEST(ChunkedWorld, ChunksAtOnceCapsTheBuildsInFlight) {
+  const Scene scene = make_builtin_scene("builtin:sphere:20000");
+  const MeshTriangleSource source(scene.mesh);
+  for (const std::size_t cap : {std::size_t{1}, std::size_t{2}}) {
+    std::atomic<int> in_flight{0}, most{0};
+    const auto build = [&](const TriangleMesh& mesh) {
+      const int now = ++in_flight;
+      for (int seen = most.load(); now > seen && !most.compare_exchange_weak(seen, now);) {
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      auto accelerator = make_accelerator(mesh, AcceleratorOptions{});
+      --in_flight;
+      return accelerator;
+    };
+    tbb::task_arena arena(4);
+    arena.execute([&] { make_chunked_accelerator(source, 2048, build, false, nullptr, cap); });
+    EXPECT_EQ(std::size_t(most.load()), cap) << "at most " << cap << " chunks at once, and that many when allowed";
+  }
+  Config config;
+  EXPECT_THROW(config.set("build.chunks_at_once=-1"), ConfigError);
+  config.set("build.chunks_at_once=1");
 }
 
 // A source that claims more triangles than hits can name, without holding any.

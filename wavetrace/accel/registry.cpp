@@ -162,7 +162,8 @@ std::unique_ptr<Accelerator> build_for_world(const TriangleSource& source, const
   if (type.builds_in_chunks && source.triangle_count() > options.chunk_triangles) {
     return make_chunked_accelerator(
         source, options.chunk_triangles,
-        [&](const TriangleMesh& chunk) { return type.make(chunk, chunk_options); }, !type.holds_own_geometry, stream);
+        [&](const TriangleMesh& chunk) { return type.make(chunk, chunk_options); }, !type.holds_own_geometry, stream,
+        options.chunks_at_once);
   }
   if (whole != nullptr) return type.make(*whole, chunk_options);
   if (!type.holds_own_geometry) {

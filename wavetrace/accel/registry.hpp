@@ -38,6 +38,8 @@ struct AcceleratorOptions {
   std::string isa = "auto";
   // Scenes of more triangles are built in chunks of at most this many (hmq, raystrips, bvh).
   std::size_t chunk_triangles = std::size_t{1} << 22;
+  // At most this many chunks built at the same time; 0: one per thread, as memory allows.
+  std::size_t chunks_at_once = 0;
   bool operator==(const AcceleratorOptions&) const = default;
 };
 

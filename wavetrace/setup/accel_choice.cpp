@@ -276,6 +276,7 @@ AccelChoice choose_accelerator(const SceneTraits& traits, std::size_t budget_byt
   AccelChoice choice;
   choice.budget_bytes = budget_bytes;
   choice.allowance = allowance;
+  if (base.chunks_at_once != 0) choice.allowance.builds_at_once = std::min(allowance.builds_at_once, base.chunks_at_once);
   choice.max_error = max_error;
   choice.traits = traits;
   const double triangles = double(traits.triangles);
@@ -301,7 +302,7 @@ AccelChoice choose_accelerator(const SceneTraits& traits, std::size_t budget_byt
     double built_at_once = triangles;
     if (candidate.chunked) {
       built_at_once = 0.0;
-      for (std::size_t c = 0; c < std::min(traits.chunk_sizes.size(), allowance.builds_at_once); ++c) {
+      for (std::size_t c = 0; c < std::min(traits.chunk_sizes.size(), choice.allowance.builds_at_once); ++c) {
         built_at_once += double(traits.chunk_sizes[c]);
       }
       if (traits.chunk_sizes.empty()) built_at_once = std::min(triangles, double(options.chunk_triangles));

@@ -23,7 +23,7 @@ void apply_accelerator_spec(Config& config, const std::string& text) {
     const bool own = std::ranges::any_of(config_schema(), [&](const ConfigKey& key) {
       return key.name == "accel." + type + "." + name;
     });
-    const std::string section = name == "chunk_triangles"                  ? "build."
+    const std::string section = name == "chunk_triangles" || name == "chunks_at_once" ? "build."
                                 : type == "auto" || (name == "isa" && !own) ? "accel."
                                                                             : "accel." + type + ".";
     config.set(section + option);

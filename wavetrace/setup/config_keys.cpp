@@ -348,6 +348,9 @@ const std::vector<ConfigKey>& config_schema() {
       {"build.chunk_triangles", T::integer, std::int64_t{1} << 22, std::int64_t{1024}, std::int64_t{1} << 30, {},
        "scenes of more triangles are built in chunks of at most this many under a top BVH (hmq, raystrips, bvh)",
        integer<&P::accelerator, &A::chunk_triangles>},
+      {"build.chunks_at_once", T::integer, std::int64_t{0}, 0, 1024, {},
+       "at most this many chunks built at the same time (0: one per thread, as memory allows); 1 holds one chunk's build temporaries, not one per thread",
+       integer<&P::accelerator, &A::chunks_at_once>},
 
       {"memory.budget", T::text, std::string("none"), 0, 0, {},
        "the page pool (simulated, or real with memory.backing = file): none, a share of the world (20%) or a size "

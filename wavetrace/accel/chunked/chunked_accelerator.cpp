@@ -66,11 +66,13 @@ struct RoundScratch {
 };
 
 // Chunks built at the same time: one per worker thread, as many as half the memory the
-// machine has available now can hold at a build's measured 200 bytes per triangle.
-std::size_t chunks_built_at_once(std::size_t chunk_triangles) {
+// machine has available now can hold at a build's measured 200 bytes per triangle, and no
+// more than `limit` (0: no limit). One at a time, a build's temporaries are one chunk's, its
+// cores shared inside the chunk (build.chunks_at_once; measurements.md, "Build speed").
+std::size_t chunks_built_at_once(std::size_t chunk_triangles, std::size_t limit) {
   const std::size_t threads = static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
   const std::size_t affordable = available_memory_bytes() / 2 / (chunk_triangles * 200);
-  return std::clamp<std::size_t>(affordable, 1, threads);
+  return std::clamp<std::size_t>(affordable, 1, limit == 0 ? threads : std::min(threads, limit));
 }
 
 // A saved chunked world, under `PREFIX`: "kind" ("chunked", version 1), "common"
@@ -128,7 +130,7 @@ class ChunkedAccelerator final : public Accelerator, public ChunkSet {
   }
 
   ChunkedAccelerator(const TriangleSource& source, std::size_t chunk_triangles, const ChunkBuilder& build_chunk,
-                     bool keeps_mesh, const ChunkStream* stream) {
+                     bool keeps_mesh, const ChunkStream* stream, std::size_t at_once_limit) {
     if (chunk_triangles < kMinChunkTriangles || chunk_triangles > kMaxChunkTriangles) {
       throw std::invalid_argument(fmt::format("build.chunk_triangles = {}: must be in [{}, {}]", chunk_triangles,
                                               kMinChunkTriangles, kMaxChunkTriangles));
@@ -146,7 +148,7 @@ class ChunkedAccelerator final : public Accelerator, public ChunkSet {
     clock.lap(build_.phases, "plan");
     std::size_t finished_bytes = 0;
     for (std::size_t wave_begin = 0; wave_begin < ranges.size();) {
-      const std::size_t wave_end = std::min(ranges.size(), wave_begin + chunks_built_at_once(chunk_triangles));
+      const std::size_t wave_end = std::min(ranges.size(), wave_begin + chunks_built_at_once(chunk_triangles, at_once_limit));
       // Extracted one after another (a PLY file's faces are read in order), then built at once.
       std::vector<std::unique_ptr<const TriangleMesh>> meshes;
       for (std::size_t c = wave_begin; c < wave_end; ++c) {
@@ -487,8 +489,8 @@ std::unique_ptr<Accelerator> load_chunked_accelerator(SectionLoader& in, const C
 
 std::unique_ptr<Accelerator> make_chunked_accelerator(const TriangleSource& source, std::size_t chunk_triangles,
                                                       const ChunkBuilder& build_chunk, bool keeps_mesh,
-                                                      const ChunkStream* stream) {
-  return std::make_unique<ChunkedAccelerator>(source, chunk_triangles, build_chunk, keeps_mesh, stream);
+                                                      const ChunkStream* stream, std::size_t at_once_limit) {
+  return std::make_unique<ChunkedAccelerator>(source, chunk_triangles, build_chunk, keeps_mesh, stream, at_once_limit);
 }
 
 }  // namespace wavetrace

@@ -52,11 +52,12 @@ struct ChunkStream {
 
 // `keeps_mesh`: the sub-accelerators read their chunk's mesh in place (bvh), so the world
 // keeps each chunk's mesh; otherwise (hmq, raystrips) a chunk's mesh is freed once built.
-// Primitive ids in hits are the source's; throws std::invalid_argument for chunk_triangles
-// outside [kMinChunkTriangles, kMaxChunkTriangles].
+// `at_once_limit`: at most this many chunks built at the same time (0: one per thread, as
+// memory allows). Primitive ids in hits are the source's; throws std::invalid_argument for
+// chunk_triangles outside [kMinChunkTriangles, kMaxChunkTriangles].
 std::unique_ptr<Accelerator> make_chunked_accelerator(const TriangleSource& source, std::size_t chunk_triangles,
                                                       const ChunkBuilder& build_chunk, bool keeps_mesh,
-                                                      const ChunkStream* stream = nullptr);
+                                                      const ChunkStream* stream = nullptr, std::size_t at_once_limit = 0);
 
 // A chunked world saved under the loader's prefix (format in chunked_accelerator.cpp), each
 // chunk's accelerator loaded by `load_chunk` from its own prefix.
