@@ -67,7 +67,7 @@ TEST(HmqPackedStream, RoundTripsEveryWidthWithByteAlignedGroups) {
     for (const std::uint32_t count : {1u, 5u, 42u}) {
       std::vector<std::uint32_t> values(count);
       for (auto& v : values) v = bits == 0 ? 0 : static_cast<std::uint32_t>(random() & ((std::uint64_t{1} << bits) - 1));
-      std::vector<std::byte> out;
+      LargeArray<std::byte> out;
       append_stream(out, values, bits);
       EXPECT_EQ(out.size(), stream_bytes(bits, count)) << bits << " bits";
       out.resize(out.size() + 8);
@@ -184,7 +184,7 @@ TEST(HmqLeaf, RecordDecodesToTheSnappedVerticesIdsAndCorners) {
       }
     }
     const GridBox grid_box = snap_outward(grid, box);
-    std::vector<std::byte> record;
+    LargeArray<std::byte> record;
     encode_leaf(quantized, triangles, grid_box, record);
     EXPECT_EQ(record.size(), leaf_record_bytes(record.data()));
     record.resize(record.size() + 8);

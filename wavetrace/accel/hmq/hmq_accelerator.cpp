@@ -107,7 +107,7 @@ class BlockEncoder {
     for (std::uint32_t f = 0; f < forward_slots; ++f) slots[forwarded[f]].index = node_slots + f;
 
     // Leaf records, in slot order.
-    std::vector<std::byte> records;
+    LargeArray<std::byte> records;
     std::vector<std::uint32_t> record_offset;
     for (Slot& slot : slots) {
       const BuildNode& node = tree_.nodes[slot.build_node];

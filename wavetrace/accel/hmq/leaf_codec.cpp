@@ -141,7 +141,7 @@ LeafStrips strips_of_leaf(const TriangleMesh& mesh, std::span<const std::uint32_
 }  // namespace
 
 void encode_leaf(const QuantizedMesh& quantized, std::span<const std::uint32_t> triangles, const GridBox& box,
-                 std::vector<std::byte>& out) {
+                 LargeArray<std::byte>& out) {
   if (triangles.empty() || triangles.size() > kMaxLeafTriangles) {
     throw std::invalid_argument("hmq: a leaf holds 1 .. 14 triangles");
   }

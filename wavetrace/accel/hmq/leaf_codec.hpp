@@ -35,7 +35,7 @@ inline GridBox snap_outward(const GlobalGrid& grid, const Box& box) {
 
 // Appends the record of `triangles` (1 .. 14 mesh triangle ids) to `out`.
 void encode_leaf(const QuantizedMesh& quantized, std::span<const std::uint32_t> triangles, const GridBox& box,
-                 std::vector<std::byte>& out);
+                 LargeArray<std::byte>& out);
 
 // A decoded leaf: vertex positions in columns (SoA, ready to gather into triangle lanes)
 // and which vertex each strip slot holds.

@@ -13,6 +13,8 @@
 #include <span>
 #include <vector>
 
+#include "wavetrace/memory/cache_aligned_allocator.hpp"
+
 namespace wavetrace::hmq {
 
 struct StreamShape {
@@ -41,7 +43,7 @@ constexpr std::size_t stream_bytes(std::uint32_t bits, std::uint32_t count) {
 }
 
 // Appends the stream to `out`; every value must fit in `bits` (0 .. 32) bits.
-inline void append_stream(std::vector<std::byte>& out, std::span<const std::uint32_t> values, std::uint32_t bits) {
+inline void append_stream(LargeArray<std::byte>& out, std::span<const std::uint32_t> values, std::uint32_t bits) {
   if (bits == 0) return;
   const StreamShape shape = stream_shape(bits);
   for (std::size_t first = 0; first < values.size(); first += shape.per_group) {

@@ -74,8 +74,8 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
     grid_ = snapped.grid;
     // Reserved past the records' usual 7-8 bytes a triangle: grown by doubling, they were copied
     // and their pages touched twice over (pages reserved and never written are not resident).
-    std::vector<std::byte> leaves;
-    leaves.reserve(mesh.triangle_count() * 12);
+    LargeArray<std::byte> leaves;
+    leaves.reserve(mesh.triangle_count() * 12 + kSlackBytes);
     PartBytes parts;
     // Leaf records are encoded as the wide tree reaches its leaves: their time is taken apart
     // from the nodes' (two clock reads a leaf, well under 1% of the build).
@@ -112,7 +112,7 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
       leaves.resize(leaves.size() + kSlackBytes, std::byte{0});
       parts.hierarchy += kSlackBytes;
       nodes_ = StoredArray<QuantizedWideNode>(std::move(tree.nodes));
-      leaves_ = StoredArray<std::byte>(LargeArray<std::byte>(leaves.begin(), leaves.end()));
+      leaves_ = StoredArray<std::byte>(std::move(leaves));  // no copy: the reserve covers the slack
     }
     clock.lap(build_.phases, options.leaves_beside_nodes ? "interleave" : "store");
     parts_ = parts;
