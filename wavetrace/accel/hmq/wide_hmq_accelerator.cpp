@@ -4,9 +4,12 @@
 #include <algorithm>
 #include <bit>
 #include <chrono>
+#include <span>
+#include <vector>
 #include <stdexcept>
 
 #include <fmt/format.h>
+#include <tbb/parallel_for.h>
 
 #include "wavetrace/accel/bvh/quantized_wide_tree.hpp"
 #include "wavetrace/build_config.hpp"  // WAVETRACE_AVX2, WAVETRACE_FMA, WAVETRACE_BMI2
@@ -62,6 +65,107 @@ struct WideHmqSavedState {
 static_assert(sizeof(WideHmqSavedState) == 112);
 constexpr std::uint32_t kWideHmqSavedVersion = 1;
 
+// A tree's leaf records, encoded in batches on every core and appended in the order the
+// tree references its leaves: the bytes one encoder going leaf by leaf would append.
+class LeafRecordWriter {
+ public:
+  LeafRecordWriter(const SnappedTree& snapped, std::size_t triangles) : snapped_(snapped) {
+    // Reserved past the records' usual 7-8 bytes a triangle: grown by doubling, they were
+    // copied and their pages touched twice over (pages reserved and never written are not resident).
+    records_.reserve(triangles * 12 + kSlackBytes);
+    pending_.reserve(kBatchLeaves);
+  }
+
+  void add(const BuildNode& leaf, const Bounds3& box) {
+    pending_.push_back({&leaf, snap_outward(snapped_.grid, Box{box.lower, box.upper})});
+    if (pending_.size() == kBatchLeaves) flush();
+  }
+
+  void flush() {
+    PhaseClock clock;
+    const std::size_t blocks = (pending_.size() + kBlockLeaves - 1) / kBlockLeaves;
+    if (block_bytes_.size() < blocks) block_bytes_.resize(blocks);
+    if (block_parts_.size() < blocks) block_parts_.resize(blocks);
+    const std::size_t first_weight = weights_.size();
+    weights_.resize(first_weight + pending_.size());
+    tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t block) {
+      LargeArray<std::byte>& out = block_bytes_[block];
+      PartBytes& parts = block_parts_[block] = {};
+      out.clear();
+      for (std::size_t i = block * kBlockLeaves, end = std::min(pending_.size(), i + kBlockLeaves); i < end; ++i) {
+        const BuildNode& leaf = *pending_[i].leaf;
+        const std::size_t at = out.size();
+        encode_leaf(snapped_.quantized, std::span(snapped_.tree.primitive_order.data() + leaf.first, leaf.count),
+                    pending_[i].box, out);
+        const LeafHeader header = read_leaf_header(out.data() + at);
+        const std::size_t identity = stream_bytes(header.id_bits, leaf.count) + stream_bytes(3, leaf.count);
+        const std::size_t record = out.size() - at;
+        out.resize(at + (record + kUnit - 1) / kUnit * kUnit, std::byte{0});
+        parts.other += identity;
+        parts.geometry += record - identity;
+        parts.hierarchy += out.size() - at - record;
+        const std::size_t weight = (out.size() - at) / kUnit;
+        if (weight < 1 || weight > QuantizedWideNode::kMaxLeafWeight) {
+          throw std::logic_error("quantized wide tree: a leaf weight outside 1 .. 254");
+        }
+        weights_[first_weight + i] = static_cast<std::uint8_t>(weight);
+      }
+    });
+    for (std::size_t block = 0; block < blocks; ++block) {
+      records_.insert(records_.end(), block_bytes_[block].begin(), block_bytes_[block].end());
+      parts_.other += block_parts_[block].other;
+      parts_.geometry += block_parts_[block].geometry;
+      parts_.hierarchy += block_parts_[block].hierarchy;
+    }
+    pending_.clear();
+    seconds_ += clock.lap();
+  }
+
+  const std::vector<std::uint8_t>& weights() const { return weights_; }
+  const PartBytes& parts() const { return parts_; }
+  double seconds() const { return seconds_; }
+  // The batch's working memory: its leaves and the blocks' buffers.
+  std::size_t batch_bytes() const {
+    std::size_t bytes = pending_.capacity() * sizeof(PendingLeaf);
+    for (const LargeArray<std::byte>& buffer : block_bytes_) bytes += buffer.capacity();
+    return bytes;
+  }
+  LargeArray<std::byte> take_records() { return std::move(records_); }
+
+ private:
+  static constexpr std::size_t kBatchLeaves = 8192, kBlockLeaves = 256;
+  struct PendingLeaf {
+    const BuildNode* leaf;
+    GridBox box;
+  };
+  const SnappedTree& snapped_;
+  LargeArray<std::byte> records_;
+  std::vector<std::uint8_t> weights_;  // each record's size in units, in the references' order
+  PartBytes parts_;
+  std::vector<PendingLeaf> pending_;
+  std::vector<LargeArray<std::byte>> block_bytes_;
+  std::vector<PartBytes> block_parts_;
+  double seconds_ = 0.0;
+};
+
+// Gives each node's leaf children their records' weights and its leaf_base the units before
+// its first leaf: laid out with weights of 1, a node's leaf_base counted the leaves before it.
+void set_leaf_weights(std::span<QuantizedWideNode> nodes, const std::vector<std::uint8_t>& weights) {
+  std::vector<std::uint64_t> units_before(weights.size() + 1, 0);
+  for (std::size_t leaf = 0; leaf < weights.size(); ++leaf) units_before[leaf + 1] = units_before[leaf] + weights[leaf];
+  if (units_before.back() >= (std::uint64_t{1} << 31)) {
+    throw std::length_error("quantized wide tree: the leaf references pass 2^31; build in smaller chunks (build.chunk_triangles)");
+  }
+  tbb::parallel_for(std::size_t{0}, nodes.size(), [&](std::size_t n) {
+    QuantizedWideNode& node = nodes[n];
+    std::size_t leaf = node.leaf_base;
+    node.leaf_base = static_cast<std::uint32_t>(units_before[leaf]);
+    for (std::uint8_t& meta : node.meta) {
+      if (meta != 0 && meta != QuantizedWideNode::kInnerMeta) meta = weights[leaf++];
+    }
+  });
+}
+
 class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
   friend class ProbedAccelerator<WideHmqAccelerator>;
 
@@ -72,32 +176,23 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
     build_.phases = snapped.phases;
     PhaseClock clock;
     grid_ = snapped.grid;
-    // Reserved past the records' usual 7-8 bytes a triangle: grown by doubling, they were copied
-    // and their pages touched twice over (pages reserved and never written are not resident).
-    LargeArray<std::byte> leaves;
-    leaves.reserve(mesh.triangle_count() * 12 + kSlackBytes);
-    PartBytes parts;
-    // Leaf records are encoded as the wide tree reaches its leaves: their time is taken apart
-    // from the nodes' (two clock reads a leaf, well under 1% of the build).
-    double leaf_seconds = 0.0;
+    // The tree is laid out with every leaf weighing 1, so a node's leaf_base counts the leaves
+    // before it; the records are encoded in batches on every core as the leaves come, and the
+    // nodes' weights and leaf_base set from their sizes once the tree is done. Encoding is
+    // timed apart from the nodes (two clock reads a batch).
+    LeafRecordWriter writer(snapped, mesh.triangle_count());
     QuantizedWideTree tree = build_quantized_wide_tree(snapped.tree, [&](const BuildNode& leaf, const Bounds3& box) {
-      PhaseClock leaf_clock;
-      const std::size_t at = leaves.size();
-      encode_leaf(snapped.quantized, std::span(snapped.tree.primitive_order.data() + leaf.first, leaf.count),
-                  snap_outward(grid_, Box{box.lower, box.upper}), leaves);
-      const LeafHeader header = read_leaf_header(leaves.data() + at);
-      const std::size_t identity = stream_bytes(header.id_bits, leaf.count) + stream_bytes(3, leaf.count);
-      const std::size_t record = leaves.size() - at;
-      leaves.resize(at + (record + kUnit - 1) / kUnit * kUnit, std::byte{0});
-      parts.other += identity;
-      parts.geometry += record - identity;
-      parts.hierarchy += leaves.size() - at - record;
-      leaf_seconds += leaf_clock.lap();
-      return static_cast<std::uint32_t>((leaves.size() - at) / kUnit);
+      writer.add(leaf, box);
+      return 1u;
     }, options.layout);
-    build_.phases.add("nodes", clock.lap() - leaf_seconds);
-    build_.phases.add("leaves", leaf_seconds);
-    std::size_t encode_peak = tree.nodes.capacity() * sizeof(QuantizedWideNode) + leaves.size();  // reserved, untouched: not held
+    writer.flush();
+    set_leaf_weights(tree.nodes, writer.weights());
+    build_.phases.add("nodes", clock.lap() - writer.seconds());
+    build_.phases.add("leaves", writer.seconds());
+    LargeArray<std::byte> leaves = writer.take_records();
+    PartBytes parts = writer.parts();
+    std::size_t encode_peak = tree.nodes.capacity() * sizeof(QuantizedWideNode) + leaves.size() +
+                              writer.weights().size() + writer.batch_bytes();  // reserved, untouched: not held
     root_ = tree.root_frame;
     children_ = tree.children;
     node_count_ = tree.nodes.size();
