@@ -202,6 +202,19 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
 
   bool occupied(std::size_t d) const { return (domain_[d / 64] >> (d % 64)) & 1u; }
 
+  // Calls f(x) for each occupied cell of row (y, z), x ascending: the row's D bits a word at
+  // a time, since rows are mostly empty.
+  template <typename F>
+  void for_each_occupied_cell_of_row(std::uint32_t y, std::uint32_t z, F&& f) const {
+    const std::size_t first = cell_index(0, y, z), row_end = first + cells_.x;
+    for (std::size_t word = first / 64; word * 64 < row_end; ++word) {
+      std::uint64_t bits = domain_[word];
+      if (word * 64 < first) bits &= ~std::uint64_t{0} << (first - word * 64);
+      if ((word + 1) * 64 > row_end) bits &= ~std::uint64_t{0} >> ((word + 1) * 64 - row_end);
+      for (; bits != 0; bits &= bits - 1) f(std::uint32_t(word * 64 + std::countr_zero(bits) - first));
+    }
+  }
+
   // First fit from the last row's offset, as the paper builds O: each row's set cells land on
   // slots of the shared bit array bH that no earlier row took.
   void displace_rows() {
@@ -213,14 +226,7 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
     for (std::uint32_t z = 0; z < cells_.z; ++z) {
       for (std::uint32_t y = 0; y < cells_.y; ++y) {
         row.clear();
-        // The row's D bits, a word at a time: rows are mostly empty.
-        const std::size_t first = cell_index(0, y, z), row_end = first + cells_.x;
-        for (std::size_t word = first / 64; word * 64 < row_end; ++word) {
-          std::uint64_t bits = domain_[word];
-          if (word * 64 < first) bits &= ~std::uint64_t{0} << (first - word * 64);
-          if ((word + 1) * 64 > row_end) bits &= ~std::uint64_t{0} >> ((word + 1) * 64 - row_end);
-          for (; bits != 0; bits &= bits - 1) row.push_back(std::uint32_t(word * 64 + std::countr_zero(bits) - first));
-        }
+        for_each_occupied_cell_of_row(y, z, [&](std::uint32_t x) { row.push_back(x); });
         if (row.empty()) continue;  // never read: its D bits are all clear
         std::size_t offset = last_offset;
         while (std::any_of(row.begin(), row.end(), [&](std::uint32_t x) { return is_taken(offset + x); })) ++offset;
@@ -260,7 +266,7 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
       throw std::runtime_error("grid: more than 2^32 cell entries; lower accel.grid.density");
     }
     clock.lap(build_.phases, "prefix");
-    items_.resize(total);  // its first touch: on this VM a visible share of the build (measurements.md)
+    items_.resize(total);
     clock.lap(build_.phases, "allocate");
     for_each_slab_row_run([&](std::uint32_t t, std::uint32_t y, std::uint32_t z, std::uint32_t x_lower, std::uint32_t x_upper) {
       std::uint32_t* row = starts_.data() + slot_of(0, y, z);
@@ -273,6 +279,8 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
 
   // Macrocells (Wald et al. 2006, as the paper uses them): level k is a bit per block of
   // factor^k fine cells, set when any cell in the block holds items; levels stop at one block.
+  // Level 1 is read off D's rows in parallel; each level above off the one below, since a
+  // block holds items when one of its factor^3 sub-blocks does.
   void build_macrocells(std::uint32_t factor) {
     macrocell_factor_ = factor;
     if (factor < 2) return;
@@ -284,13 +292,24 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
       level.span = span;
       level.cells = (cells_ + span - 1u) / span;
       level.bits.assign((std::size_t(level.cells.x) * level.cells.y * level.cells.z + 63) / 64, 0);
-      for (std::size_t word = 0; word < domain_.size(); ++word) {
-        for (std::uint64_t bits = domain_[word]; bits != 0; bits &= bits - 1) {
-          const std::size_t d = word * 64 + std::size_t(std::countr_zero(bits));
-          const std::uint32_t x = std::uint32_t(d % cells_.x), y = std::uint32_t(d / cells_.x % cells_.y),
-                              z = std::uint32_t(d / (std::size_t(cells_.x) * cells_.y));
-          const std::size_t m = level.index(glm::uvec3(x, y, z) / span);
-          level.bits[m / 64] |= std::uint64_t{1} << (m % 64);
+      const auto mark = [&level](const glm::uvec3& block) {
+        const std::size_t m = level.index(block);
+        std::atomic_ref<std::uint64_t>(level.bits[m / 64]).fetch_or(std::uint64_t{1} << (m % 64), std::memory_order_relaxed);
+      };
+      if (macrocells_.empty()) {
+        tbb::parallel_for(std::size_t{0}, std::size_t(cells_.y) * cells_.z, [&](std::size_t row) {
+          const auto y = std::uint32_t(row % cells_.y), z = std::uint32_t(row / cells_.y);
+          for_each_occupied_cell_of_row(y, z, [&](std::uint32_t x) { mark(glm::uvec3(x, y, z) / span); });
+        });
+      } else {
+        const MacrocellLevel& below = macrocells_.back();
+        for (std::size_t word = 0; word < below.bits.size(); ++word) {
+          for (std::uint64_t bits = below.bits[word]; bits != 0; bits &= bits - 1) {
+            const std::size_t b = word * 64 + std::size_t(std::countr_zero(bits));
+            const glm::uvec3 block(std::uint32_t(b % below.cells.x), std::uint32_t(b / below.cells.x % below.cells.y),
+                                   std::uint32_t(b / (std::size_t(below.cells.x) * below.cells.y)));
+            mark(block / factor);
+          }
         }
       }
       cells = level.cells;
@@ -419,7 +438,7 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
   LargeArray<std::uint64_t> domain_;   // D
   LargeArray<std::uint32_t> offsets_;  // O
   LargeArray<std::uint32_t> starts_;   // H
-  LargeArray<std::uint32_t> items_;    // L
+  UnfilledLargeArray<std::uint32_t> items_;  // L: sized unwritten, first touched by the slab tasks that fill it
   BuildReport build_;
 };
 
