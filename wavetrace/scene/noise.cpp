@@ -29,7 +29,7 @@ const EdgeGradient& lattice_gradient(int x, int y, int z, std::uint32_t seed) {
 float dot(const EdgeGradient& g, const glm::vec3& offset) { return g.x * offset.x + g.y * offset.y + g.z * offset.z; }
 
 // The gradients of the cell a thread last visited, a slot per seed (a fractal's octaves have
-// seeds 101 apart: seven octaves take seven different slots). Shapes generate their vertices
+// seeds 101 apart, odd, so up to sixteen octaves take sixteen different slots). Shapes generate their vertices
 // in lattice order, and a fine vertex lattice visits a noise cell many times in a row, so
 // most calls skip the eight hashes; the gradients, and so the values, are the same.
 struct CellGradients {

@@ -5,8 +5,8 @@
 #include <bit>
 #include <chrono>
 #include <span>
-#include <vector>
 #include <stdexcept>
+#include <vector>
 
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
