@@ -145,6 +145,36 @@ TEST(AccelChoice, ChunksThatOverlapRankAChunkedStructureBelowAWholeOne) {
   EXPECT_TRUE(candidate(on_tiled, "raystrips").chunked);
 }
 
+// A chunked candidate that fits only when its chunks are built one at a time is taken so
+// (build.chunks_at_once = 1, named in its spec); with room for all workers' chunks it is not.
+TEST(AccelChoice, AChunkedBuildThatFitsOneChunkAtATimeIsBuiltSo) {
+  const SceneTraits sphere = traits_of("builtin:sphere:100k");
+  const AutoAllowance four_workers{kAutoProcessBaseBytes, 4};
+  const auto hmq8_with = [&](std::size_t budget, const AcceleratorOptions& base) {
+    return candidate(choose_accelerator(sphere, budget, 0.01, base, true, four_workers), "hmq");
+  };
+  AcceleratorOptions one_at_a_time = small_chunks();
+  one_at_a_time.chunks_at_once = 1;
+  const double four_at_once = hmq8_with(world_budget(100000), small_chunks()).estimated_bytes;
+  const double one = hmq8_with(world_budget(100000), one_at_a_time).estimated_bytes;
+  ASSERT_LT(one, four_at_once);
+  const AccelCandidate between = hmq8_with(std::size_t((one + four_at_once) / 2), small_chunks());
+  EXPECT_TRUE(between.fits) << between.reason;
+  EXPECT_EQ(between.options.chunks_at_once, 1u);
+  EXPECT_NE(between.spec.find(":chunks_at_once=1"), std::string::npos) << between.spec;
+  EXPECT_EQ(between.estimated_bytes, one);
+  const AccelCandidate roomy = hmq8_with(std::size_t(four_at_once) + 1, small_chunks());
+  EXPECT_TRUE(roomy.fits);
+  EXPECT_EQ(roomy.options.chunks_at_once, 0u);
+  // Below one chunk's peak nothing fits this scene: auto says so, naming hmq8's need.
+  try {
+    hmq8_with(std::size_t(one) - 1, small_chunks());
+    ADD_FAILURE() << "nothing should fit below one chunk at a time";
+  } catch (const ConfigError& error) {
+    EXPECT_NE(std::string(error.what()).find("hmq:width=8"), std::string::npos) << error.what();
+  }
+}
+
 TEST(AccelChoice, TheChosenHmqGridMeetsTheErrorBound) {
   const Scene scene = make_builtin_scene("builtin:sphere:100k");
   const MeshTriangleSource source(scene.mesh);
