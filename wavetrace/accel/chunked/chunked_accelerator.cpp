@@ -68,7 +68,7 @@ struct RoundScratch {
 // Chunks built at the same time: one per worker thread, as many as half the memory the
 // machine has available now can hold at a build's measured 200 bytes per triangle, and no
 // more than `limit` (0: no limit). One at a time, a build's temporaries are one chunk's, its
-// cores shared inside the chunk (build.chunks_at_once; measurements.md, "Build speed").
+// cores shared inside the chunk (build.chunks_at_once; measurements.md, "building one chunk at a time").
 std::size_t chunks_built_at_once(std::size_t chunk_triangles, std::size_t limit) {
   const std::size_t threads = static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
   const std::size_t affordable = available_memory_bytes() / 2 / (chunk_triangles * 200);

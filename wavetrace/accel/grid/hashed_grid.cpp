@@ -169,8 +169,8 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
     });
   }
 
-  // Calls row_run(y, z, x_lower, x_upper) for each row of cells every triangle of a slab
-  // overlaps, its layers only, triangles in ascending order; slabs in parallel.
+  // Calls row_run(t, y, z, x_lower, x_upper) for each row of cells (y, z) that triangle t of a
+  // slab overlaps, within the slab's layers, triangles in ascending order; slabs in parallel.
   template <typename RowRun>
   void for_each_slab_row_run(RowRun&& row_run) const {
     tbb::parallel_for(std::size_t{0}, slab_starts_.size() - 1, [&](std::size_t slab) {
@@ -408,7 +408,7 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
   static constexpr std::size_t kTriangleBlocks = 64;
   std::uint32_t slab_layers_ = 1;
   std::vector<std::size_t> slab_starts_;      // slab s lists slab_triangles_[starts[s] .. starts[s + 1])
-  LargeArray<std::uint32_t> slab_triangles_;  // build temporary, freed once the lists are filled
+  UnfilledLargeArray<std::uint32_t> slab_triangles_;  // build temporary: sized unwritten, filled, freed after the lists
   struct MacrocellLevel {
     std::uint32_t span = 1;  // fine cells per block side
     glm::uvec3 cells{1};
