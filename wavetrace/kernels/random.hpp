@@ -17,6 +17,7 @@ enum class RandomPurpose : std::uint32_t {
   scene_generation = 6,
   benchmark = 7,
   simplification = 8,
+  fresnel_choice = 9,
 };
 
 // A 64-bit finalizer (SplitMix64's): full avalanche, cheap, and good enough for sampling.

@@ -16,7 +16,10 @@ namespace wavetrace {
 inline constexpr std::uint32_t kInvalidPrimitive = std::numeric_limits<std::uint32_t>::max();
 inline constexpr std::size_t kDefaultBatchCapacity = 4096;
 
-enum class RayKind : std::uint8_t { camera = 0, bounce = 1, shadow = 2 };
+// A specular ray leaves a mirror or glass: no light was sampled where it starts, so like a
+// camera ray it sees the emission it hits.
+enum class RayKind : std::uint8_t { camera = 0, bounce = 1, shadow = 2, specular = 3 };
+inline bool sees_emission(RayKind kind) { return kind == RayKind::camera || kind == RayKind::specular; }
 
 // Bits of RayBatch::flags.
 namespace ray_flags {

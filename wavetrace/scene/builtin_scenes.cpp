@@ -108,7 +108,9 @@ Scene make_room(std::string name, std::size_t triangles, bool streamed) {
 
 bool is_builtin_scene(std::string_view source) { return source.starts_with(kPrefix); }
 
-std::vector<std::string> builtin_scene_names() { return {"sphere", "terrain", "soup", "stadium", "fur", "default", "room"}; }
+std::vector<std::string> builtin_scene_names() {
+  return {"sphere", "ball", "plane", "terrain", "soup", "stadium", "fur", "default", "room", "furnace"};
+}
 
 std::size_t parse_triangle_count(std::string_view text, std::string_view what) {
   std::size_t multiplier = 1;
@@ -145,9 +147,9 @@ struct BuiltinCount {
   std::string_view name;
   std::size_t fallback, least;
 };
-constexpr BuiltinCount kBuiltinCounts[] = {{"sphere", 1000000, 0}, {"soup", 1000000, 0},    {"terrain", 1000000, 0},
-                                           {"stadium", 1000000, 32}, {"fur", 1000000, 200}, {"default", 200000, 0},
-                                           {"room", 1000000, 2000}};
+constexpr BuiltinCount kBuiltinCounts[] = {{"sphere", 1000000, 0},  {"ball", 20000, 0},       {"plane", 2, 0}, {"soup", 1000000, 0},
+                                           {"terrain", 1000000, 0}, {"stadium", 1000000, 32}, {"fur", 1000000, 200},
+                                           {"default", 200000, 0},  {"room", 1000000, 2000},  {"furnace", 20000, 0}};
 
 std::string_view builtin_name(std::string_view source) {
   const std::string_view spec = source.substr(kPrefix.size());
@@ -175,6 +177,16 @@ Scene make_builtin_scene(std::string_view source, bool streamed) {
   if (name == "sphere") {
     return single_object(label, displaced_sphere_shape(count, glm::vec3(0.0f), 1.0f, kSeed),
                          Material{glm::vec3(0.7f)}, streamed);
+  }
+  if (name == "ball") return single_object(label, smooth_sphere_shape(count, glm::vec3(0.0f), 1.0f), Material{}, streamed);
+  if (name == "plane") return single_object(label, terrain_shape(count, 2.0f, 0.0f, kSeed), Material{}, streamed);
+  if (name == "furnace") {
+    // Every wall emits kFurnaceEmission and reflects kFurnaceAlbedo diffusely, so the radiance
+    // everywhere inside is emission / (1 - albedo): the closed form a renderer is checked by.
+    Scene scene = single_object(label, smooth_sphere_shape(count, glm::vec3(0.0f), 1.0f, true),
+                                Material{glm::vec3(kFurnaceAlbedo), glm::vec3(kFurnaceEmission)}, streamed);
+    scene.camera = Camera{glm::vec3(0.0f), glm::vec3(0.0f, 0.0f, -1.0f), glm::vec3(0.0f, 1.0f, 0.0f), 60.0f};
+    return scene;
   }
   if (name == "soup") return single_object(label, soup_shape(count, kSeed), Material{glm::vec3(0.7f)}, streamed);
   if (name == "terrain") {

@@ -1,5 +1,7 @@
 // Procedural scenes named builtin:NAME[:TRIANGLES]; deterministic and generated in parallel.
 //   sphere   a closed, fractally displaced icosphere (20 triangles and up)
+//   ball     a smooth icosphere of radius 1 at the origin, facing out (glass in scene files)
+//   plane    a flat square of side 2 centred on the origin in the xz plane, facing +y
 //   terrain  a fractal heightfield
 //   soup     the sphere's triangles with no shared vertices (no connectivity at all)
 //   stadium  a small dense sphere inside a huge, sparse box (the grids' failure case)
@@ -7,6 +9,8 @@
 //   default  a displaced sphere on a ground plane under an area light, framed by the camera
 //   room     a closed room lit from its ceiling holding displaced spheres, a terrain patch
 //            and fur; the camera inside (the benchmark scene for bounces and reordering)
+//   furnace  a closed sphere facing inward whose walls all emit kFurnaceEmission and reflect
+//            kFurnaceAlbedo, the camera at its centre: radiance emission / (1 - albedo) = 2
 #pragma once
 
 #include <cstddef>
@@ -18,6 +22,9 @@
 #include "wavetrace/scene/scene.hpp"
 
 namespace wavetrace {
+
+inline constexpr float kFurnaceEmission = 1.0f;
+inline constexpr float kFurnaceAlbedo = 0.5f;
 
 bool is_builtin_scene(std::string_view source);
 std::vector<std::string> builtin_scene_names();

@@ -2,6 +2,7 @@
 // gives, and the camera its author suggests.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -16,11 +17,23 @@
 
 namespace wavetrace {
 
-// Lambertian reflection plus optional emission (emitting from the front face only).
+// How a surface scatters light: Lambertian, a perfect mirror, or a smooth dielectric (glass)
+// that reflects or refracts by Fresnel's equations.
+enum class Surface : std::uint32_t { diffuse = 0, mirror = 1, glass = 2 };
+Surface parse_surface(const std::string& text);  // "diffuse", "mirror", "glass"; else SceneError
+std::string to_string(Surface surface);
+
+// A surface plus optional emission (emitting from the front face only). `albedo` is the
+// diffuse reflectance, or a mirror's reflectance, or glass's tint of both reflected and
+// transmitted light. Glass takes its front face (the triangles' winding, counter-clockwise
+// seen from outside) as its outside, where the index of refraction is 1.
 struct Material {
   glm::vec3 albedo{0.7f};
   glm::vec3 emission{0.0f};
+  Surface surface = Surface::diffuse;
+  float ior = 1.5f;  // glass only: index of refraction inside
   bool emissive() const { return emission.x > 0.0f || emission.y > 0.0f || emission.z > 0.0f; }
+  bool specular() const { return surface != Surface::diffuse; }
 };
 
 struct Scene {

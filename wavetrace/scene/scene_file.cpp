@@ -74,6 +74,11 @@ class TableReader {
     }
     return result;
   }
+  const toml::table* table(std::string_view key) const {
+    const toml::table* value = table_[key].as_table();
+    if (value == nullptr) throw SceneError(fmt::format("{}: {} must be a table ({} = {{ ... }})", what_, key, key));
+    return value;
+  }
   glm::vec3 color(std::string_view key, float high) const {
     const glm::vec3 value = vector(key, true);
     for (int channel = 0; channel < 3; ++channel) {
@@ -105,6 +110,8 @@ std::vector<const toml::table*> tables_of(const toml::table& root, std::string_v
 
 constexpr float kMaxAlbedo = 1.0f;
 constexpr float kMaxEmission = 1e6f;
+// Indices of refraction from air's to past diamond's (2.42) and the densest glasses'.
+constexpr double kMinIor = 1.0, kMaxIor = 4.0;
 
 // The object's mesh and its own materials (a builtin's, or the default for a file).
 struct ObjectGeometry {
@@ -154,6 +161,43 @@ class TriangleBudget {
   double left_, total_;
 };
 
+// An object's material: `material = { type, albedo, emission, ior }`, or the shorthand of
+// `albedo` and `emission` beside the mesh (diffuse), never both.
+Material object_material(const TableReader& object) {
+  if (!object.has("material")) {
+    Material material;
+    if (object.has("albedo")) material.albedo = object.color("albedo", kMaxAlbedo);
+    if (object.has("emission")) material.emission = object.color("emission", kMaxEmission);
+    return material;
+  }
+  if (object.has("albedo") || object.has("emission")) {
+    throw SceneError(fmt::format("{}: give albedo and emission inside 'material', not beside it", object.what()));
+  }
+  const toml::table* table = object.table("material");
+  const TableReader reader(*table, object.what() + ": material", {"type", "albedo", "emission", "ior"});
+  Material material;
+  if (reader.has("type")) {
+    try {
+      material.surface = parse_surface(reader.text("type"));
+    } catch (const SceneError& error) {
+      throw SceneError(fmt::format("{}: {}", reader.what(), error.what()));
+    }
+  }
+  // A mirror or glass reflects (and glass transmits) all light unless tinted.
+  if (material.specular()) material.albedo = glm::vec3(1.0f);
+  if (reader.has("albedo")) material.albedo = reader.color("albedo", kMaxAlbedo);
+  if (reader.has("emission")) material.emission = reader.color("emission", kMaxEmission);
+  if (reader.has("ior")) {
+    if (material.surface != Surface::glass) throw SceneError(fmt::format("{}: ior is for glass only", reader.what()));
+    const double ior = reader.number("ior");
+    if (ior < kMinIor || ior > kMaxIor) {
+      throw SceneError(fmt::format("{}: ior must be in [{:g}, {:g}]", reader.what(), kMinIor, kMaxIor));
+    }
+    material.ior = static_cast<float>(ior);
+  }
+  return material;
+}
+
 void add_object(SceneAssembly& assembly, const TableReader& object, const std::filesystem::path& directory,
                 TriangleBudget& budget) {
   if (!object.has("mesh")) throw SceneError(fmt::format("{}: 'mesh' is required", object.what()));
@@ -164,10 +208,8 @@ void add_object(SceneAssembly& assembly, const TableReader& object, const std::f
   if (object.has("translate")) transform.translate = object.vector("translate", false);
   validate_transform(transform, object.what());
   const int subdivide = object.has("subdivide") ? static_cast<int>(object.integer("subdivide", 0, 6)) : 0;
-  const bool own_material = object.has("albedo") || object.has("emission");
-  Material material;
-  if (object.has("albedo")) material.albedo = object.color("albedo", kMaxAlbedo);
-  if (object.has("emission")) material.emission = object.color("emission", kMaxEmission);
+  const bool own_material = object.has("albedo") || object.has("emission") || object.has("material");
+  const Material material = object_material(object);
 
   const std::string source = object.text("mesh");
   // A builtin is charged before it is generated, a mesh file once read (its size bounds it).
@@ -232,7 +274,8 @@ Scene load_scene_file(const std::string& path, const SceneFileLimits& limits) {
   if (objects.empty() && lights.empty()) throw SceneError(fmt::format("{}: the scene has no [[object]]", path));
   for (std::size_t i = 0; i < objects.size(); ++i) {
     const TableReader object(*objects[i], object_label("object", i, *objects[i], path),
-                             {"name", "mesh", "fit", "scale", "rotate", "translate", "subdivide", "albedo", "emission"});
+                             {"name", "mesh", "fit", "scale", "rotate", "translate", "subdivide", "albedo", "emission",
+                              "material"});
     add_object(assembly, object, directory, budget);
   }
   for (std::size_t i = 0; i < lights.size(); ++i) {

@@ -17,6 +17,10 @@
 //   subdivide = 0                          # Loop subdivision levels of this object, 0-6
 //   albedo = [0.8, 0.5, 0.3]               # with emission, replaces the mesh's own materials
 //   emission = [0, 0, 0]
+//   material = { type = "glass", ior = 1.5 }   # instead of albedo and emission beside the mesh:
+//                                          # type diffuse (default), mirror or glass; albedo
+//                                          # (default 1 for mirror and glass), emission, ior
+//                                          # (glass only, [1, 4], default 1.5)
 //   [[light]]                              # a parallelogram emitting along cross(edge_u, edge_v)
 //   corner = [-0.5, 3, -0.5]
 //   edge_u = [1, 0, 0]

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cmath>
+#include <optional>
 #include <map>
 
 #include <glm/geometric.hpp>
@@ -122,14 +123,17 @@ std::uint32_t icosphere_frequency(std::size_t triangles) {
 
 class SphereShape final : public ShapeGenerator {
  public:
-  SphereShape(std::size_t triangles, const glm::vec3& center, float radius, std::uint32_t seed)
-      : n_(icosphere_frequency(triangles)), lattice_(n_), center_(center), radius_(radius), seed_(seed) {}
+  // A seed displaces the surface by fractal noise; none leaves it a smooth icosphere.
+  SphereShape(std::size_t triangles, const glm::vec3& center, float radius, std::optional<std::uint32_t> seed,
+              bool inward = false)
+      : n_(icosphere_frequency(triangles)), lattice_(n_), center_(center), radius_(radius), seed_(seed), inward_(inward) {}
   std::size_t triangle_count() const override { return lattice_.triangle_count(); }
   std::size_t vertex_count() const override { return lattice_.vertex_count(); }
   glm::vec3 position(std::uint64_t id) const override {
     const glm::vec3 direction = lattice_.direction(id);
+    if (!seed_) return center_ + direction * radius_;
     const float displacement =
-        kDisplacementAmplitude * fractal_noise(direction * kDisplacementFrequency, kDisplacementOctaves, seed_);
+        kDisplacementAmplitude * fractal_noise(direction * kDisplacementFrequency, kDisplacementOctaves, *seed_);
     return center_ + direction * (radius_ * (1.0f + displacement));
   }
   // Face f holds n^2 triangles in rows; row i has n-i "up" and n-i-1 "down" triangles,
@@ -153,6 +157,7 @@ class SphereShape final : public ShapeGenerator {
         corner[1] = lattice_.vertex(face, i + 1, j + 1);
         corner[2] = lattice_.vertex(face, i, j + 1);
       }
+      if (inward_) std::swap(corner[1], corner[2]);
       if (++p == 2 * std::size_t(n_ - i) - 1) {  // the row is done
         p = 0;
         if (++i == n_) {
@@ -168,7 +173,8 @@ class SphereShape final : public ShapeGenerator {
   IcosphereLattice lattice_;
   glm::vec3 center_;
   float radius_;
-  std::uint32_t seed_;
+  std::optional<std::uint32_t> seed_;
+  bool inward_;
 };
 
 // The sphere's triangles, each with three vertices of its own.
@@ -418,6 +424,10 @@ TriangleMesh inward_box_mesh(const glm::vec3& lower, const glm::vec3& upper) {
 std::unique_ptr<ShapeGenerator> displaced_sphere_shape(std::size_t triangles, const glm::vec3& center, float radius,
                                                        std::uint32_t seed) {
   return std::make_unique<SphereShape>(triangles, center, radius, seed);
+}
+std::unique_ptr<ShapeGenerator> smooth_sphere_shape(std::size_t triangles, const glm::vec3& center, float radius,
+                                                    bool inward) {
+  return std::make_unique<SphereShape>(triangles, center, radius, std::nullopt, inward);
 }
 std::unique_ptr<ShapeGenerator> soup_shape(std::size_t triangles, std::uint32_t seed) {
   return std::make_unique<SoupShape>(triangles, seed);

@@ -21,6 +21,11 @@ TriangleMesh make_quad(const glm::vec3& corner, const glm::vec3& u, const glm::v
 // `triangles`, radius about `radius` (displaced by up to 12%), centred at `center`.
 std::unique_ptr<ShapeGenerator> displaced_sphere_shape(std::size_t triangles, const glm::vec3& center, float radius,
                                                        std::uint32_t seed);
+// The same icosphere undisplaced: every vertex at `radius` from `center`, triangles wound
+// counter-clockwise seen from outside (the glass of a caustic scene), or from inside when
+// `inward` (a furnace's walls).
+std::unique_ptr<ShapeGenerator> smooth_sphere_shape(std::size_t triangles, const glm::vec3& center, float radius,
+                                                    bool inward = false);
 // The unit sphere's triangles (centred at the origin), each with three vertices of its own.
 std::unique_ptr<ShapeGenerator> soup_shape(std::size_t triangles, std::uint32_t seed);
 // A fractal heightfield of size x size around the origin, heights within about +-height.

@@ -64,7 +64,21 @@ struct SavedProxyInfo {
   double hit_agreement, hit_overlap, mean_distance_error;
 };
 static_assert(sizeof(SavedProxyInfo) == 48);
-static_assert(sizeof(Material) == 24 && sizeof(LightSampler::EmissiveTriangle) == 64);
+static_assert(sizeof(LightSampler::EmissiveTriangle) == 64);
+
+// "scene.materials", 24 bytes a material: albedo, emission (float x, y, z each, offsets 0
+// and 12). Worlds saved before mirrors and glass hold only these: all diffuse.
+struct SavedMaterialColors {
+  glm::vec3 albedo, emission;
+};
+static_assert(sizeof(SavedMaterialColors) == 24);
+// "scene.material_surfaces", 8 bytes a material, in the same order: Surface (uint32,
+// 0 diffuse, 1 mirror, 2 glass), ior (float).
+struct SavedMaterialSurface {
+  std::uint32_t surface;
+  float ior;
+};
+static_assert(sizeof(SavedMaterialSurface) == 8);
 
 std::span<const std::byte> text_bytes(const std::string& text) { return std::as_bytes(std::span(text.data(), text.size())); }
 
@@ -125,7 +139,14 @@ void save_world(SectionWriter& out, const Scene& scene, const LightSampler& ligh
   scene_info.subdivision_levels = scene.subdivision_levels;
   scene_info.non_manifold_faces_dropped = scene.non_manifold_faces_dropped;
   out.add_value("scene.info", scene_info);
-  out.add_array("scene.materials", std::span<const Material>(scene.materials));
+  std::vector<SavedMaterialColors> colors;
+  std::vector<SavedMaterialSurface> surfaces;
+  for (const Material& material : scene.materials) {
+    colors.push_back({material.albedo, material.emission});
+    surfaces.push_back({static_cast<std::uint32_t>(material.surface), material.ior});
+  }
+  out.add_array("scene.materials", std::span<const SavedMaterialColors>(colors));
+  out.add_array("scene.material_surfaces", std::span<const SavedMaterialSurface>(surfaces));
   out.add_array("scene.material_runs.first", scene.material_runs.firsts());
   out.add_array("scene.material_runs.material", scene.material_runs.materials());
   out.add_array("scene.lights", lights.triangles());
@@ -182,8 +203,22 @@ std::unique_ptr<LoadedWorld> load_world(const std::string& path, const std::opti
   scene.cleanup.degenerate_dropped = info.degenerate_dropped;
   scene.subdivision_levels = info.subdivision_levels;
   scene.non_manifold_faces_dropped = info.non_manifold_faces_dropped;
-  const auto materials = file.array<Material>("scene.materials");
-  scene.materials.assign(materials.begin(), materials.end());
+  for (const SavedMaterialColors& colors : file.array<SavedMaterialColors>("scene.materials")) {
+    scene.materials.push_back(Material{colors.albedo, colors.emission});
+  }
+  if (file.has("scene.material_surfaces")) {
+    const auto surfaces = file.array<SavedMaterialSurface>("scene.material_surfaces");
+    if (surfaces.size() != scene.materials.size()) {
+      file.fail("scene.material_surfaces", "lists a different number of materials than scene.materials");
+    }
+    for (std::size_t i = 0; i < surfaces.size(); ++i) {
+      if (surfaces[i].surface > static_cast<std::uint32_t>(Surface::glass) || !(surfaces[i].ior >= 1.0f)) {
+        file.fail("scene.material_surfaces", fmt::format("material {} has an unknown surface or an ior under 1", i));
+      }
+      scene.materials[i].surface = static_cast<Surface>(surfaces[i].surface);
+      scene.materials[i].ior = surfaces[i].ior;
+    }
+  }
   try {
     scene.material_runs = MaterialRuns::from_runs(file.array<std::uint64_t>("scene.material_runs.first"),
                                                   file.array<std::uint32_t>("scene.material_runs.material"));

@@ -6,6 +6,8 @@
 //   scene.name                  bytes: the scene's name, UTF-8
 //   scene.info                  SavedSceneInfo (below)
 //   scene.materials             24 bytes a material: albedo, emission (float x, y, z each)
+//   scene.material_surfaces     8 bytes a material: Surface (uint32), ior (float); absent in
+//                               worlds saved before mirrors and glass (all diffuse)
 //   scene.material_runs.first   uint64 a run: its first triangle (MaterialRuns)
 //   scene.material_runs.material  uint32 a run: its material
 //   scene.lights                64 bytes a light (LightSampler::EmissiveTriangle)

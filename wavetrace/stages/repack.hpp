@@ -25,7 +25,7 @@ class RepackStage final : public BufferingStage {
 
  private:
   std::size_t min_rays_;
-  static constexpr std::size_t kKinds = 3;  // RayKind: camera, bounce, shadow
+  static constexpr std::size_t kKinds = 4;  // RayKind: camera, bounce, shadow, specular
   mutable Batch* open_[kKinds] = {};         // the batches being filled, by kind
 
   mutable std::atomic<std::size_t> buffered_rays_{0};

@@ -34,7 +34,7 @@ std::size_t ShadeStage::shade(Batch& batch, RayRange range) const {
     }
     const glm::vec3 throughput(rays.throughput_r[i], rays.throughput_g[i], rays.throughput_b[i]);
     const Material& material = scene.materials[hits.material[i]];
-    if (material.emissive() && rays.kind[i] == RayKind::camera) {
+    if (material.emissive() && sees_emission(rays.kind[i])) {
       // Bounce rays do not count emission: next-event estimation already sampled the lights.
       const glm::vec3 direction(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]);
       if (glm::dot(hits.normal(i), direction) < 0.0f) {

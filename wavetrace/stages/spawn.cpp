@@ -1,4 +1,5 @@
-// Next-event estimation and bounce sampling for a diffuse path tracer.
+// Next-event estimation and bounce sampling for a path tracer: diffuse surfaces in vectorized
+// chunks, mirrors and glass one ray at a time.
 #include "wavetrace/stages/spawn.hpp"
 
 #include <limits>
@@ -9,6 +10,7 @@
 #include "wavetrace/kernels/random.hpp"
 #include "wavetrace/kernels/ray_offset.hpp"
 #include "wavetrace/kernels/sampling.hpp"
+#include "wavetrace/kernels/specular.hpp"
 
 namespace wavetrace {
 namespace {
@@ -27,6 +29,29 @@ void write_ray(RayBatch& to, std::size_t slot, const RayBatch& parent, std::size
   to.throughput_g[slot] = throughput.g;
   to.throughput_b[slot] = throughput.b;
   to.flags[slot] = ray_flags::alive;
+}
+
+// The bounce off a mirror or glass: its one direction (glass chooses reflection or
+// refraction by Fresnel), no light sample, and a specular ray that sees what it hits.
+void write_specular_bounce(const RayBatch& rays, const HitBatch& hits, std::size_t i, const Material& material,
+                           const PathRules& rules, RayBatch& bounces) {
+  const glm::vec3 incoming =
+      glm::normalize(glm::vec3(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]));
+  const glm::vec3 outward = glm::normalize(hits.normal(i));
+  SpecularScatter scatter{reflect_direction(incoming, outward), false};
+  if (material.surface == Surface::glass) {
+    const float u = unit_float32(
+        path_draw(path_key(rays.pixel[i], rays.sample[i]), rays.depth[i], RandomPurpose::fresnel_choice));
+    scatter = glass_scatter(incoming, outward, material.ior, u);
+  }
+  // The origin moves off the surface to the side the new ray leaves on.
+  const glm::vec3 side = glm::dot(scatter.direction, outward) > 0.0f ? outward : -outward;
+  const glm::vec3 throughput(rays.throughput_r[i], rays.throughput_g[i], rays.throughput_b[i]);
+  glm::vec3 weight = throughput * material.albedo;
+  if (rules.roulette_applies(rays.depth[i])) weight /= survival_probability(material.albedo);
+  write_ray(bounces, bounces.count++, rays, i, offset_ray_origin(hits.point(i), side), scatter.direction,
+            std::numeric_limits<float>::infinity(), RayKind::specular, static_cast<std::uint16_t>(rays.depth[i] + 1),
+            weight);
 }
 
 }  // namespace
@@ -91,6 +116,11 @@ void SpawnStage::spawn(const Batch& batch, RayRange range, RayBatch& bounces, Ra
     c.count = 0;
     for (; next < range.end && c.count < SpawnChunk::kCapacity; ++next) {
       if (!(rays.flags[next] & ray_flags::alive)) continue;
+      const Material& material = materials[hits.material[next]];
+      if (material.specular()) {  // rare beside diffuse hits: one ray at a time, outside the chunk
+        if (rays.flags[next] & ray_flags::continues) write_specular_bounce(rays, hits, next, material, rules_, bounces);
+        continue;
+      }
       const std::uint32_t k = c.count++;
       c.ray[k] = next;
       c.depth[k] = rays.depth[next];
@@ -108,7 +138,7 @@ void SpawnStage::spawn(const Batch& batch, RayRange range, RayBatch& bounces, Ra
       c.normal[0][k] = hits.normal_x[next];
       c.normal[1][k] = hits.normal_y[next];
       c.normal[2][k] = hits.normal_z[next];
-      const glm::vec3& albedo = materials[hits.material[next]].albedo;
+      const glm::vec3& albedo = material.albedo;
       c.weight[0][k] = rays.throughput_r[next] * albedo.x;
       c.weight[1][k] = rays.throughput_g[next] * albedo.y;
       c.weight[2][k] = rays.throughput_b[next] * albedo.z;

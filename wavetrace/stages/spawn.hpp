@@ -1,6 +1,6 @@
-// spawn: from each surviving hit, a shadow ray toward a light sample (carrying the light
-// it would deliver) and, if the path continues, a cosine-weighted bounce ray; each kind
-// goes out in its own batch.
+// spawn: from each surviving diffuse hit, a shadow ray toward a light sample (carrying the
+// light it would deliver) and, if the path continues, a cosine-weighted bounce ray; from a
+// mirror or glass, only its specular ray. Shadow rays go out in a batch of their own.
 #pragma once
 
 #include "wavetrace/stages/path_rules.hpp"
