@@ -183,6 +183,27 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
         {"path", facts.image_path}}},
   };
   if (facts.proxy != nullptr) stats["proxy"] = proxy_json(*facts.proxy);
+  render["integrator"] = facts.plan.integrator == Integrator::photon ? "photon" : "path";
+  if (const std::optional<PhotonPassReport>& photons = facts.output.photons) {
+    nlohmann::json photon_stages = nlohmann::json::array();
+    for (const StageStats& stage : photons->run.stages) {
+      photon_stages.push_back({{"name", stage.name},
+                               {"rays_in", stage.rays_in},
+                               {"rays_out", stage.rays_out},
+                               {"seconds", stage.seconds},
+                               {"mrays_per_s", stage.mrays_per_s()}});
+    }
+    stats["photons"] = {{"emitted", photons->emitted},
+                        {"global_photons", photons->global_photons},
+                        {"caustic_photons", photons->caustic_photons},
+                        {"k", facts.plan.photon.k},
+                        {"radius", photons->radius},
+                        {"gather_rays", facts.plan.photon.gather_rays},
+                        {"seconds", photons->run.seconds},
+                        {"map_seconds", photons->map_seconds},
+                        {"stages", photon_stages}};
+  }
+  stats["render"] = render;
   const RenderPhases& measured = facts.phases;
   stats["memory"] = {{"peak_rss_bytes", measured.peak_rss_bytes},
                      {"after_load_bytes", measured.after_load_bytes},
@@ -226,15 +247,37 @@ nlohmann::json distribute_json(const DistributedRender& render, const RenderPlan
           {"per_rank", ranks}};
 }
 
+namespace {
+
+// One row per stage of a run: rays in and out, busy seconds, share of the run's thread-seconds.
+std::string stage_rows(const PipelineRun& run) {
+  const double thread_seconds = run.seconds * run.threads;
+  std::string rows = fmt::format("{:<15} {:>14} {:>14} {:>10} {:>8} {:>12}\n", "stage", "rays in", "rays out",
+                                 "seconds", "share", "Mrays/s/thr");
+  for (const StageStats& stage : run.stages) {
+    rows += fmt::format("{:<15} {:>14} {:>14} {:>10.3f} {:>7.1f}% {:>12.2f}\n", stage.name, stage.rays_in,
+                        stage.rays_out, stage.seconds, 100.0 * stage.seconds / thread_seconds, stage.mrays_per_s());
+  }
+  return rows;
+}
+
+}  // namespace
+
 std::string render_table(const RenderFacts& facts) {
   const PipelineRun& run = facts.output.run;
   const double thread_seconds = run.seconds * run.threads;
-  std::string table = fmt::format("{:<10} {:>14} {:>14} {:>10} {:>8} {:>12}\n", "stage", "rays in", "rays out",
-                                  "seconds", "share", "Mrays/s/thr");
+  std::string table;
+  if (const std::optional<PhotonPassReport>& photons = facts.output.photons) {
+    table += fmt::format("photon pass: {} photons emitted in {:.3f} s; {} landed ({} by specular paths: the caustic "
+                         "map), maps built in {:.3f} s; estimates of k = {} within {:.4g}\n",
+                         photons->emitted, photons->run.seconds, photons->global_photons, photons->caustic_photons,
+                         photons->map_seconds, facts.plan.photon.k, photons->radius);
+    table += stage_rows(photons->run);
+    table += "camera pass:\n";
+  }
+  table += stage_rows(run);
   double traced = 0.0;
   for (const StageStats& stage : run.stages) {
-    table += fmt::format("{:<10} {:>14} {:>14} {:>10.3f} {:>7.1f}% {:>12.2f}\n", stage.name, stage.rays_in,
-                         stage.rays_out, stage.seconds, 100.0 * stage.seconds / thread_seconds, stage.mrays_per_s());
     if (stage.name == "trace" || stage.name == "megakernel") traced = double(stage.rays_in);
   }
   if (!facts.output.hit_rates.empty()) {

@@ -7,7 +7,7 @@ cd "$root"
 
 packages=(build-essential cmake pkg-config libembree-dev libtbb-dev libopenmesh-dev libglm-dev
   libopenexr-dev libimath-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev libgtest-dev
-  libbenchmark-dev libpng-dev libfmt-dev libxxhash-dev python3-matplotlib libcgal-demo openmpi-bin libopenmpi-dev)
+  libbenchmark-dev libpng-dev libfmt-dev libxxhash-dev libnanoflann-dev python3-matplotlib libcgal-demo openmpi-bin libopenmpi-dev)
 bash scripts/install_missing.sh "${packages[@]}"
 
 # Real scanned and CAD meshes (OFF/PLY) from CGAL's demo data, e.g. data/bunny00.off.

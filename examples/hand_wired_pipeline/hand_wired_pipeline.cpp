@@ -27,7 +27,7 @@ int main(int argc, char** argv) {
 
   GenerateStage generate(camera, ImageSpec{320, 240, 1}, PixelOrder::scanline);
   Film film(320, 240);  // approx_hit puts the sky of rays missing the scene's box here
-  ApproxHitStage approx_hit(proxy, film, scene.background);
+  ApproxHitStage approx_hit(proxy, &film, scene.background);
   ZSortStage zsort(ZSortOptions{ReorderHeuristic::hph, CurveKind::hilbert, 1 << 14}, scene.bounds);
   TraceStage trace(*accelerator, scene.material_runs);
   PipelineContext context(/*batch_capacity=*/1024, /*rays_in_flight=*/1 << 16);

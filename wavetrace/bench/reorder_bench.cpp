@@ -45,6 +45,10 @@ ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<Reo
   report.curve = to_string(base.reorder.curve);
   report.image = fmt::format("{}x{}, {} spp, depth {}", base.image.width, base.image.height,
                              base.image.samples_per_pixel, base.rules.max_depth);
+  if (base.integrator == Integrator::photon) {
+    report.image += fmt::format(", photon mapping ({} photons, k = {}, {} gathering rays)", base.photon.count,
+                                base.photon.k, base.photon.gather_rays);
+  }
   if (proxy) {
     const ProxyReport& p = proxy->report();
     report.proxy = fmt::format("{} triangles ({:.4g}% of the scene) by {} on {}; hit overlap {:.1f}%", p.triangles,
@@ -71,10 +75,10 @@ ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<Reo
 
     ReorderBenchResult result;
     result.heuristic = to_string(heuristic);
-    result.render_seconds = output.run.seconds;
+    result.render_seconds = output.seconds();
     result.closest_mrays_per_s = output.closest_mrays_per_s;
     result.shadow_mrays_per_s = output.any_mrays_per_s;
-    const double thread_seconds = output.run.seconds * output.run.threads;
+    const double thread_seconds = output.seconds() * output.run.threads;
     if (const StageStats* trace = find_stage(output.run, "trace")) {
       result.trace_seconds = trace->seconds;
       result.trace_mrays_per_s = trace->mrays_per_s();
@@ -112,6 +116,23 @@ ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<Reo
       result.sort_seconds = zsort->seconds;
       result.spill = zsort->spill;
     }
+    if (output.photons) {
+      // The photon pass is traced and reordered as the camera pass is: its stages count too
+      // (and [memory]'s counters above already hold both passes').
+      result.photon_seconds = output.photons->run.seconds + output.photons->map_seconds;
+      for (const StageStats& stage : output.photons->run.stages) {
+        if (stage.name == "trace") {
+          result.trace_seconds += stage.seconds;
+          result.rays_traced += stage.rays_in;
+        }
+        if (stage.name == "approx_hit") {
+          result.approx_hit_seconds += stage.seconds;
+          result.rays_retired_by_approx_hit += stage.rays_in - stage.rays_out;
+        }
+        if (stage.name == "zsort") result.sort_seconds += stage.seconds;
+      }
+      result.trace_mrays_per_s = result.trace_seconds > 0.0 ? double(result.rays_traced) / result.trace_seconds * 1e-6 : 0.0;
+    }
     result.overhead_share = (result.approx_hit_seconds + result.sort_seconds) / thread_seconds;
     if (first_image.empty()) first_image = output.image;
     result.image_identical = output.image == first_image;
@@ -132,6 +153,7 @@ nlohmann::json to_json(const ReorderBenchReport& report) {
     }
     results.push_back({{"heuristic", r.heuristic},
                        {"render_seconds", r.render_seconds},
+                       {"photon_seconds", r.photon_seconds},
                        {"trace_seconds", r.trace_seconds},
                        {"trace_mrays_per_s", r.trace_mrays_per_s},
                        {"closest_mrays_per_s", r.closest_mrays_per_s},

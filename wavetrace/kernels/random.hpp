@@ -18,6 +18,9 @@ enum class RandomPurpose : std::uint32_t {
   benchmark = 7,
   simplification = 8,
   fresnel_choice = 9,
+  photon_emission = 10,
+  gather_direction = 11,
+  gather_key = 12,
 };
 
 // A 64-bit finalizer (SplitMix64's): full avalanche, cheap, and good enough for sampling.

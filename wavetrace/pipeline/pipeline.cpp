@@ -69,7 +69,7 @@ void PipelineContext::wake_generator() {
   }
 }
 
-std::unique_ptr<GenerateNode> make_generate_node(tbb::flow::graph& graph, GenerateStage& stage,
+std::unique_ptr<GenerateNode> make_generate_node(tbb::flow::graph& graph, RaySource& stage,
                                                  PipelineContext& context, StageCounters& counters) {
   // Any number of bodies at once: each claims its rays (counting them alive first, so the
   // budget sees them) and fills its batch in parallel with the others.
@@ -78,7 +78,7 @@ std::unique_ptr<GenerateNode> make_generate_node(tbb::flow::graph& graph, Genera
         const std::size_t capacity = context.pool().batch_capacity();
         while (!stage.exhausted() && context.in_core_rays() + std::int64_t(capacity) <= std::int64_t(context.budget())) {
           const Clock::time_point start = Clock::now();
-          const GenerateStage::Claim claimed = stage.claim(capacity);
+          const RaySource::Claim claimed = stage.claim(capacity);
           if (claimed.count == 0) return;
           context.add_rays(claimed.count);
           Batch* batch = context.pool().acquire();
@@ -204,7 +204,7 @@ std::unique_ptr<tbb::flow::function_node<Batch*>> make_retire_node(tbb::flow::gr
   });
 }
 
-Pipeline::Pipeline(GenerateStage& generate, std::vector<const Stage*> chain, bool loops, const PipelineOptions& options)
+Pipeline::Pipeline(RaySource& generate, std::vector<const Stage*> chain, bool loops, const PipelineOptions& options)
     : generate_(generate), chain_(std::move(chain)), loops_(loops), options_(options) {}
 
 PipelineRun Pipeline::run(const std::function<void(const Progress&)>& on_progress, std::chrono::milliseconds interval) {

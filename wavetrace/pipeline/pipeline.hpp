@@ -54,7 +54,7 @@ class PipelineContext {
   // Rays leaving it; wakes the generator when there is room for another batch.
   void retire_rays(std::size_t count);
 
-  void attach_generator(GenerateNode* node, const GenerateStage* stage) {
+  void attach_generator(GenerateNode* node, const RaySource* stage) {
     generator_node_ = node;
     generator_stage_ = stage;
   }
@@ -70,14 +70,14 @@ class PipelineContext {
   std::size_t budget_;
   std::atomic<std::int64_t> live_rays_{0};
   GenerateNode* generator_node_ = nullptr;
-  const GenerateStage* generator_stage_ = nullptr;
+  const RaySource* generator_stage_ = nullptr;
   BatchNode* buffer_node_ = nullptr;
   const BufferingStage* buffer_stage_ = nullptr;
 };
 
 // The node that emits camera batches while the in-flight budget allows, any number of
 // them filled at once; start it with try_put(continue_msg()).
-std::unique_ptr<GenerateNode> make_generate_node(tbb::flow::graph& graph, GenerateStage& stage,
+std::unique_ptr<GenerateNode> make_generate_node(tbb::flow::graph& graph, RaySource& stage,
                                                  PipelineContext& context, StageCounters& counters);
 
 // How a buffering stage's batches reach the next stage in the order it emitted them. A
@@ -153,7 +153,8 @@ class Pipeline {
  public:
   // `chain` is everything after generate, in order. If `loops` is set, the last stage's
   // output goes back to the first (spawn feeding new rays into the chain).
-  Pipeline(GenerateStage& generate, std::vector<const Stage*> chain, bool loops, const PipelineOptions& options);
+  // `generate` makes the chain's new rays: camera rays, or photons for a photon map.
+  Pipeline(RaySource& generate, std::vector<const Stage*> chain, bool loops, const PipelineOptions& options);
 
   // Runs until every ray has finished. `on_progress`, if given, is called about every
   // `interval` from a helper thread.
@@ -161,7 +162,7 @@ class Pipeline {
                   std::chrono::milliseconds interval = std::chrono::milliseconds(250));
 
  private:
-  GenerateStage& generate_;
+  RaySource& generate_;
   std::vector<const Stage*> chain_;
   bool loops_;
   PipelineOptions options_;

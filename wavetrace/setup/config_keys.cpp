@@ -166,8 +166,8 @@ std::vector<std::string> accel_type_choices() {
 }  // namespace
 
 const std::vector<std::string>& config_sections() {
-  static const std::vector<std::string> sections = {"scene",   "camera", "render",   "accel",     "build",
-                                                    "proxy",   "reorder", "memory", "pipeline", "distribute"};
+  static const std::vector<std::string> sections = {"scene",  "camera",  "render", "photon",   "accel",     "build",
+                                                    "proxy",  "reorder", "memory", "pipeline", "distribute"};
   return sections;
 }
 
@@ -222,6 +222,22 @@ const std::vector<ConfigKey>& config_schema() {
       {"render.pixel_order", T::text, std::string("scanline"), 0, 0, {"scanline", "zcurve"},
        "order in which camera rays are generated",
        choice<parse_pixel_order, &P::pixel_order>},
+      {"render.integrator", T::text, std::string("path"), 0, 0, {"path", "photon"},
+       "path: path tracing; photon: a photon pass, then camera rays with light samples, the caustic map and final "
+       "gathering from the global map (photon.*)",
+       choice<parse_integrator, &P::integrator>},
+
+      {"photon.count", T::integer, std::int64_t{1000000}, 1, std::int64_t{4294967295}, {},
+       "photons emitted from the lights (render.integrator = photon)",
+       integer<&P::photon, &PhotonOptions::count>},
+      {"photon.k", T::integer, std::int64_t{100}, 1, 1024, {}, "photons each irradiance estimate gathers",
+       integer<&P::photon, &PhotonOptions::k>},
+      {"photon.radius", T::real, 0.0, 0.0, 1e30, {},
+       "the farthest an irradiance estimate reaches, in scene units (0: 0.25% of the scene's diagonal)",
+       real<&P::photon, &PhotonOptions::radius>},
+      {"photon.gather_rays", T::integer, std::int64_t{10}, 1, 128, {},
+       "final-gathering rays from each diffuse surface a camera path meets",
+       integer<&P::photon, &PhotonOptions::gather_rays>},
 
       {"accel.type", T::text, std::string("embree"), 0, 0,
        accel_type_choices(),

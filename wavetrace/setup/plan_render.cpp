@@ -224,6 +224,19 @@ RenderPlan plan_render(const Config& config) {
                                     plan.pipeline.rays_in_flight, plan.reorder.buffer_rays));
     }
   }
+  if (plan.integrator == Integrator::photon) {
+    if (plan.pipeline.mode == PipelineMode::megakernel) {
+      throw ConfigError("render.integrator = photon runs a photon pass and a camera pass through the stage graph: set "
+                        "pipeline.mode = wavefront");
+    }
+    for (const char* needed : {"shade", "spawn"}) {
+      if (std::find(plan.stages.begin(), plan.stages.end(), needed) == plan.stages.end()) {
+        throw ConfigError(fmt::format("render.integrator = photon needs '{}' in pipeline.stages (photons bounce, and "
+                                      "camera paths gather)",
+                                      needed));
+      }
+    }
+  }
   if (plan.pipeline.mode == PipelineMode::megakernel) check_megakernel_plan(plan);
   return plan;
 }

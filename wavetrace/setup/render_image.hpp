@@ -17,8 +17,17 @@
 
 namespace wavetrace {
 
+// The photon pass of render.integrator = photon, before the camera pass.
+struct PhotonPassReport {
+  PipelineRun run;              // emit_photons first, then its chain
+  std::uint64_t emitted = 0;    // photons that left the lights
+  std::size_t global_photons = 0, caustic_photons = 0;  // what the maps hold
+  double map_seconds = 0.0;     // sorting the deposits and building both kd-trees
+  float radius = 0.0f;          // photon.radius as resolved
+};
+
 struct RenderOutput {
-  PipelineRun run;
+  PipelineRun run;  // the camera pass
   std::vector<float> image;  // linear RGB, top row first
   std::vector<DepthHitRate> hit_rates;  // closest-hit rays per path depth
   // Set when [memory] asks for observation but the accelerator's reads cannot be seen.
@@ -27,6 +36,9 @@ struct RenderOutput {
   double closest_mrays_per_s = 0.0;  // trace's closest-hit (camera and bounce) rays per busy second
   double any_mrays_per_s = 0.0;      // trace's shadow rays per busy second
   std::uint64_t rejected_contributions = 0;
+  std::optional<PhotonPassReport> photons;  // render.integrator = photon
+  // The whole render's wall time: the camera pass, and the photon pass and its maps if any.
+  double seconds() const { return run.seconds + (photons ? photons->run.seconds + photons->map_seconds : 0.0); }
 };
 
 // How one render shares its image with others (a distributed render): which camera rays it

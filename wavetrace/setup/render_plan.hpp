@@ -17,6 +17,7 @@
 #include "wavetrace/stages/generate.hpp"
 #include "wavetrace/pipeline/memory_observation.hpp"
 #include "wavetrace/stages/path_rules.hpp"
+#include "wavetrace/stages/photon_rules.hpp"
 #include "wavetrace/pipeline/pipeline.hpp"
 #include "wavetrace/stages/zsort.hpp"
 
@@ -47,6 +48,8 @@ struct RenderPlan {
   PixelOrder pixel_order = PixelOrder::scanline;
   bool film_per_thread = false;  // render.film
   PathRules rules;
+  Integrator integrator = Integrator::path;  // render.integrator
+  PhotonOptions photon;
   PipelineOptions pipeline;
   AcceleratorOptions accelerator;  // type "auto" until resolve_accelerator chooses
   AccelGoal accel_goal;

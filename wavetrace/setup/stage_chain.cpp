@@ -4,13 +4,20 @@
 #include <stdexcept>
 
 #include "wavetrace/stages/approx_hit.hpp"
+#include "wavetrace/stages/gather_shade.hpp"
+#include "wavetrace/stages/gather_spawn.hpp"
 #include "wavetrace/stages/repack.hpp"
+#include "wavetrace/stages/scatter_photons.hpp"
 #include "wavetrace/stages/shade.hpp"
 #include "wavetrace/stages/spawn.hpp"
 
 namespace wavetrace {
 
-StageChain::StageChain(const RenderPlan& plan, const World& world, Film& film, const MemoryObservers* observers) {
+StageChain::StageChain(const RenderPlan& plan, const World& world, Film* film, const MemoryObservers* observers,
+                       ChainShading shading) {
+  if ((film == nullptr) != (shading.deposits != nullptr)) {
+    throw std::logic_error("a chain has a film, or else fills photon deposits");
+  }
   const PathRules& rules = plan.rules;
   for (const std::string& name : plan.stages) {
     if (name == "generate") continue;
@@ -29,9 +36,22 @@ StageChain::StageChain(const RenderPlan& plan, const World& world, Film& film, c
                                                     TraceInstruments{&hit_rates_, observers, &trace_times_},
                                                     LookAhead{plan.memory.look_ahead_batches, plan.memory.look_ahead_threads}));
     }
-    if (name == "shade") owned_.push_back(std::make_unique<ShadeStage>(world, film, rules));
+    if (name == "shade") {
+      if (shading.deposits != nullptr) {
+        owned_.push_back(std::make_unique<ScatterPhotonsStage>(world, *shading.deposits, rules));
+      } else if (shading.maps != nullptr) {
+        owned_.push_back(std::make_unique<GatherShadeStage>(world, *film, rules, *shading.maps));
+      } else {
+        owned_.push_back(std::make_unique<ShadeStage>(world, *film, rules));
+      }
+    }
     if (name == "spawn") {
-      owned_.push_back(std::make_unique<SpawnStage>(world, rules));
+      // The photon pass's scatter bounces its photons itself: only the loop is left.
+      if (shading.maps != nullptr) {
+        owned_.push_back(std::make_unique<GatherSpawnStage>(world, rules, plan.photon.gather_rays));
+      } else if (shading.deposits == nullptr) {
+        owned_.push_back(std::make_unique<SpawnStage>(world, rules));
+      }
       loops_ = true;
     }
   }

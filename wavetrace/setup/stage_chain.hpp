@@ -1,4 +1,5 @@
-// The stage objects a plan's chain names, built over a world and a film, in chain order.
+// The stage objects a plan's chain names, built over a world and a film (or, for the photon
+// pass, the photon deposits), in chain order.
 #pragma once
 
 #include <memory>
@@ -6,6 +7,8 @@
 
 #include "wavetrace/stages/film.hpp"
 #include "wavetrace/stages/hit_rates.hpp"
+#include "wavetrace/stages/photon_deposits.hpp"
+#include "wavetrace/stages/photon_map.hpp"
 #include "wavetrace/pipeline/memory_observation.hpp"
 #include "wavetrace/setup/render_plan.hpp"
 #include "wavetrace/stages/stage.hpp"
@@ -15,10 +18,19 @@
 
 namespace wavetrace {
 
+// What a chain's shade and spawn are: the path tracer's (neither set), photon mapping's
+// camera pass (reading `maps`, gather_shade.hpp and gather_spawn.hpp), or its photon pass
+// (filling `deposits`: scatter_photons.hpp does both, and the chain has no film).
+struct ChainShading {
+  const PhotonMaps* maps = nullptr;
+  PhotonDeposits* deposits = nullptr;
+};
+
 // Owns the stage objects a plan names, in chain order (generate excluded).
 class StageChain {
  public:
-  StageChain(const RenderPlan& plan, const World& world, Film& film, const MemoryObservers* observers = nullptr);
+  StageChain(const RenderPlan& plan, const World& world, Film* film, const MemoryObservers* observers = nullptr,
+             ChainShading shading = {});
   std::vector<const Stage*> stages() const;
   bool loops() const { return loops_; }
   const HitRateCounters& hit_rates() const { return hit_rates_; }

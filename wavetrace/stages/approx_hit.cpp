@@ -12,7 +12,7 @@
 
 namespace wavetrace {
 
-ApproxHitStage::ApproxHitStage(const Proxy& proxy, Film& film, const glm::vec3& background, HitRateCounters* hit_rates,
+ApproxHitStage::ApproxHitStage(const Proxy& proxy, Film* film, const glm::vec3& background, HitRateCounters* hit_rates,
                                const MemoryObservers* observers)
     : proxy_(proxy),
       film_(film),
@@ -35,7 +35,7 @@ void ApproxHitStage::process(Batch* batch, StageOutput& out) const {
     const glm::vec3 direction(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]);
     float near = 0.0f, far = 0.0f;
     if (!clip_to_box(make_box_ray(origin, direction), box.lower, box.upper, rays.tmin[i], rays.tmax[i], near, far)) {
-      add_escaped_ray_light(film_, rays, i, background_);
+      if (film_ != nullptr) add_escaped_ray_light(*film_, rays, i, background_);
       if (rays.kind[i] != RayKind::shadow) {
         ++missed_by_depth[std::min<std::size_t>(rays.depth[i], HitRateCounters::kDepths - 1)];
         any_missed = true;

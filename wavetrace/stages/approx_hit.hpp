@@ -15,16 +15,17 @@ namespace wavetrace {
 
 class ApproxHitStage final : public Stage {
  public:
-  // `hit_rates` (optional) counts box misses of camera and bounce rays as misses, so the
-  // per-depth hit rates do not depend on the chain. `observers` (optional) see the proxy's reads.
-  ApproxHitStage(const Proxy& proxy, Film& film, const glm::vec3& background, HitRateCounters* hit_rates = nullptr,
+  // `film` null: rays that leave carry light to no pixel (the photon pass's). `hit_rates`
+  // (optional) counts box misses of camera and bounce rays as misses, so the per-depth hit
+  // rates do not depend on the chain. `observers` (optional) see the proxy's reads.
+  ApproxHitStage(const Proxy& proxy, Film* film, const glm::vec3& background, HitRateCounters* hit_rates = nullptr,
                  const MemoryObservers* observers = nullptr);
   std::string name() const override { return "approx_hit"; }
   void process(Batch* batch, StageOutput& out) const override;
 
  private:
   const Proxy& proxy_;
-  Film& film_;
+  Film* film_;
   glm::vec3 background_;
   HitRateCounters* hit_rates_;
   const MemoryObservers* observers_;

@@ -12,6 +12,7 @@
 
 #include "wavetrace/memory/ray_batch.hpp"
 #include "wavetrace/scene/camera.hpp"
+#include "wavetrace/stages/ray_source.hpp"
 
 namespace wavetrace {
 
@@ -40,28 +41,25 @@ struct CameraRayRange {
 // generate's lock, one call at a time, a range per many batches.
 using CameraRaySource = std::function<CameraRayRange()>;
 
-class GenerateStage {
+class GenerateStage final : public RaySource {
  public:
   // Without `ranges`, every camera ray of the image; with them, the ranges they hand out.
   GenerateStage(const Camera& camera, const ImageSpec& image, PixelOrder order, CameraRaySource ranges = {});
 
-  std::string name() const { return "generate"; }
-  std::uint64_t total_rays() const { return total_; }
+  std::string name() const override { return "generate"; }
+  std::uint64_t total_rays() const override { return total_; }
   // Camera rays claimed so far (with ranges: of this process's ranges).
-  std::uint64_t generated() const {
+  std::uint64_t generated() const override {
     return ranges_ ? claimed_.load(std::memory_order_relaxed) : std::min(next_.load(std::memory_order_relaxed), total_);
   }
-  bool exhausted() const { return ranges_ ? ranges_done_.load(std::memory_order_acquire) : generated() >= total_; }
+  bool exhausted() const override {
+    return ranges_ ? ranges_done_.load(std::memory_order_acquire) : generated() >= total_;
+  }
 
-  // Claims the next camera rays, up to `capacity`: their first index and count (0 when
-  // every ray is claimed). Thread-safe, so generate runs on any number of threads at once.
-  struct Claim {
-    std::uint64_t first = 0;
-    std::size_t count = 0;
-  };
-  Claim claim(std::size_t capacity);
-  // Writes the claimed rays into `rays` and sets its count: a pure function of the indices.
-  void fill_range(RayBatch& rays, const Claim& claimed) const;
+  // Camera rays by their index in the image's order (pixel in pixel order, then sample).
+  Claim claim(std::size_t capacity) override;
+  // A pure function of the indices.
+  void fill_range(RayBatch& rays, const Claim& claimed) const override;
   // Both: fills `rays` with the next camera rays (up to its capacity); returns how many.
   std::size_t fill(RayBatch& rays);
 

@@ -31,10 +31,10 @@ void write_ray(RayBatch& to, std::size_t slot, const RayBatch& parent, std::size
   to.flags[slot] = ray_flags::alive;
 }
 
-// The bounce off a mirror or glass: its one direction (glass chooses reflection or
-// refraction by Fresnel), no light sample, and a specular ray that sees what it hits.
+}  // namespace
+
 void write_specular_bounce(const RayBatch& rays, const HitBatch& hits, std::size_t i, const Material& material,
-                           const PathRules& rules, RayBatch& bounces) {
+                           const PathRules& rules, RayBatch& bounces, RayKind kind) {
   const glm::vec3 incoming =
       glm::normalize(glm::vec3(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]));
   const glm::vec3 outward = glm::normalize(hits.normal(i));
@@ -50,11 +50,8 @@ void write_specular_bounce(const RayBatch& rays, const HitBatch& hits, std::size
   glm::vec3 weight = throughput * material.albedo;
   if (rules.roulette_applies(rays.depth[i])) weight /= survival_probability(material.albedo);
   write_ray(bounces, bounces.count++, rays, i, offset_ray_origin(hits.point(i), side), scatter.direction,
-            std::numeric_limits<float>::infinity(), RayKind::specular, static_cast<std::uint16_t>(rays.depth[i] + 1),
-            weight);
+            std::numeric_limits<float>::infinity(), kind, static_cast<std::uint16_t>(rays.depth[i] + 1), weight);
 }
-
-}  // namespace
 
 void SpawnStage::process(Batch* batch, StageOutput& out) const {
   Batch* bounces = out.acquire();
@@ -118,7 +115,9 @@ void SpawnStage::spawn(const Batch& batch, RayRange range, RayBatch& bounces, Ra
       if (!(rays.flags[next] & ray_flags::alive)) continue;
       const Material& material = materials[hits.material[next]];
       if (material.specular()) {  // rare beside diffuse hits: one ray at a time, outside the chunk
-        if (rays.flags[next] & ray_flags::continues) write_specular_bounce(rays, hits, next, material, rules_, bounces);
+        if (rays.flags[next] & ray_flags::continues) {
+          write_specular_bounce(rays, hits, next, material, rules_, bounces, RayKind::specular);
+        }
         continue;
       }
       const std::uint32_t k = c.count++;

@@ -24,4 +24,11 @@ class SpawnStage final : public Stage {
   PathRules rules_;
 };
 
+// The bounce of live ray `i` of `rays` off the mirror or glass it hit, appended to `bounces`
+// as a ray of `kind`: its one direction (glass chooses reflection or refraction by Fresnel),
+// its weight the path's times the tint (over the survival probability where Russian
+// roulette applies), and no light sample.
+void write_specular_bounce(const RayBatch& rays, const HitBatch& hits, std::size_t i, const Material& material,
+                           const PathRules& rules, RayBatch& bounces, RayKind kind);
+
 }  // namespace wavetrace

@@ -1,0 +1,60 @@
+// The photon map (Jensen 1996): photons left on diffuse surfaces, in a kd-tree (nanoflann's,
+// Debian's libnanoflann-dev), answering the k-nearest irradiance estimate. Built once after
+// the photon pass and read-only while the camera pass runs.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+namespace wavetrace {
+
+// One photon at rest (36 bytes, in memory only): where it landed, the flux it carries (the
+// scene's emission units times area), and the unit normal of the surface on the side it came
+// from, so an estimate takes no photon from the far side of a thin wall.
+struct Photon {
+  glm::vec3 position;
+  glm::vec3 power;
+  glm::vec3 normal;
+};
+
+class PhotonMap {
+ public:
+  // The most photons one estimate gathers (photon.k's bound): a query keeps them on its stack.
+  static constexpr std::uint32_t kMaxNearest = 1024;
+
+  explicit PhotonMap(std::vector<Photon> photons);
+  ~PhotonMap();
+  PhotonMap(const PhotonMap&) = delete;
+  PhotonMap& operator=(const PhotonMap&) = delete;
+
+  std::size_t size() const { return photons_.size(); }
+  std::span<const Photon> photons() const { return photons_; }
+
+  // Irradiance at `point` on a surface of unit `normal`: the flux of the `k` nearest photons
+  // within `max_radius` that arrived on the normal's side, over pi r^2, r the distance of the
+  // k-th (max_radius when fewer are that near). Deterministic: the tree is built from the
+  // photons in the order given.
+  glm::vec3 irradiance(const glm::vec3& point, const glm::vec3& normal, std::uint32_t k, float max_radius) const;
+
+ private:
+  struct Tree;
+  std::vector<Photon> photons_;
+  std::unique_ptr<Tree> tree_;
+};
+
+// The camera pass's maps and how it reads them (photon.k, photon.radius resolved).
+struct PhotonMaps {
+  PhotonMaps(std::vector<Photon> global_photons, std::vector<Photon> caustic_photons, std::uint32_t nearest,
+             float max_radius)
+      : global(std::move(global_photons)), caustic(std::move(caustic_photons)), k(nearest), radius(max_radius) {}
+  PhotonMap global;   // every landing: read where a gathering ray ends
+  PhotonMap caustic;  // landings by specular paths alone: read where a camera path meets a diffuse surface
+  std::uint32_t k;
+  float radius;
+};
+
+}  // namespace wavetrace
