@@ -1,4 +1,5 @@
-// `wavetrace bench accel`, `bench leak`, `bench reorder`, `bench pipeline` and `bench image`.
+// `wavetrace bench accel`, `bench leak`, `bench reorder`, `bench pipeline`, `bench image` and
+// `bench photons`.
 #include <functional>
 #include <fstream>
 #include <memory>
@@ -12,6 +13,7 @@
 #include "wavetrace/bench/accel_bench.hpp"
 #include "wavetrace/bench/image_bench.hpp"
 #include "wavetrace/bench/leak_bench.hpp"
+#include "wavetrace/bench/photon_bench.hpp"
 #include "wavetrace/bench/pipeline_bench.hpp"
 #include "wavetrace/bench/reorder_bench.hpp"
 #include "wavetrace/setup/render_setup.hpp"
@@ -235,6 +237,61 @@ int run_image(const ImageArguments& args) {
   return 0;
 }
 
+struct PhotonArguments {
+  std::string scene = "scenes/caustic.toml";
+  std::string accel = "embree";
+  std::string size = "160x120";
+  int spp = 16;
+  int threads = 0;
+  std::uint32_t reference_spp = 4096;
+  std::string photons = "10k,100k,1M";
+  std::string radii;
+  std::string json;
+  std::vector<std::string> assignments;
+};
+
+int run_photons(const PhotonArguments& args) {
+  const Config config = render_bench_config({"render.max_depth=8"}, args.assignments, args.scene, args.spp,
+                                            args.threads, args.size, [&](Config& flags) {
+                                              flags.set_value("accel.type", args.accel);
+                                            });
+  PhotonBenchRequest request;
+  request.reference_spp = args.reference_spp;
+  request.photon_counts.clear();
+  for (const std::string& count : split_commas(args.photons)) {
+    // "250k", "4M" or a plain number, as triangle counts are written.
+    const std::size_t suffix = count.find_first_of("kKmM");
+    const double scale = suffix == std::string::npos ? 1.0 : (count[suffix] == 'k' || count[suffix] == 'K') ? 1e3 : 1e6;
+    double value = 0.0;
+    try {
+      std::size_t used = 0;
+      value = std::stod(count.substr(0, suffix), &used) * scale;
+      if (used != std::min(suffix, count.size()) || (suffix != std::string::npos && suffix + 1 != count.size())) {
+        throw std::invalid_argument(count);
+      }
+    } catch (const std::exception&) {
+      value = 0.0;
+    }
+    if (!(value >= 1.0 && value <= 4294967295.0)) {
+      throw ConfigError(fmt::format("--photons '{}': expected comma-separated counts in [1, 2^32), e.g. 100k,1M", count));
+    }
+    request.photon_counts.push_back(static_cast<std::uint64_t>(value));
+  }
+  for (const std::string& radius : split_commas(args.radii)) {
+    try {
+      std::size_t used = 0;
+      request.radii.push_back(std::stod(radius, &used));
+      if (used != radius.size() || !(request.radii.back() >= 0.0)) throw std::invalid_argument(radius);
+    } catch (const std::exception&) {
+      throw ConfigError(fmt::format("--radii '{}': expected comma-separated reaches of 0 or more", args.radii));
+    }
+  }
+  const PhotonBenchReport report = run_photon_bench(config, request);
+  fmt::print("{}", to_table(report));
+  if (!args.json.empty()) write_text(args.json, to_json(report).dump(2) + "\n");
+  return 0;
+}
+
 void add_common_options(CLI::App* command, BenchArguments& args) {
   add_scene_option(*command, args.scene, SceneKinds::with_worlds, false);
   add_accel_option(*command, args.accel, true);
@@ -313,6 +370,21 @@ void add_bench_command(CLI::App& app, int& exit_code) {
   image->add_option("--json", image_args->json, "write results as JSON");
   add_set_option(*image, image_args->assignments, "render.max_depth=2");
   image->callback([image_args, &exit_code] { exit_code = run_image(*image_args); });
+
+  auto photon_args = std::make_shared<PhotonArguments>();
+  CLI::App* photons = bench->add_subcommand(
+      "photons", "photon mapping against a path-traced reference as photons grow: seconds, RMSE, bias");
+  add_scene_option(*photons, photon_args->scene, SceneKinds::without_worlds, false);
+  photons->add_option("--accel", photon_args->accel, "accelerator type (accel.type)");
+  add_spp_option(*photons, photon_args->spp);
+  add_size_option(*photons, photon_args->size);
+  add_threads_option(*photons, photon_args->threads);
+  photons->add_option("--reference-spp", photon_args->reference_spp, "the path-traced reference's samples per pixel");
+  photons->add_option("--photons", photon_args->photons, "comma-separated photon counts (k and M suffixes)");
+  photons->add_option("--radii", photon_args->radii, "comma-separated photon.radius values at each count (0: auto)");
+  photons->add_option("--json", photon_args->json, "write results as JSON");
+  add_set_option(*photons, photon_args->assignments, "photon.k=50");
+  photons->callback([photon_args, &exit_code] { exit_code = run_photons(*photon_args); });
 
   add_bench_report_command(*bench, exit_code);
 }

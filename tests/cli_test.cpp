@@ -250,6 +250,31 @@ TEST(Cli, BenchReorderReportsEveryHeuristicWithTheIssuesKeys) {
   EXPECT_TRUE(spilled["results"][1]["disk_pages_per_1000_rays"].is_null());  // no world file paged
 }
 
+// Photon mapping in the reorder bench: both passes counted, every heuristic the same image
+// (the photon maps are built from deposits in key order); and bench photons against the path
+// tracer, whose error shrinks as photons grow.
+TEST(Cli, BenchReorderAndBenchPhotonsRunPhotonMapping) {
+  const nlohmann::json reordered = testing::run_bench_json(
+      "reorder_photon.json", "reorder --scene " + std::string(WAVETRACE_SOURCE_DIR) + "/scenes/caustic.toml "
+      "--accel bvh --size 16x12 --spp 1 --threads 2 --heuristics none,hph --set render.integrator=photon "
+      "--set photon.count=20000 --set photon.gather_rays=2",
+      "photon mapping (20000 photons");
+  ASSERT_EQ(reordered["results"].size(), 2u);
+  for (const auto& entry : reordered["results"]) {
+    EXPECT_GT(entry["photon_seconds"].get<double>(), 0.0);
+    EXPECT_LT(entry["photon_seconds"].get<double>(), entry["render_seconds"].get<double>());
+    EXPECT_TRUE(entry["image_identical"].get<bool>());
+  }
+  const nlohmann::json json = testing::run_bench_json(
+      "photons.json", "photons --size 20x15 --spp 2 --threads 2 --reference-spp 64 --photons 1k,100k --radii 0,0.05");
+  ASSERT_EQ(json["results"].size(), 4u);
+  EXPECT_GT(json["reference"]["noise_rmse"].get<double>(), 0.0);
+  EXPECT_GT(json["results"][0]["radius"].get<double>(), 0.0) << "0 resolved to a share of the scene";
+  EXPECT_FLOAT_EQ(json["results"][1]["radius"].get<float>(), 0.05f);
+  EXPECT_GT(json["results"][2]["caustic_photons"].get<std::uint64_t>(), json["results"][0]["caustic_photons"].get<std::uint64_t>());
+  EXPECT_LT(json["results"][2]["rmse"].get<double>(), json["results"][0]["rmse"].get<double>());
+}
+
 // A key given with --set wins over a bench flag left at its default, as in `render`: before,
 // `bench reorder --set reorder.curve=hilbert` rendered with the --curve default, morton.
 TEST(Cli, BenchSetAssignmentsAreNotOverriddenByFlagDefaults) {
