@@ -266,7 +266,8 @@ TEST(Cli, BenchReorderAndBenchPhotonsRunPhotonMapping) {
     EXPECT_TRUE(entry["image_identical"].get<bool>());
   }
   const nlohmann::json json = testing::run_bench_json(
-      "photons.json", "photons --size 20x15 --spp 2 --threads 2 --reference-spp 64 --photons 1k,100k --radii 0,0.05");
+      "photons.json", "photons --scene " + std::string(WAVETRACE_SOURCE_DIR) + "/scenes/caustic.toml --size 20x15 "
+      "--spp 2 --threads 2 --reference-spp 64 --photons 1k,100k --radii 0,0.05");
   ASSERT_EQ(json["results"].size(), 4u);
   EXPECT_GT(json["reference"]["noise_rmse"].get<double>(), 0.0);
   EXPECT_GT(json["results"][0]["radius"].get<double>(), 0.0) << "0 resolved to a share of the scene";
