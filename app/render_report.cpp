@@ -201,6 +201,7 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
                         {"gather_rays", facts.plan.photon.gather_rays},
                         {"seconds", photons->run.seconds},
                         {"map_seconds", photons->map_seconds},
+                        {"precomputed", photons->precomputed},
                         {"stages", photon_stages}};
   }
   stats["render"] = render;
@@ -269,9 +270,10 @@ std::string render_table(const RenderFacts& facts) {
   std::string table;
   if (const std::optional<PhotonPassReport>& photons = facts.output.photons) {
     table += fmt::format("photon pass: {} photons emitted in {:.3f} s; {} landed ({} by specular paths: the caustic "
-                         "map), maps built in {:.3f} s; estimates of k = {} within {:.4g}\n",
+                         "map), maps built in {:.3f} s ({} irradiance estimates precomputed); estimates of k = {} "
+                         "within {:.4g}\n",
                          photons->emitted, photons->run.seconds, photons->global_photons, photons->caustic_photons,
-                         photons->map_seconds, facts.plan.photon.k, photons->radius);
+                         photons->map_seconds, photons->precomputed, facts.plan.photon.k, photons->radius);
     table += stage_rows(photons->run);
     table += "camera pass:\n";
   }

@@ -73,6 +73,28 @@ TEST(PhotonMap, EstimatesTheDensityOfFluxFromTheNearestPhotons) {
   EXPECT_EQ(PhotonMap({}).irradiance(centre, up, 100, 1.0f), glm::vec3(0.0f));
 }
 
+TEST(PhotonMap, PrecomputedIrradianceIsTheNearestPrecomputedEstimate) {
+  PhotonMap map(square_of_photons(100));  // 10,000 photons
+  EXPECT_FALSE(map.has_precomputed());
+  map.precompute_irradiance(4, 50, 0.2f);
+  EXPECT_EQ(map.precomputed_count(), 2500u);
+  const glm::vec3 up(0, 0, 1), query(0.4f, 0.6f, 0.0f);
+  // The nearest precomputed point's estimate: the full estimate there, not at the query.
+  const Photon* closest = nullptr;
+  for (std::size_t i = 0; i < map.size(); i += 4) {
+    const Photon& photon = map.photons()[i];
+    if (closest == nullptr || glm::length(photon.position - query) < glm::length(closest->position - query)) {
+      closest = &photon;
+    }
+  }
+  const glm::vec3 cached = map.precomputed_irradiance(query, up, 50, 0.2f);
+  EXPECT_EQ(cached, map.irradiance(closest->position, closest->normal, 50, 0.2f));
+  EXPECT_NE(cached, map.irradiance(query, up, 50, 0.2f));
+  EXPECT_NEAR(cached.x, 10000.0f, 0.25f * 10000.0f);
+  // Facing away from every photon: no precomputed point qualifies, and the full estimate is 0.
+  EXPECT_EQ(map.precomputed_irradiance(query, -up, 50, 0.2f), glm::vec3(0.0f));
+}
+
 TEST(PhotonDeposits, MergeInKeyOrderWhateverThreadAddedThem) {
   PhotonDeposits deposits;
   deposits.add(PhotonDeposits::key(7, 1), Photon{glm::vec3(7.1f), glm::vec3(1), glm::vec3(0, 1, 0)}, false);
@@ -100,6 +122,13 @@ TEST(PhotonRender, FurnaceRadianceIsEmissionOverOneMinusAlbedo) {
   // Every photon lands (nothing escapes a closed sphere), then half go on at each bounce.
   EXPECT_NEAR(double(output.photons->global_photons), 400000.0, 0.02 * 400000.0);
   EXPECT_EQ(output.photons->caustic_photons, 0u) << "no mirror or glass";
+  EXPECT_EQ(output.photons->precomputed, 0u);
+  // Gathering rays reading irradiance precomputed at every 4th photon instead.
+  const RenderOutput cached = render(furnace, {"render.max_depth=64", "render.spp=4", "photon.count=200000",
+                                               "photon.gather_rays=4", "photon.precompute=4"});
+  EXPECT_NEAR(mean(cached.image), expected, 0.01 * expected);
+  EXPECT_NEAR(double(cached.photons->precomputed), double(output.photons->global_photons) / 4, 1.0);
+  EXPECT_FALSE(cached.image == output.image);
 }
 
 const Scene& caustic_scene() {

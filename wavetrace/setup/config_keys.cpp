@@ -238,6 +238,10 @@ const std::vector<ConfigKey>& config_schema() {
       {"photon.gather_rays", T::integer, std::int64_t{10}, 1, 128, {},
        "final-gathering rays from each diffuse surface a camera path meets",
        integer<&P::photon, &PhotonOptions::gather_rays>},
+      {"photon.precompute", T::integer, std::int64_t{0}, 0, 1024, {},
+       "precompute the global map's irradiance at every Nth photon and let gathering rays read the nearest "
+       "(Christensen 1999); 0: a full k-nearest estimate at every gathering hit",
+       integer<&P::photon, &PhotonOptions::precompute>},
 
       {"accel.type", T::text, std::string("embree"), 0, 0,
        accel_type_choices(),

@@ -59,7 +59,8 @@ std::unique_ptr<PhotonMaps> run_photon_pass(const RenderPlan& plan, const World&
   report.radius = plan.photon.radius > 0.0f ? plan.photon.radius
                                             : kAutoRadiusShare * glm::length(world.scene.bounds.upper - world.scene.bounds.lower);
   auto maps = std::make_unique<PhotonMaps>(std::move(landed.global), std::move(landed.caustic), plan.photon.k,
-                                           report.radius);
+                                           report.radius, plan.photon.precompute);
+  report.precomputed = maps->global.precomputed_count();
   report.map_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return maps;
 }

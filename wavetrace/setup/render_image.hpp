@@ -22,7 +22,8 @@ struct PhotonPassReport {
   PipelineRun run;              // emit_photons first, then its chain
   std::uint64_t emitted = 0;    // photons that left the lights
   std::size_t global_photons = 0, caustic_photons = 0;  // what the maps hold
-  double map_seconds = 0.0;     // sorting the deposits and building both kd-trees
+  std::size_t precomputed = 0;  // irradiance estimates precomputed in the global map (photon.precompute)
+  double map_seconds = 0.0;     // sorting the deposits, building both kd-trees, precomputing
   float radius = 0.0f;          // photon.radius as resolved
 };
 

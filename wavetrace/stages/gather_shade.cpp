@@ -20,8 +20,9 @@ void GatherShadeStage::process(Batch* batch, StageOutput& out) const {
     const glm::vec3 normal = glm::normalize(hits.normal(i));
     const glm::vec3 facing = glm::dot(normal, direction) > 0.0f ? -normal : normal;
     const bool gathering = rays.kind[i] == RayKind::bounce;
-    const PhotonMap& map = gathering ? maps_.global : maps_.caustic;
-    const glm::vec3 irradiance = map.irradiance(hits.point(i), facing, maps_.k, maps_.radius);
+    const glm::vec3 irradiance = gathering
+                                     ? maps_.global.precomputed_irradiance(hits.point(i), facing, maps_.k, maps_.radius)
+                                     : maps_.caustic.irradiance(hits.point(i), facing, maps_.k, maps_.radius);
     const glm::vec3 light = glm::vec3(rays.throughput_r[i], rays.throughput_g[i], rays.throughput_b[i]) *
                             material.albedo * (1.0f / kPi) * irradiance;
     film_.add(rays.pixel[i], light.r, light.g, light.b);

@@ -8,6 +8,8 @@
 
 #include <glm/geometric.hpp>
 #include <nanoflann.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include "wavetrace/kernels/sampling.hpp"
 
@@ -32,14 +34,19 @@ using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<
 // faces the query's side, kept sorted by squared distance in arrays on the stack.
 class NearestPhotons {
  public:
-  NearestPhotons(std::span<const Photon> photons, const glm::vec3& normal, std::uint32_t k, float max_distance_squared)
-      : photons_(photons), normal_(normal), capacity_(std::min(k, PhotonMap::kMaxNearest)), worst_(max_distance_squared) {}
+  NearestPhotons(std::span<const Photon> photons, const glm::vec3& normal, std::uint32_t k, float max_distance_squared,
+                 float min_cosine = 0.0f)
+      : photons_(photons),
+        normal_(normal),
+        min_cosine_(min_cosine),
+        capacity_(std::min(k, PhotonMap::kMaxNearest)),
+        worst_(max_distance_squared) {}
 
   std::size_t size() const { return count_; }
   bool full() const { return count_ == capacity_; }
   float worstDist() const { return worst_; }  // the search skips what is farther
   bool addPoint(float distance_squared, std::uint32_t index) {
-    if (distance_squared >= worst_ || glm::dot(photons_[index].normal, normal_) <= 0.0f) return true;
+    if (distance_squared >= worst_ || glm::dot(photons_[index].normal, normal_) <= min_cosine_) return true;
     std::uint32_t slot = std::min(count_, capacity_ - 1);
     while (slot > 0 && distances_[slot - 1] > distance_squared) {
       distances_[slot] = distances_[slot - 1];
@@ -59,6 +66,7 @@ class NearestPhotons {
  private:
   std::span<const Photon> photons_;
   glm::vec3 normal_;
+  float min_cosine_;
   std::uint32_t capacity_;
   std::uint32_t count_ = 0;
   float worst_;
@@ -93,6 +101,40 @@ glm::vec3 PhotonMap::irradiance(const glm::vec3& point, const glm::vec3& normal,
   glm::vec3 flux(0.0f);
   for (std::uint32_t i = 0; i < nearest.size(); ++i) flux += photons_[nearest.index(i)].power;
   return flux * (1.0f / (kPi * nearest.radius_squared()));
+}
+
+}  // namespace wavetrace
+
+namespace wavetrace {
+
+const Photon* PhotonMap::nearest(const glm::vec3& point, const glm::vec3& normal, float max_radius,
+                                 float min_cosine) const {
+  if (tree_ == nullptr) return nullptr;
+  NearestPhotons nearest(photons_, normal, 1, max_radius * max_radius, min_cosine);
+  const float query[3] = {point.x, point.y, point.z};
+  tree_->index.findNeighbors(nearest, query, nanoflann::SearchParams());
+  return nearest.size() == 0 ? nullptr : &photons_[nearest.index(0)];
+}
+
+void PhotonMap::precompute_irradiance(std::uint32_t stride, std::uint32_t k, float max_radius) {
+  std::vector<Photon> points((photons_.size() + stride - 1) / stride);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 1024), [&](const auto& range) {
+    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+      const Photon& at = photons_[i * stride];
+      points[i] = Photon{at.position, irradiance(at.position, at.normal, k, max_radius), at.normal};
+    }
+  });
+  precomputed_ = std::make_unique<PhotonMap>(std::move(points));
+}
+
+glm::vec3 PhotonMap::precomputed_irradiance(const glm::vec3& point, const glm::vec3& normal, std::uint32_t k,
+                                            float max_radius) const {
+  // Surfaces within 25 degrees share an estimate (Christensen's normal test).
+  constexpr float kSameSurfaceCosine = 0.906f;
+  if (precomputed_ != nullptr) {
+    if (const Photon* near = precomputed_->nearest(point, normal, max_radius, kSameSurfaceCosine)) return near->power;
+  }
+  return irradiance(point, normal, k, max_radius);
 }
 
 }  // namespace wavetrace

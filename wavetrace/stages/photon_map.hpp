@@ -40,17 +40,36 @@ class PhotonMap {
   // photons in the order given.
   glm::vec3 irradiance(const glm::vec3& point, const glm::vec3& normal, std::uint32_t k, float max_radius) const;
 
+  // The photon nearest `point` within `max_radius` whose normal is within acos(min_cosine) of
+  // `normal`; null if none.
+  const Photon* nearest(const glm::vec3& point, const glm::vec3& normal, float max_radius, float min_cosine) const;
+
+  // Christensen's precomputed irradiance ("Faster photon map global illumination", 1999): the
+  // estimate made once at every `stride`-th photon, in parallel, and kept as a map of its own,
+  // so that a gathering ray reads the nearest instead of searching for k photons.
+  void precompute_irradiance(std::uint32_t stride, std::uint32_t k, float max_radius);
+  bool has_precomputed() const { return precomputed_ != nullptr; }
+  std::size_t precomputed_count() const { return precomputed_ != nullptr ? precomputed_->size() : 0; }
+  // The precomputed irradiance nearest `point` on a surface facing about as `normal` does
+  // (within 25 degrees); where none is within `max_radius`, the full estimate.
+  glm::vec3 precomputed_irradiance(const glm::vec3& point, const glm::vec3& normal, std::uint32_t k,
+                                   float max_radius) const;
+
  private:
   struct Tree;
   std::vector<Photon> photons_;
   std::unique_ptr<Tree> tree_;
+  std::unique_ptr<PhotonMap> precomputed_;  // power holds the irradiance there
 };
 
-// The camera pass's maps and how it reads them (photon.k, photon.radius resolved).
+// The camera pass's maps and how it reads them (photon.k, photon.radius resolved; with
+// photon.precompute > 0 the global map's irradiance precomputed at every that many photons).
 struct PhotonMaps {
   PhotonMaps(std::vector<Photon> global_photons, std::vector<Photon> caustic_photons, std::uint32_t nearest,
-             float max_radius)
-      : global(std::move(global_photons)), caustic(std::move(caustic_photons)), k(nearest), radius(max_radius) {}
+             float max_radius, std::uint32_t precompute_stride)
+      : global(std::move(global_photons)), caustic(std::move(caustic_photons)), k(nearest), radius(max_radius) {
+    if (precompute_stride > 0) global.precompute_irradiance(precompute_stride, k, radius);
+  }
   PhotonMap global;   // every landing: read where a gathering ray ends
   PhotonMap caustic;  // landings by specular paths alone: read where a camera path meets a diffuse surface
   std::uint32_t k;

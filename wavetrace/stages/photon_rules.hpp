@@ -23,6 +23,9 @@ struct PhotonOptions {
   std::uint32_t k = 100;           // photons an irradiance estimate gathers
   float radius = 0.0f;             // the farthest an estimate reaches; 0: 0.25% of the scene's diagonal
   std::uint32_t gather_rays = 10;  // final-gathering rays from each diffuse hit of a camera path
+  // Irradiance precomputed at every this many photons of the global map, read by gathering
+  // rays at the nearest (Christensen 1999); 0: the full estimate at every gathering hit.
+  std::uint32_t precompute = 0;
   bool operator==(const PhotonOptions&) const = default;
 };
 
