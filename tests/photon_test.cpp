@@ -190,6 +190,14 @@ TEST(PhotonRender, PlansThatCannotRunArePlainErrors) {
   chain.set("render.integrator=photon");
   chain.set("pipeline.stages=[generate, trace, shade]");
   EXPECT_THROW(plan_render(chain), ConfigError);
+  // Maps past the memory available: refused before a photon is traced.
+  try {
+    render(make_builtin_scene("builtin:furnace:200"), {"photon.count=4000000000"});
+    ADD_FAILURE() << "no error for 4G photons";
+  } catch (const ConfigError& error) {
+    EXPECT_NE(std::string(error.what()).find("photon.count = 4000000000: its photon maps would need"), std::string::npos)
+        << error.what();
+  }
   Config unknown;
   EXPECT_THROW(
       {
