@@ -10,7 +10,7 @@
 #include "wavetrace/kernels/random.hpp"
 #include "wavetrace/kernels/ray_offset.hpp"
 #include "wavetrace/kernels/sampling.hpp"
-#include "wavetrace/kernels/specular.hpp"
+#include "wavetrace/stages/spawn.hpp"
 
 namespace wavetrace {
 
@@ -43,12 +43,7 @@ void ScatterPhotonsStage::process(Batch* batch, StageOutput& out) const {
     glm::vec3 direction;
     RayKind kind = RayKind::bounce;
     if (material.specular()) {
-      SpecularScatter scatter{reflect_direction(incoming, outward), false};
-      if (material.surface == Surface::glass) {
-        scatter = glass_scatter(incoming, outward, material.ior,
-                                unit_float32(path_draw(key, depth, RandomPurpose::fresnel_choice)));
-      }
-      direction = scatter.direction;
+      direction = scatter_specular(material, incoming, outward, key, depth).direction;
       // Straight from the light (depth 0) or by specular surfaces alone: still a caustic path.
       if (depth == 0 || caustic_path) kind = RayKind::specular;
     } else {

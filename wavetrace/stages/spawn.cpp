@@ -10,7 +10,6 @@
 #include "wavetrace/kernels/random.hpp"
 #include "wavetrace/kernels/ray_offset.hpp"
 #include "wavetrace/kernels/sampling.hpp"
-#include "wavetrace/kernels/specular.hpp"
 
 namespace wavetrace {
 namespace {
@@ -33,17 +32,20 @@ void write_ray(RayBatch& to, std::size_t slot, const RayBatch& parent, std::size
 
 }  // namespace
 
+SpecularScatter scatter_specular(const Material& material, const glm::vec3& incoming, const glm::vec3& outward,
+                                 std::uint64_t path, std::uint32_t depth) {
+  if (material.surface != Surface::glass) return {reflect_direction(incoming, outward), false};
+  return glass_scatter(incoming, outward, material.ior,
+                       unit_float32(path_draw(path, depth, RandomPurpose::fresnel_choice)));
+}
+
 void write_specular_bounce(const RayBatch& rays, const HitBatch& hits, std::size_t i, const Material& material,
                            const PathRules& rules, RayBatch& bounces, RayKind kind) {
   const glm::vec3 incoming =
       glm::normalize(glm::vec3(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]));
   const glm::vec3 outward = glm::normalize(hits.normal(i));
-  SpecularScatter scatter{reflect_direction(incoming, outward), false};
-  if (material.surface == Surface::glass) {
-    const float u = unit_float32(
-        path_draw(path_key(rays.pixel[i], rays.sample[i]), rays.depth[i], RandomPurpose::fresnel_choice));
-    scatter = glass_scatter(incoming, outward, material.ior, u);
-  }
+  const SpecularScatter scatter =
+      scatter_specular(material, incoming, outward, path_key(rays.pixel[i], rays.sample[i]), rays.depth[i]);
   // The origin moves off the surface to the side the new ray leaves on.
   const glm::vec3 side = glm::dot(scatter.direction, outward) > 0.0f ? outward : -outward;
   const glm::vec3 throughput(rays.throughput_r[i], rays.throughput_g[i], rays.throughput_b[i]);

@@ -3,6 +3,7 @@
 // mirror or glass, only its specular ray. Shadow rays go out in a batch of their own.
 #pragma once
 
+#include "wavetrace/kernels/specular.hpp"
 #include "wavetrace/stages/path_rules.hpp"
 #include "wavetrace/stages/stage.hpp"
 #include "wavetrace/stages/world.hpp"
@@ -23,6 +24,11 @@ class SpawnStage final : public Stage {
   const World& world_;
   PathRules rules_;
 };
+
+// Where light arriving along unit `incoming` leaves a mirror or glass whose unit `outward`
+// normal faces its outside; glass draws its Fresnel choice from path `path` at `depth`.
+SpecularScatter scatter_specular(const Material& material, const glm::vec3& incoming, const glm::vec3& outward,
+                                 std::uint64_t path, std::uint32_t depth);
 
 // The bounce of live ray `i` of `rays` off the mirror or glass it hit, appended to `bounces`
 // as a ray of `kind`: its one direction (glass chooses reflection or refraction by Fresnel),
