@@ -25,13 +25,11 @@ const std::vector<std::string> kSettings = {"render.width=40", "render.height=30
                                             "render.threads=2", "reorder.heuristic=hph", "render.batch_size=256"};
 
 // Two renders of one world each take every other range of 700 camera rays; the second adds
-// its film into the first's. The result is the whole render's image, bit for bit.
-TEST(ImageShare, RangesOfCameraRaysWithTheirFilmsSummedAreTheWholeImage) {
-  const Scene scene = make_builtin_scene("builtin:room:5000");
-  const RenderOutput whole = testing::render_scene(scene, kSettings);
+// its film into the first's. Returns the image and how many camera rays the two generated.
+std::pair<std::vector<float>, std::uint64_t> render_in_two_shares(const Scene& scene,
+                                                                  const std::vector<std::string>& settings) {
   const std::uint64_t total = 40 * 30 * 3;  // kSettings: 40x30 at 3 spp
   constexpr std::uint64_t kRange = 700;
-
   std::vector<std::int64_t> first_sums;
   std::uint64_t generated = 0;
   std::vector<float> image;
@@ -53,13 +51,31 @@ TEST(ImageShare, RangesOfCameraRaysWithTheirFilmsSummedAreTheWholeImage) {
         for (std::size_t i = 0; i < sums.size(); ++i) sums[i] += first_sums[i];
       }
     };
-    image = testing::render_scene(scene, kSettings, share).image;
+    image = testing::render_scene(scene, settings, share).image;
   }
-  EXPECT_EQ(generated, total);
+  return {image, generated};
+}
+
+// The shares' films summed are the whole render's image, bit for bit.
+TEST(ImageShare, RangesOfCameraRaysWithTheirFilmsSummedAreTheWholeImage) {
+  const Scene scene = make_builtin_scene("builtin:room:5000");
+  const RenderOutput whole = testing::render_scene(scene, kSettings);
+  const auto [image, generated] = render_in_two_shares(scene, kSettings);
+  EXPECT_EQ(generated, 40u * 30 * 3);
   EXPECT_EQ(image, whole.image);
   double sum = 0.0;
   for (float value : image) sum += value;
   EXPECT_GT(sum, 0.0);
+}
+
+// Photon mapping shares an image the same way: each share traces every photon (the maps are
+// the same in each, built in key order) and only its own camera rays.
+TEST(ImageShare, PhotonMappingSharesAnImageAsThePathTracerDoes) {
+  const Scene scene = make_builtin_scene("builtin:room:5000");
+  std::vector<std::string> settings = kSettings;
+  settings.insert(settings.end(), {"render.integrator=photon", "photon.count=20000", "photon.gather_rays=2"});
+  const RenderOutput whole = testing::render_scene(scene, settings);
+  EXPECT_EQ(render_in_two_shares(scene, settings).first, whole.image);
 }
 
 TEST(ImageShare, TheMegakernelCannotShareAnImage) {
