@@ -31,7 +31,7 @@ int run_export(const ExportArguments& args) {
   SceneRequest request{args.scene, args.subdivide};
   request.streamed = true;
   const Scene scene = load_scene(request);
-  const MeshTriangleSource whole(scene.mesh);
+  const MeshTriangleSource whole(scene.mesh, scene.object_starts);
   const TriangleSource& source = scene.streamed() ? *scene.stream : static_cast<const TriangleSource&>(whole);
   const std::size_t vertices = write_binary_ply(source, args.out, piece_triangles);
   fmt::print("wrote {}: {} triangles, {} vertices (binary PLY), in {:.1f} s\n", args.out, source.triangle_count(), vertices,

@@ -125,6 +125,34 @@ TEST(ChunkedWorld, ProbedAnswersAsUnprobedAndReadsOnlyItsWorld) {
   EXPECT_EQ(pager.outside_accesses(), 0u);
 }
 
+// A scene kept whole (as it is when a proxy is wanted) is cut where the same scene streamed
+// is: its objects' starts survive the assembly and the dropping of degenerate triangles.
+TEST(ChunkedWorld, AWholeSceneIsCutWhereItsStreamIs) {
+  const Scene whole = make_builtin_scene("builtin:room:20000", false);
+  const Scene streamed = make_builtin_scene("builtin:room:20000", true);
+  ASSERT_TRUE(streamed.streamed());
+  EXPECT_GT(whole.object_starts.size(), 5u);
+  EXPECT_EQ(whole.object_starts, streamed.stream->object_starts());
+  const std::vector<ChunkRange> from_whole =
+      plan_chunks(MeshTriangleSource(whole.mesh, whole.object_starts).object_starts(), whole.triangle_count, 2048);
+  const std::vector<ChunkRange> from_stream =
+      plan_chunks(streamed.stream->object_starts(), streamed.triangle_count, 2048);
+  ASSERT_EQ(from_whole.size(), from_stream.size());
+  for (std::size_t c = 0; c < from_whole.size(); ++c) {
+    EXPECT_EQ(from_whole[c].first, from_stream[c].first) << c;
+    EXPECT_EQ(from_whole[c].count, from_stream[c].count) << c;
+  }
+
+  TriangleMesh mesh;
+  mesh.positions = {glm::vec3(0, 0, 0), glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), glm::vec3(0, 0, 1)};
+  // Triangles 1 and 4 are degenerate (a repeated corner); objects start at 0, 2 and 4.
+  mesh.triangles = {{0, 1, 2}, {0, 0, 1}, {0, 1, 3}, {0, 2, 3}, {1, 1, 2}, {1, 2, 3}};
+  std::vector<std::size_t> starts = {0, 2, 4};
+  validate_and_clean(mesh, "test mesh", &starts);
+  EXPECT_EQ(mesh.triangles.size(), 4u);
+  EXPECT_EQ(starts, (std::vector<std::size_t>{0, 1, 3}));
+}
+
 // build.chunks_at_once caps the chunks in flight: each build lingers so that two threads
 // would overlap, and the most seen at once must stay within the cap.
 TEST(ChunkedWorld, ChunksAtOnceCapsTheBuildsInFlight) {

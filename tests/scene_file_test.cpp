@@ -115,6 +115,8 @@ emission = 7
   EXPECT_EQ(scene.materials[0].albedo, glm::vec3(0.9f, 0.1f, 0.1f));
   EXPECT_EQ(scene.materials.back().emission, glm::vec3(7.0f));
   EXPECT_EQ(scene.background, glm::vec3(0.5f));
+  // Each object and the light begin a chunk of their own in a chunked build.
+  EXPECT_EQ(scene.object_starts, (std::vector<std::size_t>{0, 4, 4 + builtin.mesh.triangle_count()}));
   // Both the builtin's ceiling light and the file's light are emitters.
   EXPECT_EQ(LightSampler(scene).count(), 4u);
   // Facing down: the quad's normal is cross(edge_u, edge_v) = -y.

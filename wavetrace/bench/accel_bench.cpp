@@ -93,7 +93,7 @@ void resolve_accelerator_spec(AcceleratorSpec& spec, const Scene& scene, const C
   if (!spec.goal.automatic && !pixel_epsilon_applies(spec.options, spec.goal)) return;
   if (scene.streamed()) throw ConfigError(fmt::format("--accel {}: needs the scene's mesh", spec.label));
   const RenderPlan plan = plan_render(base);
-  const MeshTriangleSource source(scene.mesh);
+  const MeshTriangleSource source(scene.mesh, scene.object_starts);
   const ResolvedAccelerator resolved = resolve_accelerator(spec.options, spec.goal, source,
                                                            resolve_camera(plan.camera, scene), plan.image, false);
   spec.options = resolved.options;

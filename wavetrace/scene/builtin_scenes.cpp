@@ -47,7 +47,8 @@ class ObjectList {
     scene.background = background;
     if (!streamed) {
       scene.mesh = procedural->assemble();
-      scene.cleanup = validate_and_clean(scene.mesh, scene.name);
+      scene.object_starts = procedural->object_starts();
+      scene.cleanup = validate_and_clean(scene.mesh, scene.name, &scene.object_starts);
       scene.describe_mesh();
       return scene;
     }

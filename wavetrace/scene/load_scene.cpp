@@ -52,6 +52,7 @@ Scene load_scene(const SceneRequest& request) {
     scene.cleanup.degenerate_dropped += cleanup.degenerate_dropped;
     scene.subdivision_levels = static_cast<std::size_t>(request.subdivide);
     scene.enclosure.reset();  // Loop subdivision pulls the walls inward
+    scene.object_starts = {0};  // its faces no longer follow the objects' order
   }
   if (!scene.streamed()) scene.describe_mesh();
   return scene;

@@ -42,6 +42,11 @@ struct Scene {
   // range at a time) or was released once an accelerator that keeps its own geometry was built.
   TriangleMesh mesh;
   std::shared_ptr<const TriangleSource> stream;  // set when streamed
+  // Where each object's (or object part's) triangles begin in `mesh`, ascending from 0, as a
+  // streamed scene's source would say: a chunked build of the mesh cuts its chunks there, so
+  // that a world is chunked the same whether its scene was kept whole (for a proxy) or not.
+  // {0} where the objects are not known (a mesh file, a subdivided scene).
+  std::vector<std::size_t> object_starts{0};
   // What stays known without the mesh: counts, bounds, each triangle's material.
   std::size_t triangle_count = 0;
   std::size_t vertex_count = 0;

@@ -19,6 +19,7 @@ std::uint32_t SceneAssembly::append_geometry(const TriangleMesh& part) {
                                  std::numeric_limits<std::uint32_t>::max()));
   }
   const auto offset = static_cast<std::uint32_t>(mesh_.positions.size());
+  object_starts_.push_back(mesh_.triangles.size());
   mesh_.positions.insert(mesh_.positions.end(), part.positions.begin(), part.positions.end());
   const std::size_t first = mesh_.triangles.size();
   mesh_.triangles.resize(first + part.triangles.size());
@@ -50,8 +51,10 @@ Scene SceneAssembly::finish(std::string name, const glm::vec3& background) && {
       throw SceneError(fmt::format("{}: a triangle uses material {} of {}", scene.name, material, materials_.size()));
     }
   }
-  scene.cleanup = validate_and_clean(mesh_, scene.name);
+  if (object_starts_.empty()) object_starts_.push_back(0);
+  scene.cleanup = validate_and_clean(mesh_, scene.name, &object_starts_);
   scene.mesh = std::move(mesh_);
+  scene.object_starts = std::move(object_starts_);
   scene.materials = std::move(materials_);
   scene.background = background;
   return scene;

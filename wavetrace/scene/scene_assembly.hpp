@@ -27,6 +27,7 @@ class SceneAssembly {
  private:
   std::uint32_t append_geometry(const TriangleMesh& part);
   TriangleMesh mesh_;
+  std::vector<std::size_t> object_starts_;  // each added part's first triangle
   std::vector<Material> materials_;
 };
 

@@ -56,7 +56,7 @@ void validate_bounds(const Bounds3& bounds, std::string_view source) {
   }
 }
 
-MeshCleanup validate_and_clean(TriangleMesh& mesh, std::string_view source) {
+MeshCleanup validate_and_clean(TriangleMesh& mesh, std::string_view source, std::vector<std::size_t>* object_starts) {
   if (mesh.triangles.empty()) throw SceneError(fmt::format("{}: the mesh has no triangles", source));
   for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
     const glm::vec3& p = mesh.positions[i];
@@ -88,7 +88,13 @@ MeshCleanup validate_and_clean(TriangleMesh& mesh, std::string_view source) {
 
   MeshCleanup cleanup;
   std::size_t kept = 0;
+  std::size_t next_start = 0;  // the first of object_starts not yet moved
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    if (object_starts != nullptr) {
+      for (; next_start < object_starts->size() && (*object_starts)[next_start] <= t; ++next_start) {
+        (*object_starts)[next_start] = kept;
+      }
+    }
     if (is_degenerate(mesh, mesh.triangles[t])) {
       ++cleanup.degenerate_dropped;
       continue;
@@ -99,6 +105,9 @@ MeshCleanup validate_and_clean(TriangleMesh& mesh, std::string_view source) {
   }
   mesh.triangles.resize(kept);
   if (!mesh.material_of_triangle.empty()) mesh.material_of_triangle.resize(kept);
+  if (object_starts != nullptr) {
+    for (; next_start < object_starts->size(); ++next_start) (*object_starts)[next_start] = kept;
+  }
   if (mesh.triangles.empty()) {
     throw SceneError(fmt::format("{}: all {} triangles are degenerate", source, cleanup.degenerate_dropped));
   }

@@ -68,7 +68,9 @@ struct MeshCleanup {
 // throws SceneError naming `source` for an empty mesh, NaN/Inf or huge coordinates,
 // out-of-range indices or a material list of the wrong length; drops degenerate triangles.
 // Leaves one vertex of spare capacity so an accelerator may read 16 bytes at the last vertex.
-MeshCleanup validate_and_clean(TriangleMesh& mesh, std::string_view source);
+// `object_starts` (ascending triangle indices, or null) are moved past the dropped triangles.
+MeshCleanup validate_and_clean(TriangleMesh& mesh, std::string_view source,
+                               std::vector<std::size_t>* object_starts = nullptr);
 
 // The checks of validate_and_clean that a streamed scene can make without its mesh: the box
 // of all its vertices is finite and within kMaxCoordinateMagnitude (throws SceneError).

@@ -30,16 +30,20 @@ class TriangleSource {
 };
 
 // The ranges of a mesh that is already in memory (read in place; it must outlive the source).
+// `object_starts` as Scene::object_starts: a scene's mesh is cut into chunks where the same
+// scene streamed would be.
 class MeshTriangleSource final : public TriangleSource {
  public:
-  explicit MeshTriangleSource(const TriangleMesh& mesh) : mesh_(mesh) {}
+  explicit MeshTriangleSource(const TriangleMesh& mesh, std::vector<std::size_t> object_starts = {0})
+      : mesh_(mesh), object_starts_(std::move(object_starts)) {}
   std::size_t triangle_count() const override { return mesh_.triangle_count(); }
   Bounds3 bounds() const override { return mesh_.bounds(); }
-  std::vector<std::size_t> object_starts() const override { return {0}; }
+  std::vector<std::size_t> object_starts() const override { return object_starts_; }
   TriangleMesh extract(std::size_t first, std::size_t count) const override;
 
  private:
   const TriangleMesh& mesh_;
+  std::vector<std::size_t> object_starts_;
 };
 
 }  // namespace wavetrace

@@ -14,7 +14,7 @@ namespace wavetrace {
 std::unique_ptr<Accelerator> build_world_accelerator(const Scene& scene, const AcceleratorOptions& options,
                                                     const ChunkStream* stream) {
   if (scene.streamed()) return make_world_accelerator(*scene.stream, nullptr, options, stream);
-  const MeshTriangleSource source(scene.mesh);
+  const MeshTriangleSource source(scene.mesh, scene.object_starts);
   return make_world_accelerator(source, &scene.mesh, options, stream);
 }
 
@@ -54,7 +54,7 @@ SceneForWorld load_scene_for_world(const RenderPlan& plan, bool keep_mesh, bool 
   check_scene_fits(checked, structure_to_file);
   Scene scene = load_scene(request);
   const Camera camera = resolve_camera(plan.camera, scene);
-  const MeshTriangleSource whole(scene.mesh);
+  const MeshTriangleSource whole(scene.mesh, scene.object_starts);
   const TriangleSource& triangles = scene.streamed() ? *scene.stream : static_cast<const TriangleSource&>(whole);
   ResolvedAccelerator resolved =
       resolve_accelerator(plan.accelerator, plan.accel_goal, triangles, camera, plan.image, scene.streamed());
