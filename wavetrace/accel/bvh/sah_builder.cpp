@@ -123,10 +123,9 @@ class Builder {
     next_node_.store(1);
     build_node(0, 0, count, root_bounds, centroid_bounds(0, count), 1);
     const std::uint32_t used = next_node_.load();
-    tree_.nodes.assign(slots_.get(), slots_.get() + used);
-    slots_.reset();
+    tree_.nodes = BuildNodes(slots_.release(), used);
     tree_.peak_bytes = references_.size() * sizeof(SahReference) + count * sizeof(std::uint32_t) +
-                       2 * std::size_t{used} * sizeof(BuildNode);
+                       std::size_t{used} * sizeof(BuildNode);
     tree_.primitive_order.resize(count);
     tbb::parallel_for(std::uint32_t{0}, count, [&](std::uint32_t i) { tree_.primitive_order[i] = references_[i].id; });
   }
@@ -391,8 +390,8 @@ class Builder {
   LargeArray<SahReference> references_;
   // Slots for the worst case, 2n - 1 nodes, as raw memory: a tree takes about one node per two
   // primitives or fewer, and the pages no node is written to are never touched (a first touch
-  // of a page costs a VM dearly: it was a third of a build's time). The nodes made are copied
-  // to the tree at the end.
+  // of a page costs a VM dearly: it was a third of a build's time). The tree takes them over
+  // at the end (BuildNodes).
   struct FreeSlots {
     void operator()(BuildNode* slots) const { std::free(slots); }
   };

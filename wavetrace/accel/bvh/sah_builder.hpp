@@ -4,6 +4,8 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdlib>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -39,8 +41,32 @@ struct BuildNode {
   bool leaf() const { return count > 0; }
 };
 
+// The builder's node slots, handed to the tree as they are: a build reserves the worst case,
+// 2n - 1 nodes, as raw memory and writes about a quarter of them, so the pages past `size()`
+// are never touched (never resident). Copying the nodes made into an array of their own had
+// both copies resident at once, at the top of an hmq chunk's build (measurements.md,
+// "A build's peak").
+class BuildNodes {
+ public:
+  BuildNodes() = default;
+  BuildNodes(BuildNode* slots, std::size_t size) : slots_(slots), size_(size) {}
+  std::size_t size() const { return size_; }
+  bool empty() const { return size_ == 0; }
+  const BuildNode& operator[](std::size_t i) const { return slots_[i]; }
+  BuildNode& operator[](std::size_t i) { return slots_[i]; }
+  const BuildNode* begin() const { return slots_.get(); }
+  const BuildNode* end() const { return slots_.get() + size_; }
+
+ private:
+  struct Free {
+    void operator()(BuildNode* slots) const { std::free(slots); }
+  };
+  std::unique_ptr<BuildNode[], Free> slots_;
+  std::size_t size_ = 0;
+};
+
 struct BuildTree {
-  LargeArray<BuildNode> nodes;                 // root at index 0
+  BuildNodes nodes;                            // root at index 0
   LargeArray<std::uint32_t> primitive_order;   // input primitive ids in leaf order
   std::size_t peak_bytes = 0;                  // the builder's own working memory at its peak
   std::uint32_t depth() const;                 // levels from the root to the deepest leaf, root = 1
