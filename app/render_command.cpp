@@ -15,6 +15,7 @@
 #include "app/progress_line.hpp"
 #include "app/render_report.hpp"
 #include "wavetrace/distribute/chunk_exchange.hpp"
+#include "wavetrace/distribute/chunk_probe.hpp"
 #include "wavetrace/distribute/shared_render.hpp"
 #include "wavetrace/distribute/mpi_session.hpp"
 #include "wavetrace/memory/process_memory.hpp"
@@ -113,7 +114,11 @@ int render_in_session(const RenderArguments& args, const MpiSession& session) {
                                       "than build.chunk_triangles, or a world file built with chunks",
                                       built.world().accelerator.name()));
       }
-      exchange = std::make_unique<ChunkExchange>(session, *chunks);
+      std::vector<std::uint64_t> rays_due;
+      if (done.distribute.replicate > 0.0) {
+        rays_due = probe_rays_due(*chunks, built.camera(), float(done.image.width) / float(done.image.height));
+      }
+      exchange = std::make_unique<ChunkExchange>(session, *chunks, done.distribute.replicate, rays_due);
     }
     RankSetup rank_setup{exchange.get()};
     if (exchange) {

@@ -231,6 +231,8 @@ nlohmann::json distribute_json(const DistributedRender& render, const RenderPlan
       ranks.back()["load_peak_resident_bytes"] = rank.load_peak_resident_bytes;
       ranks.back()["exchange"] = {{"chunks_owned", traffic.chunks_owned},
                                   {"triangles_owned", traffic.triangles_owned},
+                                  {"chunks_copied", traffic.chunks_copied},
+                                  {"triangles_copied", traffic.triangles_copied},
                                   {"queries_sent", traffic.queries_sent},
                                   {"rays_sent", traffic.rays_sent},
                                   {"bytes_sent", traffic.bytes_sent},
@@ -242,6 +244,7 @@ nlohmann::json distribute_json(const DistributedRender& render, const RenderPlan
   return {{"mode", to_string(plan.distribute.mode)},
           {"ranks", render.ranks.size()},
           {"range_rays", render.range_rays},
+          {"replicate", plan.distribute.replicate},
           {"wall_seconds", render.wall_seconds},
           {"rays_traced", render.rays_traced()},
           {"mrays_per_s", double(render.rays_traced()) / render.wall_seconds * 1e-6},
@@ -318,10 +321,12 @@ std::string render_table(const RenderFacts& facts) {
                            rank.wait_seconds, double(rank.peak_resident_bytes) * 1e-9);
       if (facts.plan.distribute.mode == DistributeMode::data) {
         const ChunkTraffic& traffic = rank.traffic;
-        table += fmt::format("    owns {} chunks ({} triangles); sent {} rays in {} queries ({:.1f} MB with the answers "
-                             "it gave), answered {} rays of others' in {} queries; waited {:.3f} s for answers; "
-                             "{:.2f} GB resident at most while loading (every chunk checked)\n",
-                             traffic.chunks_owned, traffic.triangles_owned, traffic.rays_sent, traffic.queries_sent,
+        table += fmt::format("    owns {} chunks ({} triangles) and answers {} of others' itself ({} triangles); sent {} "
+                             "rays in {} queries ({:.1f} MB with the answers it gave), answered {} rays of others' in {} "
+                             "queries; waited {:.3f} s for answers; {:.2f} GB resident at most while loading (every "
+                             "chunk checked)\n",
+                             traffic.chunks_owned, traffic.triangles_owned, traffic.chunks_copied,
+                             traffic.triangles_copied, traffic.rays_sent, traffic.queries_sent,
                              double(traffic.bytes_sent) * 1e-6, traffic.rays_answered, traffic.queries_answered,
                              traffic.wait_seconds, double(rank.load_peak_resident_bytes) * 1e-9);
       }

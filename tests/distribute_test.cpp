@@ -11,6 +11,8 @@
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "render_support.hpp"
@@ -181,6 +183,47 @@ TEST(Distribute, DataModeOnTwoAndThreeRanksIsTheSingleProcessImage) {
     EXPECT_GT(sent, 0u);
     EXPECT_EQ(sent, answered);  // every ray sent was answered by its chunk's owner
   }
+}
+
+// distribute.replicate: the chunks a probe of the view asks most are answered by every rank
+// itself. The image stays the single process's; the whole world copied, no ray travels; a
+// share of it, fewer rays travel than with none.
+TEST(Distribute, ReplicatedChunksAreAnsweredWhereTheRaysAre) {
+  if (!mpi_ready()) GTEST_SKIP() << "built without MPI, or no mpirun";
+  const std::string arguments =
+      "render builtin:room:20000 --accel hmq:width=8 --set build.chunk_triangles=2048 --size 64x48 --spp 2 "
+      "--set render.rays_in_flight=2048 --set distribute.range_rays=500 ";
+  const std::string alone = testing::write_temp_file("replicate_alone.exr", "");
+  const auto single = testing::run_wavetrace(arguments + "--threads 2 --out " + alone);
+  ASSERT_EQ(single.exit_code, 0) << single.output;
+  std::map<std::string, std::uint64_t> rays_sent;
+  for (const std::string share : {"0", "0.3", "1"}) {
+    const std::string image = testing::write_temp_file("replicate_" + share + ".exr", "");
+    const std::string stats = testing::write_temp_file("replicate_" + share + ".json", "");
+    const auto shared = testing::run_shell(mpirun(2) + WAVETRACE_BINARY + " " + arguments +
+                                           "--set distribute.mode=data --set distribute.replicate=" + share +
+                                           " --threads 1 --out " + image + " --stats " + stats + " 2>&1");
+    ASSERT_EQ(shared.exit_code, 0) << shared.output;
+    EXPECT_EQ(read_bytes(image), read_bytes(alone)) << "replicate " << share;
+    const nlohmann::json report = nlohmann::json::parse(std::ifstream(stats))["distribute"];
+    std::uint64_t owned = 0, copied = 0;
+    for (const nlohmann::json& rank : report["per_rank"]) {
+      const nlohmann::json& exchange = rank["exchange"];
+      rays_sent[share] += exchange["rays_sent"].get<std::uint64_t>();
+      owned += exchange["triangles_owned"].get<std::uint64_t>();
+      copied += exchange["triangles_copied"].get<std::uint64_t>();
+    }
+    EXPECT_EQ(owned, 20472u);
+    if (share == "0") EXPECT_EQ(copied, 0u);
+    if (share == "0.3") {
+      EXPECT_GT(copied, 0u);
+      EXPECT_LE(copied, 20472u * 3 / 10);  // the share is of the world's triangles
+    }
+    if (share == "1") EXPECT_EQ(copied, 20472u);  // every rank holds every chunk
+  }
+  EXPECT_GT(rays_sent["0"], 0u);
+  EXPECT_LT(rays_sent["0.3"], rays_sent["0"]);
+  EXPECT_EQ(rays_sent["1"], 0u);
 }
 
 TEST(Distribute, DataModeNeedsAChunkedWorld) {

@@ -72,8 +72,9 @@ struct ChunkExchange::Outgoing {
 #endif
 };
 
-ChunkExchange::ChunkExchange(const MpiSession& session, ChunkSet& chunks)
-    : session_(session), chunks_(chunks), owner_(chunks.chunk_count(), 0) {
+ChunkExchange::ChunkExchange(const MpiSession& session, ChunkSet& chunks, double replicate_share,
+                             std::span<const std::uint64_t> rays_due)
+    : session_(session), chunks_(chunks), owner_(chunks.chunk_count(), 0), replicated_(chunks.chunk_count(), false) {
   std::uint64_t total = 0;
   for (std::size_t c = 0; c < chunks.chunk_count(); ++c) total += chunks.chunk_triangles(c);
   // Rank r owns the chunks whose first triangle falls in [r, r + 1) * total / ranks: runs of
@@ -84,6 +85,21 @@ ChunkExchange::ChunkExchange(const MpiSession& session, ChunkSet& chunks)
     owner_[c] = static_cast<int>(std::min<std::uint64_t>(std::uint64_t(session.ranks()) * middle / std::max<std::uint64_t>(total, 1),
                                                          std::uint64_t(session.ranks() - 1)));
     before += chunks.chunk_triangles(c);
+  }
+  if (replicate_share > 0.0) {
+    if (rays_due.size() != chunks.chunk_count()) throw std::invalid_argument("distribute.replicate: one count a chunk");
+    // The most rays a triangle first: the traffic a copy saves for the memory it costs. Ties in chunk order.
+    std::vector<std::size_t> order(chunks.chunk_count());
+    for (std::size_t c = 0; c < order.size(); ++c) order[c] = c;
+    const auto density = [&](std::size_t c) { return double(rays_due[c]) / double(std::max<std::size_t>(chunks.chunk_triangles(c), 1)); };
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return density(a) > density(b); });
+    const double allowed = replicate_share * double(total);
+    double copied = 0.0;
+    for (const std::size_t c : order) {
+      if (rays_due[c] == 0 || copied + double(chunks.chunk_triangles(c)) > allowed) continue;
+      replicated_[c] = true;
+      copied += double(chunks.chunk_triangles(c));
+    }
   }
   chunks_.route(this);
 }
@@ -129,7 +145,7 @@ void ChunkExchange::answer_elsewhere(ChunkQuery query, const RayBatch& rays, Hit
     std::uint32_t count = 0;
     for (std::size_t c = 0; c + 1 < chunk_start.size(); ++c) {
       const std::uint32_t n = chunk_start[c + 1] - chunk_start[c];
-      if (n == 0 || owner_[c] != owner) continue;
+      if (n == 0 || !asks(c, owner)) continue;
       groups.push_back(static_cast<std::uint32_t>(c));
       groups.push_back(n);
       count += n;
@@ -181,7 +197,7 @@ void ChunkExchange::answer_elsewhere(ChunkQuery query, const RayBatch& rays, Hit
     std::uint32_t count = 0;
     for (std::size_t c = 0; c + 1 < chunk_start.size(); ++c) {
       const std::uint32_t n = chunk_start[c + 1] - chunk_start[c];
-      if (n == 0 || owner_[c] != status.MPI_SOURCE) continue;
+      if (n == 0 || !asks(c, status.MPI_SOURCE)) continue;
       slots.emplace_back(chunk_start[c], n);
       count += n;
     }
@@ -292,9 +308,13 @@ void ChunkExchange::finish() {
 ChunkTraffic ChunkExchange::traffic() const {
   ChunkTraffic traffic;
   for (std::size_t c = 0; c < owner_.size(); ++c) {
-    if (owner_[c] != session_.rank()) continue;
-    ++traffic.chunks_owned;
-    traffic.triangles_owned += chunks_.chunk_triangles(c);
+    if (owner_[c] == session_.rank()) {
+      ++traffic.chunks_owned;
+      traffic.triangles_owned += chunks_.chunk_triangles(c);
+    } else if (replicated_[c]) {
+      ++traffic.chunks_copied;
+      traffic.triangles_copied += chunks_.chunk_triangles(c);
+    }
   }
   traffic.queries_sent = queries_sent_.load();
   traffic.rays_sent = rays_sent_.load();

@@ -5,6 +5,7 @@
 #include <atomic>
 #include <cstdint>
 #include <mutex>
+#include <span>
 #include <vector>
 
 #include "wavetrace/accel/chunked/chunk_router.hpp"
@@ -15,6 +16,7 @@ namespace wavetrace {
 // What one rank's exchange did.
 struct ChunkTraffic {
   std::uint64_t chunks_owned = 0, triangles_owned = 0;
+  std::uint64_t chunks_copied = 0, triangles_copied = 0;  // others' chunks it answers itself (distribute.replicate)
   std::uint64_t queries_sent = 0, rays_sent = 0, bytes_sent = 0;  // its rounds' rays to owners, and their answers back
   std::uint64_t queries_answered = 0, rays_answered = 0;          // others' rays it answered
   double wait_seconds = 0.0;  // its tracing threads waiting for answers (serving others meanwhile)
@@ -33,12 +35,16 @@ class ChunkExchange final : public ChunkRouter {
  public:
   // Collective. Deals the chunks to the ranks in runs of consecutive chunks (chunks follow
   // the scene's order, so a run is a region) of about equal triangles, and routes `chunks`.
-  ChunkExchange(const MpiSession& session, ChunkSet& chunks);
+  // `replicate_share` of the world's triangles, the chunks with the most `rays_due` a triangle
+  // first (probe_rays_due, one count a chunk), are answered by every rank itself: the same on
+  // every rank, since every rank counts the same probe (distribute.replicate).
+  ChunkExchange(const MpiSession& session, ChunkSet& chunks, double replicate_share = 0.0,
+                std::span<const std::uint64_t> rays_due = {});
   ~ChunkExchange() override;
   ChunkExchange(const ChunkExchange&) = delete;
   ChunkExchange& operator=(const ChunkExchange&) = delete;
 
-  bool is_local(std::size_t chunk) const override { return owner_[chunk] == session_.rank(); }
+  bool is_local(std::size_t chunk) const override { return owner_[chunk] == session_.rank() || replicated_[chunk]; }
   void answer_elsewhere(ChunkQuery query, const RayBatch& rays, HitBatch& hits, std::span<const std::uint32_t> chunk_start,
                         const std::function<void()>& local_work) const override;
   void meanwhile() const override;  // answers every query waiting here
@@ -47,6 +53,7 @@ class ChunkExchange final : public ChunkRouter {
   void finish();
   ChunkTraffic traffic() const;
   int owner(std::size_t chunk) const { return owner_[chunk]; }
+  bool replicated(std::size_t chunk) const { return replicated_[chunk]; }
 
  private:
   bool answer_one_query() const;  // answers one query waiting here, if there is one
@@ -56,6 +63,9 @@ class ChunkExchange final : public ChunkRouter {
   const MpiSession& session_;
   ChunkSet& chunks_;
   std::vector<int> owner_;
+  std::vector<bool> replicated_;  // answered by every rank (never asked of its owner)
+  // Whether this round asks `rank` about `chunk`: its owner, and not a chunk every rank holds.
+  bool asks(std::size_t chunk, int rank) const { return owner_[chunk] == rank && !replicated_[chunk]; }
   struct Outgoing;
   mutable std::mutex outbox_mutex_;
   mutable std::vector<Outgoing*> outbox_;

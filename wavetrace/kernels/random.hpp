@@ -21,6 +21,7 @@ enum class RandomPurpose : std::uint32_t {
   photon_emission = 10,
   gather_direction = 11,
   gather_key = 12,
+  chunk_probe = 13,
 };
 
 // A 64-bit finalizer (SplitMix64's): full avalanche, cheap, and good enough for sampling.

@@ -469,6 +469,10 @@ const std::vector<ConfigKey>& config_schema() {
        "camera rays rank 0 hands out at a time (0: the image's rays over 64 ranges a rank, at least "
        "16 batches)",
        integer<&P::distribute, &DistributePlan::range_rays>},
+      {"distribute.replicate", T::real, 0.0, 0.0, 1.0, {},
+       "data mode: the share of the world's triangles every rank answers itself instead of asking their owner: "
+       "the chunks a probe of the view (a coarse image's camera rays and a bounce) asks most a triangle first",
+       real<&P::distribute, &DistributePlan::replicate>},
   };
   return schema;
 }

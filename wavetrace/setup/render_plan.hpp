@@ -38,6 +38,7 @@ std::string to_string(DistributeMode mode);
 struct DistributePlan {
   DistributeMode mode = DistributeMode::image;
   std::uint64_t range_rays = 0;  // camera rays handed out at a time (0: chosen from the image and ranks)
+  double replicate = 0.0;        // data mode: share of the triangles every rank answers itself
   bool operator==(const DistributePlan&) const = default;
 };
 

@@ -45,6 +45,10 @@ class ChunkSet {
   // From now on the chunks the router does not hold are asked through it (null: every chunk
   // here). Set between renders, never during one.
   virtual void route(const ChunkRouter* router) = 0;
+  // Closest hits of every ray of `rays`, as intersect_closest finds them, adding to
+  // `rays_due[c]` the rays each chunk c was asked about (rays_due holds chunk_count()): the
+  // work each chunk does for these rays. Before route() only (throws std::logic_error after).
+  virtual void count_rays_due(const RayBatch& rays, HitBatch& hits, std::span<std::uint64_t> rays_due) const = 0;
 };
 
 }  // namespace wavetrace

@@ -257,6 +257,14 @@ class ChunkedAccelerator final : public Accelerator, public ChunkSet {
     }
   }
   void route(const ChunkRouter* router) override { router_ = router; }
+  void count_rays_due(const RayBatch& rays, HitBatch& hits, std::span<std::uint64_t> rays_due) const override {
+    if (rays_due.size() != chunks_.size()) throw std::invalid_argument("count_rays_due: one count a chunk");
+    if (router_ != nullptr) throw std::logic_error("count_rays_due: the world is routed; count before routing it");
+    NullProbe probe;
+    trace<false>(rays, hits, rays.all(), probe, ChunkQuery::closest,
+                 [](const Accelerator& sub, const RayBatch& r, HitBatch& h, RayRange g) { sub.intersect_closest(r, h, g); },
+                 rays_due.data());
+  }
 
   MemoryReport memory() const override {
     MemoryReport report;
@@ -358,8 +366,10 @@ class ChunkedAccelerator final : public Accelerator, public ChunkSet {
     }
   }
 
+  // `rays_due` (null, or one count a chunk): each round's rays added to their chunk's count.
   template <bool kAnyHit, typename Probe, typename Query>
-  void trace(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe, ChunkQuery kind, Query&& query) const {
+  void trace(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe, ChunkQuery kind, Query&& query,
+             std::uint64_t* rays_due = nullptr) const {
     if (streamed_to_ != nullptr) throw std::logic_error(kStreamedIsNotTraced);
     thread_local RoundScratch scratch;
     const std::uint32_t n = range.size();
@@ -397,7 +407,10 @@ class ChunkedAccelerator final : public Accelerator, public ChunkSet {
         ++due;
       }
       if (due == 0) return;
-      for (std::size_t c = 0; c < chunks_.size(); ++c) scratch.chunk_start[c + 1] += scratch.chunk_start[c];
+      for (std::size_t c = 0; c < chunks_.size(); ++c) {
+        if (rays_due != nullptr) rays_due[c] += scratch.chunk_start[c + 1];
+        scratch.chunk_start[c + 1] += scratch.chunk_start[c];
+      }
       // Rays grouped by chunk, in their batch order within each group (coherent rays stay coherent).
       scratch.cursor.assign(scratch.chunk_start.begin(), scratch.chunk_start.end() - 1);
       std::vector<std::uint32_t>& cursor = scratch.cursor;
