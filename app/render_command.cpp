@@ -93,7 +93,10 @@ int render_in_session(const RenderArguments& args, const MpiSession& session) {
   // What was being done, so that running out of memory says where (and not "bad_alloc").
   std::string activity;
   try {
-    BuiltWorld built(plan, &activity);
+    // A data-parallel rank answers for its own chunks: the load gives each chunk's pages back
+    // once checked, so that it never holds the whole world.
+    const bool answers_a_part = session.distributed() && plan.distribute.mode == DistributeMode::data;
+    BuiltWorld built(plan, &activity, answers_a_part ? CheckedPages::given_back : CheckedPages::kept);
     if (const ResolvedAccelerator* resolved = built.resolution(); resolved != nullptr && session.rank() == 0) {
       if (const std::string line = resolution_summary(*resolved); !line.empty()) fmt::print("{}\n", line);
     }
@@ -122,8 +125,9 @@ int render_in_session(const RenderArguments& args, const MpiSession& session) {
     }
     RankSetup rank_setup{exchange.get()};
     if (exchange) {
-      // The load's checks read every chunk: give those pages back, so that the rank holds the
-      // chunks it answers for, and measure the render's peak apart from the load's.
+      // The load gave each chunk's pages back once checked; what it touched after the last
+      // chunk goes back too, so that the rank holds the chunks it answers for, and the render's
+      // peak is measured apart from the load's.
       rank_setup.load_peak_resident_bytes = read_resident_memory().peak_bytes;
       built.drop_resident_world_pages();
       reset_peak_resident_memory();

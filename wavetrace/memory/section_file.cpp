@@ -83,9 +83,11 @@ void SectionFile::fail(std::string_view section, const std::string& problem) con
   throw SectionFileError(fmt::format("{}: section '{}' {}", path_, section, problem));
 }
 
-std::shared_ptr<const SectionFile> SectionFile::open(const std::string& path, const std::optional<PagingRequest>& paging) {
+std::shared_ptr<const SectionFile> SectionFile::open(const std::string& path, const std::optional<PagingRequest>& paging,
+                                                     CheckedPages checked) {
   std::shared_ptr<SectionFile> file(new SectionFile());
   file->path_ = path;
+  file->checked_ = checked;
   const FileDescriptor fd(::open(path.c_str(), O_RDONLY | O_CLOEXEC));
   if (fd.get() < 0) file->fail({}, fmt::format("cannot open: {}", std::strerror(errno)));
   struct stat status {};

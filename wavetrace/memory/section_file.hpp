@@ -31,12 +31,19 @@ struct SectionInfo {
   std::uint32_t element_bytes = 1;
 };
 
+// What the loaders' checks of a mapped file leave resident: every page they touched, as a
+// render of the whole world wants; or, for a process that answers for a part of a chunked world
+// (a data-parallel rank), nothing past each chunk: a chunked world's loader gives the pages back
+// as each chunk is checked (chunk_checked), so the load never holds the whole world at once.
+enum class CheckedPages { kept, given_back };
+
 class SectionFile {
  public:
   // Without `paging` the file is mapped whole (read-only, shared); with it, its pages are
   // read on demand into a pool of the budget's size. Throws SectionFileError.
   static std::shared_ptr<const SectionFile> open(const std::string& path,
-                                                 const std::optional<PagingRequest>& paging = std::nullopt);
+                                                 const std::optional<PagingRequest>& paging = std::nullopt,
+                                                 CheckedPages checked = CheckedPages::kept);
   ~SectionFile();
   SectionFile(const SectionFile&) = delete;
   SectionFile& operator=(const SectionFile&) = delete;
@@ -49,6 +56,11 @@ class SectionFile {
   // A mapped file: gives back the pages this process has touched (they stay in the page
   // cache), so that from now on it holds only what it reads again. No-op when paged.
   void drop_resident_pages() const;
+  // Called by a chunked world's loader after each chunk: drop_resident_pages when the file was
+  // opened with CheckedPages::given_back, nothing otherwise.
+  void chunk_checked() const {
+    if (checked_ == CheckedPages::given_back) drop_resident_pages();
+  }
   // The real pager, when the file is paged; null when it is mapped.
   FilePager* pager() const { return pager_.get(); }
 
@@ -83,6 +95,7 @@ class SectionFile {
   void* mapping_ = nullptr;  // the whole-file mapping, when not paged
   std::unique_ptr<FilePager> pager_;
   double verify_seconds_ = 0.0;
+  CheckedPages checked_ = CheckedPages::kept;
 };
 
 }  // namespace wavetrace

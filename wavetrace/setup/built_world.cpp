@@ -12,12 +12,12 @@
 
 namespace wavetrace {
 
-BuiltWorld::BuiltWorld(const RenderPlan& plan, std::string* activity) : plan_(plan) {
+BuiltWorld::BuiltWorld(const RenderPlan& plan, std::string* activity, CheckedPages checked) : plan_(plan) {
   std::string ignored;
   std::string& doing = activity != nullptr ? *activity : ignored;
   if (is_world_file(plan_.scene.source)) {
     doing = fmt::format("loading the world {}", plan_.scene.source);
-    open_world_file();
+    open_world_file(checked);
   } else {
     if (plan_.memory.file_backing) {
       throw ConfigError(fmt::format(
@@ -29,8 +29,8 @@ BuiltWorld::BuiltWorld(const RenderPlan& plan, std::string* activity) : plan_(pl
 
 BuiltWorld::~BuiltWorld() = default;
 
-void BuiltWorld::open_world_file() {
-  loaded_ = load_world(plan_.scene.source, world_paging(plan_), plan_.pipeline.threads);
+void BuiltWorld::open_world_file(CheckedPages checked) {
+  loaded_ = load_world(plan_.scene.source, world_paging(plan_), plan_.pipeline.threads, checked);
   loaded_->accelerator->use_isa(parse_kernel_isa(plan_.accelerator.isa));
   phases_.load_seconds = loaded_->seconds;
   phases_.after_load_bytes = phases_.after_build_bytes = read_resident_memory().current_bytes;

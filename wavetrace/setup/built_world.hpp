@@ -10,6 +10,7 @@
 
 #include "wavetrace/accel/accelerator.hpp"
 #include "wavetrace/accel/proxy/proxy.hpp"
+#include "wavetrace/memory/section_file.hpp"
 #include "wavetrace/scene/camera.hpp"
 #include "wavetrace/scene/lights.hpp"
 #include "wavetrace/scene/scene.hpp"
@@ -31,7 +32,10 @@ class BuiltWorld {
  public:
   // Throws ConfigError, SceneError or SectionFileError naming what is wrong. `activity`,
   // when given, is kept up to date with what is being done (for an out-of-memory message).
-  explicit BuiltWorld(const RenderPlan& plan, std::string* activity = nullptr);
+  // `checked`: what loading a world file leaves resident (section_file.hpp; given back by a
+  // data-parallel rank).
+  explicit BuiltWorld(const RenderPlan& plan, std::string* activity = nullptr,
+                      CheckedPages checked = CheckedPages::kept);
   ~BuiltWorld();
   BuiltWorld(const BuiltWorld&) = delete;
   BuiltWorld& operator=(const BuiltWorld&) = delete;
@@ -54,7 +58,7 @@ class BuiltWorld {
 
  private:
   void build_from_scene(std::string& activity);
-  void open_world_file();
+  void open_world_file(CheckedPages checked);
 
   RenderPlan plan_;
   std::unique_ptr<LoadedWorld> loaded_;  // a world file

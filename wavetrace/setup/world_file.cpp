@@ -183,11 +183,12 @@ void save_world(SectionWriter& out, const Scene& scene, const LightSampler& ligh
   out.finish();
 }
 
-std::unique_ptr<LoadedWorld> load_world(const std::string& path, const std::optional<PagingRequest>& paging, int threads) {
+std::unique_ptr<LoadedWorld> load_world(const std::string& path, const std::optional<PagingRequest>& paging, int threads,
+                                        CheckedPages checked) {
   const auto start = std::chrono::steady_clock::now();
   auto loaded = std::make_unique<LoadedWorld>();
   LoadedWorld& world = *loaded;
-  world.file = SectionFile::open(path, paging);
+  world.file = SectionFile::open(path, paging, checked);
   const SectionFile& file = *world.file;
   SectionLoader(world.file, "world.").expect_kind("world", kWorldFileVersion);
 

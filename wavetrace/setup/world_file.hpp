@@ -86,8 +86,9 @@ struct RenderPlan;
 std::optional<PagingRequest> world_paging(const RenderPlan& plan);
 
 // Maps `path` (or pages it under `paging`) and loads the world in place. `threads` is for
-// a rebuilt Embree. Throws SectionFileError naming the file and its problem.
+// a rebuilt Embree; `checked` says what the load's checks leave resident (section_file.hpp).
+// Throws SectionFileError naming the file and its problem.
 std::unique_ptr<LoadedWorld> load_world(const std::string& path, const std::optional<PagingRequest>& paging = std::nullopt,
-                       int threads = 0);
+                                        int threads = 0, CheckedPages checked = CheckedPages::kept);
 
 }  // namespace wavetrace

@@ -108,6 +108,7 @@ class ChunkedAccelerator final : public Accelerator, public ChunkSet {
       SectionLoader chunk_in(in.file(), in.prefix() + fmt::format("chunk.{}/", c));
       chunks_[c] = Chunk{saved[c].first, saved[c].count, saved[c].bounds, nullptr, load_chunk(chunk_in), {}};
       chunks_[c].memory = chunks_[c].accelerator->memory();
+      in.file()->chunk_checked();
     }
   }
 
