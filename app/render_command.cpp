@@ -117,11 +117,12 @@ int render_in_session(const RenderArguments& args, const MpiSession& session) {
                                       "than build.chunk_triangles, or a world file built with chunks",
                                       built.world().accelerator.name()));
       }
-      std::vector<std::uint64_t> rays_due;
-      if (done.distribute.replicate > 0.0) {
-        rays_due = probe_rays_due(*chunks, built.camera(), float(done.image.width) / float(done.image.height));
+      ChunkSharing sharing{done.distribute.balance, done.distribute.replicate, {}};
+      if (sharing.balance == DistributeBalance::rays || sharing.replicate > 0.0) {
+        sharing.rays_due = probe_rays_due(*chunks, built.camera(), float(done.image.width) / float(done.image.height),
+                                          128, [&] { built.drop_resident_world_pages(); });
       }
-      exchange = std::make_unique<ChunkExchange>(session, *chunks, done.distribute.replicate, rays_due);
+      exchange = std::make_unique<ChunkExchange>(session, *chunks, sharing);
     }
     RankSetup rank_setup{exchange.get()};
     if (exchange) {

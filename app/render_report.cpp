@@ -245,6 +245,7 @@ nlohmann::json distribute_json(const DistributedRender& render, const RenderPlan
           {"ranks", render.ranks.size()},
           {"range_rays", render.range_rays},
           {"replicate", plan.distribute.replicate},
+          {"balance", to_string(plan.distribute.balance)},
           {"wall_seconds", render.wall_seconds},
           {"rays_traced", render.rays_traced()},
           {"mrays_per_s", double(render.rays_traced()) / render.wall_seconds * 1e-6},

@@ -7,7 +7,7 @@
 # Usage: bench/distribute_suite.sh SCENE OUT_DIR   (SCENE: a saved world .wtw, or builtin:...)
 # Settings (environment): SIZE (640x480), SPP (8), DEPTH (5), HEURISTIC (hph), REPEAT (3),
 #   RUNS ("alone:1:2 image:2:1"): MODE:RANKS:THREADS each, alone = without mpirun; data mode may
-#   add :SHARE, its distribute.replicate (data:2:1:0.25).
+#   add :SHARE, its distribute.replicate, and :BALANCE, its distribute.balance (data:2:1:0.25:rays).
 set -euo pipefail
 scene=${1:?usage: bench/distribute_suite.sh SCENE OUT_DIR}
 out=${2:-out/distribute}
@@ -21,13 +21,14 @@ common=(render "$scene" --size "${SIZE:-640x480}" --spp "${SPP:-8}" --set "reord
 cat "$out/cpu.txt"
 for repeat in $(seq 1 "${REPEAT:-3}"); do
   for run in ${RUNS:-alone:1:2 image:2:1}; do
-    IFS=: read -r mode ranks threads share <<< "$run"
-    name="$out/${mode}_${ranks}x${threads}${share:+_r$share}_$repeat"
+    IFS=: read -r mode ranks threads share balance <<< "$run"
+    name="$out/${mode}_${ranks}x${threads}${share:+_r$share}${balance:+_$balance}_$repeat"
     if [[ $mode == alone ]]; then
       "$wavetrace" "${common[@]}" --threads "$threads" --out "$name.exr" --stats "$name.json" > "$name.txt" 2>&1
     else
       mpirun --oversubscribe -np "$ranks" "$wavetrace" "${common[@]}" --threads "$threads" \
           --set "distribute.mode=$mode" --set "distribute.replicate=${share:-0}" \
+          --set "distribute.balance=${balance:-triangles}" \
           --out "$name.exr" --stats "$name.json" > "$name.txt" 2>&1
     fi
   done
@@ -41,8 +42,9 @@ print("| run | ranks x threads | render s (median) | rays traced | Mrays/s (medi
 print("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |")
 alone_peak = None
 for run in runs:
-    mode, ranks, threads, *share = run.split(":")
-    tag = f"_r{share[0]}" if share else ""
+    mode, ranks, threads, *extra = run.split(":")
+    share, balance = (extra + [None, None])[:2]
+    tag = (f"_r{share}" if share else "") + (f"_{balance}" if balance else "")
     files = sorted(glob.glob(f"{out}/{mode}_{ranks}x{threads}{tag}_[0-9]*.json"))
     seconds, rates, peaks, loads, sent, traced = [], [], [], [], [], 0
     for path in files:
@@ -63,7 +65,8 @@ for run in runs:
     first = f"{out}/{runs[0].split(':')[0]}_{runs[0].split(':')[1]}x{runs[0].split(':')[2]}_1.exr"
     identical = all(filecmp.cmp(p.replace(".json", ".exr"), first, shallow=False) for p in files)
     alone_peak = alone_peak or max(peaks)
-    print(f"| {mode}{' (replicate ' + share[0] + ')' if share else ''} | {ranks} x {threads} | {statistics.median(seconds):.3f} | {traced:,} | {rate:.3f} | "
+    label = mode + "".join(f", {k} {v}" for k, v in (("replicate", share), ("balance", balance)) if v)
+    print(f"| {label} | {ranks} x {threads} | {statistics.median(seconds):.3f} | {traced:,} | {rate:.3f} | "
           f"{rate / base:.3f} | {max(peaks):.2f} | {max(peaks) / alone_peak:.0%} | "
           f"{max(loads) if loads and max(loads) > 0 else float('nan'):.2f} | "
           f"{statistics.median(sent) if sent else 0:.1f} | {'identical' if identical else 'DIFFERS'} |")

@@ -224,6 +224,20 @@ TEST(Distribute, ReplicatedChunksAreAnsweredWhereTheRaysAre) {
   EXPECT_GT(rays_sent["0"], 0u);
   EXPECT_LT(rays_sent["0.3"], rays_sent["0"]);
   EXPECT_EQ(rays_sent["1"], 0u);
+
+  // Chunks dealt by the probe's rays instead of triangles: another deal, the same image.
+  const std::string image = testing::write_temp_file("balance_rays.exr", "");
+  const std::string stats = testing::write_temp_file("balance_rays.json", "");
+  const auto shared = testing::run_shell(mpirun(2) + WAVETRACE_BINARY + " " + arguments +
+                                         "--set distribute.mode=data --set distribute.balance=rays --threads 1 --out " +
+                                         image + " --stats " + stats + " 2>&1");
+  ASSERT_EQ(shared.exit_code, 0) << shared.output;
+  EXPECT_EQ(read_bytes(image), read_bytes(alone));
+  const nlohmann::json report = nlohmann::json::parse(std::ifstream(stats))["distribute"];
+  EXPECT_EQ(report["balance"], "rays");
+  std::uint64_t owned = 0;
+  for (const nlohmann::json& rank : report["per_rank"]) owned += rank["exchange"]["triangles_owned"].get<std::uint64_t>();
+  EXPECT_EQ(owned, 20472u);
 }
 
 TEST(Distribute, DataModeNeedsAChunkedWorld) {

@@ -72,28 +72,38 @@ struct ChunkExchange::Outgoing {
 #endif
 };
 
-ChunkExchange::ChunkExchange(const MpiSession& session, ChunkSet& chunks, double replicate_share,
-                             std::span<const std::uint64_t> rays_due)
+ChunkExchange::ChunkExchange(const MpiSession& session, ChunkSet& chunks, const ChunkSharing& sharing)
     : session_(session), chunks_(chunks), owner_(chunks.chunk_count(), 0), replicated_(chunks.chunk_count(), false) {
-  std::uint64_t total = 0;
-  for (std::size_t c = 0; c < chunks.chunk_count(); ++c) total += chunks.chunk_triangles(c);
-  // Rank r owns the chunks whose first triangle falls in [r, r + 1) * total / ranks: runs of
-  // about equal triangles, every rank at least one chunk where there are enough.
+  const bool needs_rays = sharing.balance == DistributeBalance::rays || sharing.replicate > 0.0;
+  if (needs_rays && sharing.rays_due.size() != chunks.chunk_count()) {
+    throw std::invalid_argument("distribute: balance by rays and replicate need one probe count a chunk");
+  }
+  std::uint64_t triangles = 0, rays = 0;
+  for (std::size_t c = 0; c < chunks.chunk_count(); ++c) {
+    triangles += chunks.chunk_triangles(c);
+    if (needs_rays) rays += sharing.rays_due[c];
+  }
+  // A probe that met nothing cannot weigh the chunks: triangles do.
+  const bool by_rays = sharing.balance == DistributeBalance::rays && rays > 0;
+  const auto weight = [&](std::size_t c) { return by_rays ? sharing.rays_due[c] : std::uint64_t(chunks.chunk_triangles(c)); };
+  const std::uint64_t total = by_rays ? rays : triangles;
+  // Rank r owns the chunks whose weight's middle falls in [r, r + 1) * total / ranks: runs of
+  // about equal weight, every rank at least one chunk where there are enough.
   std::uint64_t before = 0;
   for (std::size_t c = 0; c < chunks.chunk_count(); ++c) {
-    const std::uint64_t middle = before + chunks.chunk_triangles(c) / 2;
+    const std::uint64_t middle = before + weight(c) / 2;
     owner_[c] = static_cast<int>(std::min<std::uint64_t>(std::uint64_t(session.ranks()) * middle / std::max<std::uint64_t>(total, 1),
                                                          std::uint64_t(session.ranks() - 1)));
-    before += chunks.chunk_triangles(c);
+    before += weight(c);
   }
-  if (replicate_share > 0.0) {
-    if (rays_due.size() != chunks.chunk_count()) throw std::invalid_argument("distribute.replicate: one count a chunk");
+  if (sharing.replicate > 0.0) {
     // The most rays a triangle first: the traffic a copy saves for the memory it costs. Ties in chunk order.
+    const std::vector<std::uint64_t>& rays_due = sharing.rays_due;
     std::vector<std::size_t> order(chunks.chunk_count());
     for (std::size_t c = 0; c < order.size(); ++c) order[c] = c;
     const auto density = [&](std::size_t c) { return double(rays_due[c]) / double(std::max<std::size_t>(chunks.chunk_triangles(c), 1)); };
     std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return density(a) > density(b); });
-    const double allowed = replicate_share * double(total);
+    const double allowed = sharing.replicate * double(triangles);
     double copied = 0.0;
     for (const std::size_t c : order) {
       if (rays_due[c] == 0 || copied + double(chunks.chunk_triangles(c)) > allowed) continue;

@@ -5,11 +5,11 @@
 #include <atomic>
 #include <cstdint>
 #include <mutex>
-#include <span>
 #include <vector>
 
 #include "wavetrace/accel/chunked/chunk_router.hpp"
 #include "wavetrace/distribute/mpi_session.hpp"
+#include "wavetrace/setup/render_plan.hpp"
 
 namespace wavetrace {
 
@@ -20,6 +20,19 @@ struct ChunkTraffic {
   std::uint64_t queries_sent = 0, rays_sent = 0, bytes_sent = 0;  // its rounds' rays to owners, and their answers back
   std::uint64_t queries_answered = 0, rays_answered = 0;          // others' rays it answered
   double wait_seconds = 0.0;  // its tracing threads waiting for answers (serving others meanwhile)
+};
+
+// How the ranks share a chunked world's chunks.
+struct ChunkSharing {
+  // Runs of consecutive chunks (chunks follow the scene's order, so a run is a region) are
+  // dealt about equal in triangles (memory) or in `rays_due` (work).
+  DistributeBalance balance = DistributeBalance::triangles;
+  // This share of the world's triangles, the chunks with the most `rays_due` a triangle first,
+  // is answered by every rank itself.
+  double replicate = 0.0;
+  // The rays each chunk was asked about by probe_rays_due (one count a chunk; the same on every
+  // rank, since every rank counts the same probe): needed by balance = rays and replicate > 0.
+  std::vector<std::uint64_t> rays_due;
 };
 
 // Wire formats (little-endian, as this machine writes them; all ranks run one build):
@@ -33,13 +46,9 @@ struct ChunkTraffic {
 //   done, tag kDone: empty; a rank's render has finished and it asks nothing more.
 class ChunkExchange final : public ChunkRouter {
  public:
-  // Collective. Deals the chunks to the ranks in runs of consecutive chunks (chunks follow
-  // the scene's order, so a run is a region) of about equal triangles, and routes `chunks`.
-  // `replicate_share` of the world's triangles, the chunks with the most `rays_due` a triangle
-  // first (probe_rays_due, one count a chunk), are answered by every rank itself: the same on
-  // every rank, since every rank counts the same probe (distribute.replicate).
-  ChunkExchange(const MpiSession& session, ChunkSet& chunks, double replicate_share = 0.0,
-                std::span<const std::uint64_t> rays_due = {});
+  // Deals the chunks to the ranks as `sharing` says (every rank the same deal) and routes
+  // `chunks`. Throws std::invalid_argument where `sharing` needs rays_due and has none.
+  ChunkExchange(const MpiSession& session, ChunkSet& chunks, const ChunkSharing& sharing = {});
   ~ChunkExchange() override;
   ChunkExchange(const ChunkExchange&) = delete;
   ChunkExchange& operator=(const ChunkExchange&) = delete;
