@@ -72,10 +72,13 @@ TEST(SpaceFillingCurve, HilbertStepsBetweenNeighbouringCells) {
   expect_curve_visits_every_cell_once<5, 2>([](auto c) { return hilbert_key<5, 2>(c); }, true);
 }
 
+// Small arrays sort in one block, large ones (200k) in blocks on several threads.
 TEST(RadixSort, SortsStablyLikeAStableComparisonSort) {
-  for (const std::uint64_t key_mask : {std::uint64_t{0xF}, std::uint64_t{0xFFFF0000FF}, ~std::uint64_t{0}}) {
+  for (const std::uint32_t count : {5000u, 200000u})
+  for (const std::uint64_t key_mask : {std::uint64_t{0xF}, std::uint64_t{0xFFFF0000FF}, ~std::uint64_t{0},
+                                       (std::uint64_t{1} << 63) | 0xFFF}) {
     std::vector<SortEntry> entries;
-    for (std::uint32_t i = 0; i < 5000; ++i) {
+    for (std::uint32_t i = 0; i < count; ++i) {
       entries.push_back({random_bits(i, 1, 0, RandomPurpose::benchmark) & key_mask, i / 100, i % 100});
     }
     std::vector<SortEntry> expected = entries, scratch;
