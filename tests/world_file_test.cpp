@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cctype>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -604,42 +603,6 @@ TEST(CraftedLeaves, GridLinesAndStripCornersStayInRangeForAnyInput) {
       EXPECT_FLOAT_EQ(std::fabs(hits.normal_z[0]), 1.0f) << code;
     }
   }
-}
-
-// Kilobytes of `path`'s mapping resident in this process (its /proc/self/smaps entry).
-std::size_t resident_kilobytes_of_mapping(const std::string& path) {
-  std::ifstream smaps("/proc/self/smaps");
-  const std::string absolute = std::filesystem::absolute(path).string();
-  std::size_t total = 0;
-  bool inside = false;
-  for (std::string line; std::getline(smaps, line);) {
-    if (!line.empty() && std::isxdigit(static_cast<unsigned char>(line[0])) && line.find('-') < 16) {
-      inside = line.ends_with(absolute);
-    } else if (inside && line.starts_with("Rss:")) {
-      total += std::stoull(line.substr(4));
-    }
-  }
-  return total;
-}
-
-// A data-parallel rank's load (CheckedPages::given_back) gives each chunk's pages back once
-// it is checked: after the load it holds a small part of what a whole load holds.
-TEST(WorldFile, ALoadThatGivesBackCheckedChunksHoldsLittleOfTheWorld) {
-  const std::string world = temp_path("given_back.wtw");
-  const auto built = testing::run_wavetrace("build builtin:room:200k --accel hmq:width=8 "
-                                            "--set build.chunk_triangles=16384 --out " + world);
-  ASSERT_EQ(built.exit_code, 0) << built.output;
-  std::size_t kept = 0, given_back = 0;
-  {
-    const std::unique_ptr<LoadedWorld> loaded = load_world(world, std::nullopt, 1, CheckedPages::kept);
-    kept = resident_kilobytes_of_mapping(world);
-  }
-  {
-    const std::unique_ptr<LoadedWorld> loaded = load_world(world, std::nullopt, 1, CheckedPages::given_back);
-    given_back = resident_kilobytes_of_mapping(world);
-  }
-  EXPECT_GT(kept, 1000u) << "the checks of a whole load touch the world (about 2 MB)";
-  EXPECT_LT(given_back, kept / 4) << kept << " KB kept against " << given_back << " KB given back";
 }
 
 TEST(WorldFileCli, BuildRenderAndInfo) {

@@ -85,7 +85,9 @@ ChunkExchange::ChunkExchange(const MpiSession& session, ChunkSet& chunks, const 
   }
   // A probe that met nothing cannot weigh the chunks: triangles do.
   const bool by_rays = sharing.balance == DistributeBalance::rays && rays > 0;
-  const auto weight = [&](std::size_t c) { return by_rays ? sharing.rays_due[c] : std::uint64_t(chunks.chunk_triangles(c)); };
+  const auto weight = [&](std::size_t c) {
+    return by_rays ? sharing.rays_due[c] : std::uint64_t(chunks.chunk_triangles(c));
+  };
   const std::uint64_t total = by_rays ? rays : triangles;
   // Rank r owns the chunks whose weight's middle falls in [r, r + 1) * total / ranks: runs of
   // about equal weight, every rank at least one chunk where there are enough.
@@ -101,7 +103,9 @@ ChunkExchange::ChunkExchange(const MpiSession& session, ChunkSet& chunks, const 
     const std::vector<std::uint64_t>& rays_due = sharing.rays_due;
     std::vector<std::size_t> order(chunks.chunk_count());
     for (std::size_t c = 0; c < order.size(); ++c) order[c] = c;
-    const auto density = [&](std::size_t c) { return double(rays_due[c]) / double(std::max<std::size_t>(chunks.chunk_triangles(c), 1)); };
+    const auto density = [&](std::size_t c) {
+      return double(rays_due[c]) / double(std::max<std::size_t>(chunks.chunk_triangles(c), 1));
+    };
     std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return density(a) > density(b); });
     const double allowed = sharing.replicate * double(triangles);
     double copied = 0.0;
