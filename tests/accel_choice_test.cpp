@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include <fmt/format.h>
 #include <glm/trigonometric.hpp>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -173,6 +174,39 @@ TEST(AccelChoice, AChunkedBuildThatFitsOneChunkAtATimeIsBuiltSo) {
   } catch (const ConfigError& error) {
     EXPECT_NE(std::string(error.what()).find("hmq:width=8"), std::string::npos) << error.what();
   }
+}
+
+// A budget too small for a whole (or default-chunked) build takes the compact structure in
+// smaller chunks, measured in the same pass: a quarter of the size each step, down to
+// kSmallestAutoChunk; a roomy one keeps the options' chunks.
+TEST(AccelChoice, ABudgetTooSmallForTheBuildTakesSmallerChunks) {
+  const Scene scene = make_builtin_scene("builtin:room:300k");
+  const std::size_t default_chunk = AcceleratorOptions{}.chunk_triangles;
+  const SceneTraits traits =
+      measure_scene_traits(MeshTriangleSource(scene.mesh, scene.object_starts), default_chunk, nullptr, nullptr, true);
+  ASSERT_GE(traits.smaller_chunkings.size(), 2u);
+  for (std::size_t k = 0; k < traits.smaller_chunkings.size(); ++k) {
+    const SceneTraits::Chunking& chunking = traits.smaller_chunkings[k];
+    EXPECT_GE(chunking.chunk_triangles, kSmallestAutoChunk);
+    EXPECT_GT(chunking.chunks, 1u);
+    EXPECT_LE(chunking.sizes.front(), chunking.chunk_triangles);
+    EXPECT_GE(chunking.overlap, 1.0);
+    if (k > 0) EXPECT_EQ(chunking.chunk_triangles * 4, traits.smaller_chunkings[k - 1].chunk_triangles);
+  }
+  const auto hmq8_with = [&](std::size_t budget) {
+    return candidate(choose_accelerator(traits, budget, 0.01, AcceleratorOptions{}, true, kAllowance), "hmq");
+  };
+  const AccelCandidate whole = hmq8_with(world_budget(100000));
+  EXPECT_TRUE(whole.fits);
+  EXPECT_FALSE(whole.chunked);
+  EXPECT_EQ(whole.spec.find(":chunk_triangles="), std::string::npos) << whole.spec;
+  const AccelCandidate tight = hmq8_with(std::size_t(whole.estimated_bytes) - 1);
+  EXPECT_TRUE(tight.fits) << tight.reason;
+  EXPECT_TRUE(tight.chunked);
+  EXPECT_LT(tight.options.chunk_triangles, default_chunk);
+  EXPECT_NE(tight.spec.find(fmt::format(":chunk_triangles={}", tight.options.chunk_triangles)), std::string::npos)
+      << tight.spec;
+  EXPECT_LT(tight.estimated_bytes, whole.estimated_bytes);
 }
 
 TEST(AccelChoice, TheChosenHmqGridMeetsTheErrorBound) {

@@ -141,7 +141,7 @@ AutoAllowance auto_allowance(const ImageSpec& image) {
 }
 
 SceneTraits measure_scene_traits(const TriangleSource& source, std::size_t chunk_triangles, const Camera* camera,
-                                 const ImageSpec* image) {
+                                 const ImageSpec* image, bool smaller_chunkings) {
   SceneTraits traits;
   traits.triangles = source.triangle_count();
   traits.bounds = source.bounds();
@@ -155,11 +155,22 @@ SceneTraits measure_scene_traits(const TriangleSource& source, std::size_t chunk
   std::vector<std::uint64_t> cells;
   cells.reserve(traits.triangles / stride + 1);
   std::atomic<std::uint64_t> cells_spanned{0};  // by the sampled triangles' boxes
-  const std::vector<ChunkRange> chunks =
-      chunk_triangles > 0 && traits.triangles > chunk_triangles
-          ? plan_chunks(source.object_starts(), traits.triangles, chunk_triangles)
-          : std::vector<ChunkRange>{};
-  std::vector<Bounds3> chunk_boxes(chunks.size());
+  // Plan 0 in chunks of chunk_triangles, then each smaller chunking asked for (an empty plan:
+  // never chunked at that size).
+  std::vector<std::size_t> plan_sizes = {chunk_triangles};
+  if (smaller_chunkings && chunk_triangles > 0) {
+    for (std::size_t size = chunk_triangles / 4; size >= kSmallestAutoChunk && size >= kMinChunkTriangles; size /= 4) {
+      plan_sizes.push_back(size);
+    }
+  }
+  std::vector<std::vector<ChunkRange>> plans;
+  for (const std::size_t size : plan_sizes) {
+    plans.push_back(size > 0 && traits.triangles > size ? plan_chunks(source.object_starts(), traits.triangles, size)
+                                                        : std::vector<ChunkRange>{});
+  }
+  std::vector<std::vector<Bounds3>> plan_boxes;
+  for (const std::vector<ChunkRange>& plan : plans) plan_boxes.emplace_back(plan.size());
+  const bool any_chunks = std::any_of(plans.begin(), plans.end(), [](const auto& plan) { return !plan.empty(); });
   std::vector<glm::vec3> centroids;  // a sample, to count the chunk boxes around each
   const std::size_t centroid_stride = std::max<std::size_t>(1, traits.triangles / kOverlapSamples);
   double nearest = std::numeric_limits<double>::infinity();
@@ -195,11 +206,15 @@ SceneTraits measure_scene_traits(const TriangleSource& source, std::size_t chunk
       }
       cells_spanned.fetch_add(overlapped, std::memory_order_relaxed);
     });
-    if (!chunks.empty()) {
+    if (any_chunks) {
       for (std::size_t i = (centroid_stride - first % centroid_stride) % centroid_stride; i < count; i += centroid_stride) {
         const glm::uvec3 t = chunk.triangles[i];
         centroids.push_back((chunk.positions[t.x] + chunk.positions[t.y] + chunk.positions[t.z]) / 3.0f);
       }
+    }
+    for (std::size_t p = 0; p < plans.size(); ++p) {
+      const std::vector<ChunkRange>& chunks = plans[p];
+      std::vector<Bounds3>& chunk_boxes = plan_boxes[p];
       for (std::size_t c = 0; c < chunks.size(); ++c) {
         const std::size_t begin = std::max(chunks[c].first, first);
         const std::size_t end = std::min(chunks[c].first + chunks[c].count, first + count);
@@ -251,17 +266,34 @@ SceneTraits measure_scene_traits(const TriangleSource& source, std::size_t chunk
     run = end;
   }
   traits.triangles_per_grid_cell = total > 0.0 ? std::max(1.0, squares / (share * total)) : 0.0;
-  if (!chunks.empty()) {
-    traits.chunks = chunks.size();
-    for (const ChunkRange& chunk : chunks) traits.chunk_sizes.push_back(chunk.count);
-    std::sort(traits.chunk_sizes.begin(), traits.chunk_sizes.end(), std::greater<>());
-    std::size_t containing = 0;
-    for (const glm::vec3& point : centroids) {
-      for (const Bounds3& box : chunk_boxes) {
-        containing += glm::all(glm::lessThanEqual(box.lower, point)) && glm::all(glm::lessThanEqual(point, box.upper));
-      }
+  for (std::size_t p = 0; p < plans.size(); ++p) {
+    SceneTraits::Chunking chunking{plan_sizes[p], 1.0, 1, {}};
+    if (!plans[p].empty()) {
+      chunking.chunks = plans[p].size();
+      for (const ChunkRange& chunk : plans[p]) chunking.sizes.push_back(chunk.count);
+      std::sort(chunking.sizes.begin(), chunking.sizes.end(), std::greater<>());
+      // Samples times chunks box tests (a billion for a billion triangles in chunks of 64k): in parallel.
+      const std::size_t containing = tbb::parallel_reduce(
+          tbb::blocked_range<std::size_t>(0, centroids.size()), std::size_t{0},
+          [&](const tbb::blocked_range<std::size_t>& range, std::size_t inside) {
+            for (std::size_t i = range.begin(); i != range.end(); ++i) {
+              for (const Bounds3& box : plan_boxes[p]) {
+                inside += glm::all(glm::lessThanEqual(box.lower, centroids[i])) &&
+                          glm::all(glm::lessThanEqual(centroids[i], box.upper));
+              }
+            }
+            return inside;
+          },
+          std::plus<>());
+      chunking.overlap = centroids.empty() ? 1.0 : std::max(1.0, double(containing) / double(centroids.size()));
     }
-    traits.chunk_overlap = centroids.empty() ? 1.0 : std::max(1.0, double(containing) / double(centroids.size()));
+    if (p == 0) {
+      traits.chunks = plans[0].empty() ? 1 : chunking.chunks;
+      traits.chunk_sizes = chunking.sizes;
+      traits.chunk_overlap = chunking.overlap;
+    } else if (!plans[p].empty()) {
+      traits.smaller_chunkings.push_back(std::move(chunking));
+    }
   }
   if (std::isfinite(nearest)) traits.nearest_in_view = nearest;
   return traits;
@@ -286,52 +318,68 @@ AccelChoice choose_accelerator(const SceneTraits& traits, std::size_t budget_byt
   for (const AcceleratorType* type : types) {
     const AutoCandidate& facts = type->automatic;
     AccelCandidate& candidate = choice.candidates.emplace_back(make_candidate(*type, base, max_error));
-    const AcceleratorOptions& options = candidate.options;
-    candidate.chunked = type->builds_in_chunks && traits.triangles > options.chunk_triangles;
-    candidate.estimated_speed = facts.relative_speed / (candidate.chunked ? chunk_slowdown(traits.chunk_overlap) : 1.0);
-    // Peak while building: the structure, the whole mesh unless the type keeps its own
-    // geometry and is built from a streamed source (counted apart even where the structure's
-    // bytes include the mesh it reads in place: measured peaks need it), the temporaries of
-    // the builds at once (the largest chunks, one per worker) and the process. On
-    // builtin:room:8M (render, VmHWM), estimate against peak: robust Embree 1.19 / 1.02 GB,
-    // bvh:width=8 1.57 / 1.54, hmq:width=8 0.90 / 0.64, raystrips:width=8 0.98 / 0.67;
-    // `bench report` measures them on its scenes.
-    double mesh = type->holds_own_geometry && streamed_source ? 0.0 : traits.mesh_bytes_per_triangle;
-    // bvh's chunks keep copies of their meshes, beside a whole mesh that was not streamed.
-    if (candidate.chunked && !type->holds_own_geometry && !streamed_source) mesh *= 2.0;
-    double structure = facts.structure_from_grid_entries
-                           ? kGridBytesPerTriangle + kGridBytesPerEntry * traits.grid_entries_per_triangle
-                           : type->bytes_per_triangle(options);
-    double build_temporaries = type->build_bytes_per_triangle;
-    if (facts.grows_in_sparse_chunks && candidate.chunked) {
-      const double sparse = std::max(1.0, kConnectedTrianglesPerVertex / std::max(traits.triangles_per_vertex, 1.0));
-      structure *= sparse;
-      build_temporaries *= sparse;
-    }
-    // The peak with `at_once` chunks built at the same time (the largest ones).
-    const auto estimate = [&](std::size_t at_once) {
-      double built_at_once = triangles;
-      if (candidate.chunked) {
-        built_at_once = 0.0;
-        for (std::size_t c = 0; c < std::min(traits.chunk_sizes.size(), at_once); ++c) {
-          built_at_once += double(traits.chunk_sizes[c]);
-        }
-        if (traits.chunk_sizes.empty()) built_at_once = std::min(triangles, double(options.chunk_triangles));
-      }
-      return triangles * (structure + mesh) + built_at_once * build_temporaries + double(allowance.process_bytes);
-    };
-    candidate.estimated_bytes = estimate(choice.allowance.builds_at_once);
-    candidate.fits = candidate.estimated_bytes <= double(budget_bytes);
-    // A chunked build that fits one chunk at a time is built so (build.chunks_at_once = 1):
-    // its cores share each chunk, a quarter slower to build at room:64M, no slower to trace.
+    // Chunks of the options' size first; a type built in chunks that fits in none of those
+    // tries smaller ones, whose builds hold less at once and whose boxes overlap more.
+    std::vector<SceneTraits::Chunking> chunkings = {
+        {candidate.options.chunk_triangles, traits.chunk_overlap, traits.chunks, traits.chunk_sizes}};
+    if (type->builds_in_chunks) chunkings.insert(chunkings.end(), traits.smaller_chunkings.begin(), traits.smaller_chunkings.end());
     bool one_at_a_time = false;
-    if (!candidate.fits && candidate.chunked && choice.allowance.builds_at_once > 1 && estimate(1) <= double(budget_bytes)) {
-      candidate.estimated_bytes = estimate(1);
-      candidate.fits = true;
-      candidate.options.chunks_at_once = 1;
-      candidate.spec += ":chunks_at_once=1";
-      one_at_a_time = true;
+    const SceneTraits::Chunking* used = &chunkings.front();
+    for (const SceneTraits::Chunking& chunking : chunkings) {
+      used = &chunking;
+      one_at_a_time = false;
+      candidate.options.chunks_at_once = base.chunks_at_once;
+      candidate.chunked = type->builds_in_chunks && traits.triangles > chunking.chunk_triangles;
+      candidate.estimated_speed = facts.relative_speed / (candidate.chunked ? chunk_slowdown(chunking.overlap) : 1.0);
+      // Peak while building: the structure, the whole mesh unless the type keeps its own
+      // geometry and is built from a streamed source (counted apart even where the structure's
+      // bytes include the mesh it reads in place: measured peaks need it), the temporaries of
+      // the builds at once (the largest chunks, one per worker) and the process. On
+      // builtin:room:8M (render, VmHWM), estimate against peak: robust Embree 1.19 / 1.02 GB,
+      // bvh:width=8 1.57 / 1.54, hmq:width=8 0.90 / 0.64, raystrips:width=8 0.98 / 0.67;
+      // `bench report` measures them on its scenes.
+      double mesh = type->holds_own_geometry && streamed_source ? 0.0 : traits.mesh_bytes_per_triangle;
+      // bvh's chunks keep copies of their meshes, beside a whole mesh that was not streamed.
+      if (candidate.chunked && !type->holds_own_geometry && !streamed_source) mesh *= 2.0;
+      double structure = facts.structure_from_grid_entries
+                             ? kGridBytesPerTriangle + kGridBytesPerEntry * traits.grid_entries_per_triangle
+                             : type->bytes_per_triangle(candidate.options);
+      double build_temporaries = type->build_bytes_per_triangle;
+      if (facts.grows_in_sparse_chunks && candidate.chunked) {
+        const double sparse = std::max(1.0, kConnectedTrianglesPerVertex / std::max(traits.triangles_per_vertex, 1.0));
+        structure *= sparse;
+        build_temporaries *= sparse;
+      }
+      // The peak with `at_once` chunks built at the same time (the largest ones).
+      const auto estimate = [&](std::size_t at_once) {
+        double built_at_once = triangles;
+        if (candidate.chunked) {
+          built_at_once = 0.0;
+          for (std::size_t c = 0; c < std::min(chunking.sizes.size(), at_once); ++c) {
+            built_at_once += double(chunking.sizes[c]);
+          }
+          if (chunking.sizes.empty()) built_at_once = std::min(triangles, double(chunking.chunk_triangles));
+        }
+        return triangles * (structure + mesh) + built_at_once * build_temporaries + double(allowance.process_bytes);
+      };
+      candidate.estimated_bytes = estimate(choice.allowance.builds_at_once);
+      candidate.fits = candidate.estimated_bytes <= double(budget_bytes);
+      // A chunked build that fits one chunk at a time is built so (build.chunks_at_once = 1):
+      // its cores share each chunk, a quarter slower to build at room:64M, no slower to trace.
+      if (!candidate.fits && candidate.chunked && choice.allowance.builds_at_once > 1 &&
+          estimate(1) <= double(budget_bytes)) {
+        candidate.estimated_bytes = estimate(1);
+        candidate.fits = true;
+        candidate.options.chunks_at_once = 1;
+        one_at_a_time = true;
+      }
+      if (candidate.fits) break;
     }
+    if (used != &chunkings.front()) {
+      candidate.options.chunk_triangles = used->chunk_triangles;
+      candidate.spec += fmt::format(":chunk_triangles={}", used->chunk_triangles);
+    }
+    if (one_at_a_time) candidate.spec += ":chunks_at_once=1";
 
     std::string error_reason;
     candidate.meets_error = true;
@@ -362,8 +410,8 @@ AccelChoice choose_accelerator(const SceneTraits& traits, std::size_t budget_byt
     const std::string size = fmt::format("about {} of {}", gigabytes(candidate.estimated_bytes), gigabytes(double(budget_bytes)));
     const std::string speed =
         candidate.chunked ? fmt::format("{:.2f}x robust Embree's speed ({} chunks{}, {:.2f} boxes around a triangle)",
-                                        candidate.estimated_speed, traits.chunks,
-                                        one_at_a_time ? " built one at a time" : "", traits.chunk_overlap)
+                                        candidate.estimated_speed, used->chunks,
+                                        one_at_a_time ? " built one at a time" : "", used->overlap)
                           : fmt::format("{:.2f}x robust Embree's speed", candidate.estimated_speed);
     if (!candidate.fits) {
       candidate.reason = "needs " + size;
@@ -456,7 +504,7 @@ ResolvedAccelerator resolve_accelerator(const AcceleratorOptions& options, const
   if (!goal.automatic && !hmq_pixel) return resolved;
   const bool needs_pixel = hmq_pixel || (goal.automatic && !goal.max_error);
   const SceneTraits traits = measure_scene_traits(source, goal.automatic ? options.chunk_triangles : 0,
-                                                  needs_pixel ? &camera : nullptr, &image);
+                                                  needs_pixel ? &camera : nullptr, &image, goal.automatic);
   if (needs_pixel) {
     if (!traits.nearest_in_view) {
       throw ConfigError("an error bound of 'pixel' needs a surface in view, and no triangle lies in the camera's view");

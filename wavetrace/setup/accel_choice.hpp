@@ -61,7 +61,20 @@ struct SceneTraits {
   double chunk_overlap = 1.0;
   std::size_t chunks = 1;
   std::vector<std::size_t> chunk_sizes;  // triangles, largest first (the chunked builds at once)
+  // The same measures for smaller chunks, which auto falls back to where a chunked candidate
+  // does not fit in chunks of the options' size (its build holds smaller chunks at once):
+  // each a quarter of the one before, measured in the same pass, largest first.
+  struct Chunking {
+    std::size_t chunk_triangles = 0;
+    double overlap = 1.0;
+    std::size_t chunks = 1;
+    std::vector<std::size_t> sizes;  // largest first
+  };
+  std::vector<Chunking> smaller_chunkings;
 };
+// The smallest chunks auto falls back to: a chunk's fixed costs (its box in the top BVH, a
+// round of the chunked walk) outweigh its build's temporaries below this.
+inline constexpr std::size_t kSmallestAutoChunk = std::size_t{1} << 16;
 inline constexpr std::size_t kTraitSampleLimit = std::size_t{1} << 20;
 // A mean over a grid cell past this is crowded; triangles per vertex under this, a soup.
 inline constexpr double kCrowdedGridCell = 64.0;
@@ -83,9 +96,12 @@ AutoAllowance auto_allowance(const ImageSpec& image);
 inline constexpr double kWholeMeshBytesPerTriangle = 22.0;
 
 // The pass; `chunk_triangles` as the chunked builder would cut the scene (0: never chunked);
-// `camera` and `image` (for the aspect) when the nearest distance in view is wanted.
+// `camera` and `image` (for the aspect) when the nearest distance in view is wanted; with
+// `smaller_chunkings`, the chunkings of a quarter, a sixteenth ... of chunk_triangles down to
+// kSmallestAutoChunk are measured too.
 SceneTraits measure_scene_traits(const TriangleSource& source, std::size_t chunk_triangles = 0,
-                                 const Camera* camera = nullptr, const ImageSpec* image = nullptr);
+                                 const Camera* camera = nullptr, const ImageSpec* image = nullptr,
+                                 bool smaller_chunkings = false);
 
 // Half the footprint of a pixel (at the image's centre, the narrowest) at `distance`.
 double half_pixel_footprint(const Camera& camera, const ImageSpec& image, double distance);
