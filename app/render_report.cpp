@@ -238,7 +238,8 @@ nlohmann::json distribute_json(const DistributedRender& render, const RenderPlan
                                   {"bytes_sent", traffic.bytes_sent},
                                   {"queries_answered", traffic.queries_answered},
                                   {"rays_answered", traffic.rays_answered},
-                                  {"wait_seconds", traffic.wait_seconds}};
+                                  {"wait_seconds", traffic.wait_seconds},
+                                  {"rounds_suspended", traffic.rounds_suspended}};
     }
   }
   return {{"mode", to_string(plan.distribute.mode)},
@@ -324,12 +325,12 @@ std::string render_table(const RenderFacts& facts) {
         const ChunkTraffic& traffic = rank.traffic;
         table += fmt::format("    owns {} chunks ({} triangles) and answers {} of others' itself ({} triangles); sent {} "
                              "rays in {} queries ({:.1f} MB with the answers it gave), answered {} rays of others' in {} "
-                             "queries; waited {:.3f} s for answers; {:.2f} GB resident at most while loading (every "
+                             "queries; its rounds waited {:.3f} s for answers ({} of them suspended, the thread tracing on); {:.2f} GB resident at most while loading (every "
                              "chunk checked)\n",
                              traffic.chunks_owned, traffic.triangles_owned, traffic.chunks_copied,
                              traffic.triangles_copied, traffic.rays_sent, traffic.queries_sent,
                              double(traffic.bytes_sent) * 1e-6, traffic.rays_answered, traffic.queries_answered,
-                             traffic.wait_seconds, double(rank.load_peak_resident_bytes) * 1e-9);
+                             traffic.wait_seconds, traffic.rounds_suspended, double(rank.load_peak_resident_bytes) * 1e-9);
       }
     }
   }

@@ -185,6 +185,47 @@ TEST(Distribute, DataModeOnTwoAndThreeRanksIsTheSingleProcessImage) {
   }
 }
 
+// A round whose rays travel is suspended and its thread traces other batches (rays that
+// travel on), unless WAVETRACE_SUSPEND_ROUNDS=0 keeps it waiting on its thread: the image is
+// the single process's either way, and only the first suspends rounds (none under
+// AddressSanitizer, which cannot follow TBB's stack switches).
+TEST(Distribute, RoundsSuspendedWhileTheirRaysTravelGiveTheSingleProcessImage) {
+  if (!mpi_ready()) GTEST_SKIP() << "built without MPI, or no mpirun";
+  const std::string arguments =
+      "render builtin:room:20000 --accel hmq:width=8 --set build.chunk_triangles=2048 --size 64x48 --spp 4 "
+      "--set render.max_depth=3 --set distribute.range_rays=500 --set distribute.mode=data ";
+  const std::string alone = testing::write_temp_file("suspend_alone.exr", "");
+  const auto single = testing::run_wavetrace(arguments + "--threads 2 --out " + alone);
+  ASSERT_EQ(single.exit_code, 0) << single.output;
+#if defined(__SANITIZE_ADDRESS__)
+  constexpr bool kSuspends = false;
+#else
+  constexpr bool kSuspends = true;
+#endif
+  for (const std::string setting : {"1", "0"}) {
+    const std::string image = testing::write_temp_file("suspend_" + setting + ".exr", "");
+    const std::string stats = testing::write_temp_file("suspend_" + setting + ".json", "");
+    const auto shared = testing::run_shell("WAVETRACE_SUSPEND_ROUNDS=" + setting + " " + mpirun(2) +
+                                           "-x WAVETRACE_SUSPEND_ROUNDS " + WAVETRACE_BINARY + " " + arguments +
+                                           "--threads 1 --out " + image + " --stats " + stats + " 2>&1");
+    ASSERT_EQ(shared.exit_code, 0) << shared.output;
+    EXPECT_EQ(read_bytes(image), read_bytes(alone)) << "WAVETRACE_SUSPEND_ROUNDS=" << setting;
+    std::uint64_t suspended = 0, sent = 0;
+    const nlohmann::json report = nlohmann::json::parse(std::ifstream(stats))["distribute"];
+    for (const nlohmann::json& rank : report["per_rank"]) {
+      suspended += rank["exchange"]["rounds_suspended"].get<std::uint64_t>();
+      sent += rank["exchange"]["queries_sent"].get<std::uint64_t>();
+    }
+    EXPECT_GT(sent, 0u);
+    if (setting == "1" && kSuspends) {
+      EXPECT_GT(suspended, 0u);
+      EXPECT_LE(suspended, sent);  // a round asks one query of each owner it needs
+    } else {
+      EXPECT_EQ(suspended, 0u);
+    }
+  }
+}
+
 // distribute.replicate: the chunks a probe of the view asks most are answered by every rank
 // itself. The image stays the single process's; the whole world copied, no ray travels; a
 // share of it, fewer rays travel than with none.

@@ -1,14 +1,21 @@
-// The exchange's messages (formats in chunk_exchange.hpp). Every send is non-blocking and
-// every wait answers others' queries meanwhile: two ranks waiting on each other's answers
-// both keep answering, so no rank waits on one that cannot move.
+// The exchange's messages (formats in chunk_exchange.hpp). Every send is non-blocking; a
+// round waiting for answers is suspended (its thread goes on to other batches) or, where it
+// cannot be, answers others' queries while it waits; and a polling thread answers and takes
+// in answers when no worker does. So no rank waits on one that cannot move.
 #include "wavetrace/distribute/chunk_exchange.hpp"
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <memory>
 #include <stdexcept>
 #include <thread>
+
+#include <tbb/task.h>
+#include <tbb/task_arena.h>
 
 #if WAVETRACE_HAVE_MPI
 #include <mpi.h>
@@ -19,15 +26,21 @@ namespace {
 
 constexpr int kQuery = 7101;
 constexpr int kDone = 7102;
-constexpr int kFirstReplyTag = 8000;  // a tracing thread's own tag: kFirstReplyTag + its number
+// Each round waiting for answers has a reply tag of its own, so answers find their round;
+// tags cycle through kReplyTags values (MPI promises tags up to 32767), far more than the
+// rounds a rank has waiting at once (one or a few a batch in flight).
+constexpr int kFirstReplyTag = 8000;
+constexpr std::uint64_t kReplyTags = 24000;
+constexpr std::uint64_t kMaxSuspendedRounds = 32;
 using Clock = std::chrono::steady_clock;
 
-// Each thread that waits for answers has a tag of its own, so answers find their thread.
-int reply_tag_of_this_thread() {
-  static std::atomic<int> next{0};
-  thread_local const int tag = kFirstReplyTag + next.fetch_add(1);
-  return tag;
-}
+// TBB's resumable tasks switch stacks, which AddressSanitizer cannot follow without
+// annotations TBB does not make: under it, rounds wait without being suspended.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kRoundsCanSuspend = false;
+#else
+constexpr bool kRoundsCanSuspend = true;
+#endif
 
 struct Writer {
   std::vector<std::byte>& out;
@@ -69,6 +82,58 @@ struct ChunkExchange::Outgoing {
   std::vector<std::byte> bytes;
 #if WAVETRACE_HAVE_MPI
   MPI_Request request = MPI_REQUEST_NULL;
+#endif
+};
+
+struct ChunkExchange::AnswerChannel {
+#if WAVETRACE_HAVE_MPI
+  MPI_Comm comm = MPI_COMM_NULL;
+#endif
+};
+
+// One round's wait: where each owner's answer goes, and how many are still out. Lives on
+// the waiting round's stack; registered under its reply tag before its queries leave, and
+// untouched by the receivers once the last answer is in.
+struct ChunkExchange::Waiter {
+  HitBatch* hits = nullptr;
+  std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> slots;  // per rank: (first slot, rays), in query order
+  std::vector<std::uint32_t> rays;                                          // per rank: the rays asked of it
+  std::size_t pending = 0;  // answers still out (waiters_mutex_)
+  std::exception_ptr error;  // an answer that did not fit its query
+  std::mutex mutex;          // the hand-over between the last answer and the round's suspension
+  bool parked = false, done = false;
+  std::atomic<bool> answered{false};  // for a round that spins rather than suspends
+#if __TBB_RESUMABLE_TASKS
+  tbb::task::suspend_point point{};
+#endif
+
+  // The last answer is in: wake the round (it may not have finished suspending yet).
+  void finish() {
+#if __TBB_RESUMABLE_TASKS
+    std::unique_lock lock(mutex);
+    done = true;
+    const bool resume = parked;
+    const tbb::task::suspend_point resume_point = point;
+    answered.store(true, std::memory_order_release);
+    lock.unlock();
+    if (resume) tbb::task::resume(resume_point);  // after which this waiter may be gone
+#else
+    answered.store(true, std::memory_order_release);
+#endif
+  }
+#if __TBB_RESUMABLE_TASKS
+  // From the suspension's callback: the round's stack is parked; resume it now if its answers
+  // came in the meantime.
+  void park(tbb::task::suspend_point at) {
+    std::unique_lock lock(mutex);
+    if (done) {
+      lock.unlock();
+      tbb::task::resume(at);
+      return;
+    }
+    parked = true;
+    point = at;
+  }
 #endif
 };
 
@@ -115,19 +180,51 @@ ChunkExchange::ChunkExchange(const MpiSession& session, ChunkSet& chunks, const 
       copied += double(chunks.chunk_triangles(c));
     }
   }
+  // WAVETRACE_SUSPEND_ROUNDS=0 keeps every round waiting on its thread, for the A/B.
+  const char* suspend_setting = std::getenv("WAVETRACE_SUSPEND_ROUNDS");
+  rounds_suspend_ = kRoundsCanSuspend && !(suspend_setting != nullptr && std::string(suspend_setting) == "0");
+  answers_ = std::make_unique<AnswerChannel>();
+#if WAVETRACE_HAVE_MPI
+  if (session_.distributed()) {
+    MPI_Comm_dup(MPI_COMM_WORLD, &answers_->comm);  // collective: every rank makes its exchange here
+    poller_ = std::thread([this] { poll_until_stopped(); });
+  }
+#endif
   chunks_.route(this);
 }
 
 ChunkExchange::~ChunkExchange() {
+  stop_polling_.store(true, std::memory_order_release);
+  if (poller_.joinable()) poller_.join();
+  // The answers' communicator is left to MPI_Finalize: freeing it is collective, and this
+  // runs on a failing rank's way out too.
   chunks_.route(nullptr);
   for (Outgoing* outgoing : outbox_) delete outgoing;  // finish() completed them; after an error MPI_Abort ends all
 }
 
-void ChunkExchange::send(std::vector<std::byte> message, int destination, int tag) const {
+void ChunkExchange::poll_until_stopped() {
+  // A short sleep when nothing came: the poller shares the cores with the workers, and an
+  // answer waits at most this long when no worker looks.
+  constexpr auto kIdle = std::chrono::microseconds(20);
+  try {
+    while (!stop_polling_.load(std::memory_order_acquire)) {
+      bool worked = receive_one_answer();
+      worked = answer_one_query() || worked;
+      progress_sends();
+      if (!worked) std::this_thread::sleep_for(kIdle);
+    }
+  } catch (const std::exception& error) {
+    // Every rank would wait on this one: say why and end them all, as a failed rank does.
+    std::fprintf(stderr, "wavetrace: rank %d: %s\n", session_.rank(), error.what());
+    session_.abort(1);
+  }
+}
+
+void ChunkExchange::send(std::vector<std::byte> message, int destination, int tag, bool answer) const {
 #if WAVETRACE_HAVE_MPI
   auto* outgoing = new Outgoing{std::move(message)};
-  MPI_Isend(outgoing->bytes.data(), static_cast<int>(outgoing->bytes.size()), MPI_BYTE, destination, tag, MPI_COMM_WORLD,
-            &outgoing->request);
+  MPI_Isend(outgoing->bytes.data(), static_cast<int>(outgoing->bytes.size()), MPI_BYTE, destination, tag,
+            answer ? answers_->comm : MPI_COMM_WORLD, &outgoing->request);
   bytes_sent_.fetch_add(outgoing->bytes.size(), std::memory_order_relaxed);
   std::lock_guard lock(outbox_mutex_);
   outbox_.push_back(outgoing);
@@ -148,23 +245,42 @@ void ChunkExchange::progress_sends() const {
 
 void ChunkExchange::answer_elsewhere(ChunkQuery query, const RayBatch& rays, HitBatch& hits,
                                      std::span<const std::uint32_t> chunk_start,
-                                     const std::function<void()>& local_work) const {
+                                     const std::function<void()>& local_work, bool may_suspend) const {
 #if WAVETRACE_HAVE_MPI
-  const int reply_tag = reply_tag_of_this_thread();
+  Waiter waiter;
+  waiter.hits = &hits;
+  waiter.slots.resize(std::size_t(session_.ranks()));
+  waiter.rays.assign(std::size_t(session_.ranks()), 0);
+  for (std::size_t c = 0; c + 1 < chunk_start.size(); ++c) {
+    const std::uint32_t n = chunk_start[c + 1] - chunk_start[c];
+    if (n == 0 || owner_[c] == session_.rank() || replicated_[c]) continue;
+    waiter.slots[std::size_t(owner_[c])].emplace_back(chunk_start[c], n);
+    waiter.rays[std::size_t(owner_[c])] += n;
+  }
+  for (int owner = 0; owner < session_.ranks(); ++owner) waiter.pending += waiter.rays[std::size_t(owner)] > 0 ? 1 : 0;
+  if (waiter.pending == 0) {
+    local_work();
+    return;
+  }
+  const int reply_tag = kFirstReplyTag + int(next_reply_.fetch_add(1, std::memory_order_relaxed) % kReplyTags);
+  {
+    // Registered before any query leaves, so that every answer finds its round.
+    std::lock_guard lock(waiters_mutex_);
+    if (!waiters_.emplace(reply_tag, &waiter).second) {
+      throw std::logic_error("chunk exchange: more rounds waiting at once than reply tags");
+    }
+  }
   // One query per owner with rays due this round, its groups in chunk order.
-  std::vector<int> asked;
   for (int owner = 0; owner < session_.ranks(); ++owner) {
-    if (owner == session_.rank()) continue;
+    const std::uint32_t count = waiter.rays[std::size_t(owner)];
+    if (count == 0) continue;
     std::vector<std::uint32_t> groups;
-    std::uint32_t count = 0;
     for (std::size_t c = 0; c + 1 < chunk_start.size(); ++c) {
       const std::uint32_t n = chunk_start[c + 1] - chunk_start[c];
       if (n == 0 || !asks(c, owner)) continue;
       groups.push_back(static_cast<std::uint32_t>(c));
       groups.push_back(n);
-      count += n;
     }
-    if (count == 0) continue;
     std::vector<std::byte> message;
     message.reserve(16 + groups.size() * 4 + std::size_t(count) * 33);
     Writer out{message};
@@ -182,61 +298,92 @@ void ChunkExchange::answer_elsewhere(ChunkQuery query, const RayBatch& rays, Hit
     send(std::move(message), owner, kQuery);
     queries_sent_.fetch_add(1, std::memory_order_relaxed);
     rays_sent_.fetch_add(count, std::memory_order_relaxed);
-    asked.push_back(owner);
   }
   local_work();
-  if (asked.empty()) return;
 
   const Clock::time_point start = Clock::now();
-  std::size_t pending = asked.size();
-  std::vector<std::byte> answer;
-  while (pending > 0) {
-    int arrived = 0;
-    MPI_Message message;
-    MPI_Status status;
-    MPI_Improbe(MPI_ANY_SOURCE, reply_tag, MPI_COMM_WORLD, &arrived, &message, &status);
-    if (!arrived) {
-      if (!answer_one_query()) {
-        progress_sends();
-        std::this_thread::yield();
-      }
-      continue;
+#if __TBB_RESUMABLE_TASKS
+  // Suspended only inside a task of an arena, with the poller there to resume it should every
+  // worker be idle.
+  // A suspended round holds its scratch (about 130 KB a batch of 1,024 rays) and a stack:
+  // past kMaxSuspendedRounds at once, a round waits on its thread as it would without.
+  const bool suspend = rounds_suspend_ && may_suspend && poller_.joinable() &&
+                       tbb::this_task_arena::current_thread_index() != tbb::task_arena::not_initialized;
+  if (suspend && !waiter.answered.load(std::memory_order_acquire)) {
+    if (rounds_suspended_now_.fetch_add(1, std::memory_order_acq_rel) < kMaxSuspendedRounds) {
+      rounds_suspended_.fetch_add(1, std::memory_order_relaxed);
+      tbb::task::suspend([&waiter](tbb::task::suspend_point point) { waiter.park(point); });
     }
-    int bytes = 0;
-    MPI_Get_count(&status, MPI_BYTE, &bytes);
-    answer.resize(std::size_t(bytes));
-    MPI_Mrecv(answer.data(), bytes, MPI_BYTE, &message, MPI_STATUS_IGNORE);
-    // The owner's slots in the order its query listed them.
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> slots;
-    std::uint32_t count = 0;
-    for (std::size_t c = 0; c + 1 < chunk_start.size(); ++c) {
-      const std::uint32_t n = chunk_start[c + 1] - chunk_start[c];
-      if (n == 0 || !asks(c, status.MPI_SOURCE)) continue;
-      slots.emplace_back(chunk_start[c], n);
-      count += n;
+    rounds_suspended_now_.fetch_sub(1, std::memory_order_acq_rel);
+  }
+#else
+  (void)may_suspend;
+#endif
+  while (!waiter.answered.load(std::memory_order_acquire)) {
+    if (!receive_one_answer() && !answer_one_query()) {
+      progress_sends();
+      std::this_thread::yield();
     }
-    if (std::size_t(bytes) != std::size_t(count) * HitBatch::kBytesPerHit) {
-      throw std::runtime_error("rank " + std::to_string(status.MPI_SOURCE) + " answered a chunk query with " +
-                               std::to_string(bytes) + " bytes for " + std::to_string(count) + " rays");
-    }
-    Reader in{answer};
-#define WAVETRACE_READ_HIT_COLUMN(type, name) \
-  for (const auto& [first, n] : slots) in.get(hits.name + first, n);
-    WAVETRACE_HIT_COLUMNS(WAVETRACE_READ_HIT_COLUMN)
-#undef WAVETRACE_READ_HIT_COLUMN
-    --pending;
   }
   wait_nanoseconds_.fetch_add(
       std::uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - start).count()),
       std::memory_order_relaxed);
+  if (waiter.error) std::rethrow_exception(waiter.error);
 #else
-  (void)query, (void)rays, (void)hits, (void)chunk_start;
+  (void)query, (void)rays, (void)hits, (void)chunk_start, (void)may_suspend;
   local_work();  // one rank: every chunk is local
 #endif
 }
 
+bool ChunkExchange::receive_one_answer() const {
+#if WAVETRACE_HAVE_MPI
+  if (answers_->comm == MPI_COMM_NULL) return false;
+  int arrived = 0;
+  MPI_Message message;
+  MPI_Status status;
+  MPI_Improbe(MPI_ANY_SOURCE, MPI_ANY_TAG, answers_->comm, &arrived, &message, &status);
+  if (!arrived) return false;
+  int bytes = 0;
+  MPI_Get_count(&status, MPI_BYTE, &bytes);
+  std::vector<std::byte> answer(static_cast<std::size_t>(bytes));
+  MPI_Mrecv(answer.data(), bytes, MPI_BYTE, &message, MPI_STATUS_IGNORE);
+  Waiter* waiter = nullptr;
+  bool last = false;
+  {
+    std::lock_guard lock(waiters_mutex_);
+    const auto found = waiters_.find(status.MPI_TAG);
+    if (found == waiters_.end()) {
+      throw std::runtime_error("rank " + std::to_string(status.MPI_SOURCE) + " answered a round (tag " +
+                               std::to_string(status.MPI_TAG) + ") no one here waits for");
+    }
+    waiter = found->second;
+    const auto source = std::size_t(status.MPI_SOURCE);
+    const std::uint32_t count = source < waiter->rays.size() ? waiter->rays[source] : 0;
+    if (std::size_t(bytes) != std::size_t(count) * HitBatch::kBytesPerHit) {
+      waiter->error = std::make_exception_ptr(std::runtime_error(
+          "rank " + std::to_string(status.MPI_SOURCE) + " answered a chunk query with " + std::to_string(bytes) +
+          " bytes for " + std::to_string(count) + " rays"));
+    } else {
+      // The owner's slots in the order its query listed them.
+      HitBatch& hits = *waiter->hits;
+      Reader in{answer};
+#define WAVETRACE_READ_HIT_COLUMN(type, name) \
+  for (const auto& [first, n] : waiter->slots[source]) in.get(hits.name + first, n);
+      WAVETRACE_HIT_COLUMNS(WAVETRACE_READ_HIT_COLUMN)
+#undef WAVETRACE_READ_HIT_COLUMN
+    }
+    last = --waiter->pending == 0;
+    if (last) waiters_.erase(found);
+  }
+  if (last) waiter->finish();
+  return true;
+#else
+  return false;
+#endif
+}
+
 void ChunkExchange::meanwhile() const {
-  while (answer_one_query()) {
+  while (answer_one_query() || receive_one_answer()) {
   }
 }
 
@@ -282,7 +429,7 @@ bool ChunkExchange::answer_one_query() const {
 #define WAVETRACE_WRITE_HIT_COLUMN(type, name) out.put(batch.hits.name, count);
   WAVETRACE_HIT_COLUMNS(WAVETRACE_WRITE_HIT_COLUMN)
 #undef WAVETRACE_WRITE_HIT_COLUMN
-  send(std::move(answer), status.MPI_SOURCE, reply_tag);
+  send(std::move(answer), status.MPI_SOURCE, reply_tag, /*answer=*/true);
   queries_answered_.fetch_add(1, std::memory_order_relaxed);
   rays_answered_.fetch_add(count, std::memory_order_relaxed);
   return true;
@@ -336,6 +483,7 @@ ChunkTraffic ChunkExchange::traffic() const {
   traffic.queries_answered = queries_answered_.load();
   traffic.rays_answered = rays_answered_.load();
   traffic.wait_seconds = double(wait_nanoseconds_.load()) * 1e-9;
+  traffic.rounds_suspended = rounds_suspended_.load();
   return traffic;
 }
 

@@ -4,7 +4,10 @@
 
 #include <atomic>
 #include <cstdint>
+#include <memory>
 #include <mutex>
+#include <thread>
+#include <unordered_map>
 #include <vector>
 
 #include "wavetrace/accel/chunked/chunk_router.hpp"
@@ -19,7 +22,10 @@ struct ChunkTraffic {
   std::uint64_t chunks_copied = 0, triangles_copied = 0;  // others' chunks it answers itself (distribute.replicate)
   std::uint64_t queries_sent = 0, rays_sent = 0, bytes_sent = 0;  // its rounds' rays to owners, and their answers back
   std::uint64_t queries_answered = 0, rays_answered = 0;          // others' rays it answered
-  double wait_seconds = 0.0;  // its tracing threads waiting for answers (serving others meanwhile)
+  // Its rounds waiting for answers, summed: a suspended round's thread traces other batches
+  // meanwhile, a round that cannot be suspended serves others' queries while it waits.
+  double wait_seconds = 0.0;
+  std::uint64_t rounds_suspended = 0;  // rounds whose thread went on to other work while their rays travelled
 };
 
 // How the ranks share a chunked world's chunks.
@@ -40,7 +46,9 @@ struct ChunkSharing {
 //     G x {u32 chunk, u32 rays}, the groups' rays one after another in this order; then the
 //     ray columns, each N values: f32 origin_x, origin_y, origin_z, direction_x, direction_y,
 //     direction_z, tmin, tmax; u8 kind.
-//   answer, the query's reply tag: the hit columns of HitBatch (WAVETRACE_HIT_COLUMNS), each N
+//   answer, the query's reply tag, on the exchange's own communicator (a duplicate of
+//     MPI_COMM_WORLD, so that any answer can be probed for without taking a query or a done):
+//     the hit columns of HitBatch (WAVETRACE_HIT_COLUMNS), each N
 //     values of 4 bytes in the query's ray order: f32 t, u32 primitive (the chunk's own ids),
 //     f32 u, v, point_x, point_y, point_z, normal_x, normal_y, normal_z, u32 material.
 //   done, tag kDone: empty; a rank's render has finished and it asks nothing more.
@@ -54,9 +62,12 @@ class ChunkExchange final : public ChunkRouter {
   ChunkExchange& operator=(const ChunkExchange&) = delete;
 
   bool is_local(std::size_t chunk) const override { return owner_[chunk] == session_.rank() || replicated_[chunk]; }
+  // A round that may be suspended and runs as a TBB task is suspended until its answers are
+  // in (rays that travel on: its thread traces other batches meanwhile); an answer
+  // wherever it is received goes to its round, and the last one resumes it.
   void answer_elsewhere(ChunkQuery query, const RayBatch& rays, HitBatch& hits, std::span<const std::uint32_t> chunk_start,
-                        const std::function<void()>& local_work) const override;
-  void meanwhile() const override;  // answers every query waiting here
+                        const std::function<void()>& local_work, bool may_suspend) const override;
+  void meanwhile() const override;  // answers every query waiting here and takes in every answer arrived
 
   // After this rank's render: answers the others' rays until every rank has finished its own.
   void finish();
@@ -65,9 +76,15 @@ class ChunkExchange final : public ChunkRouter {
   bool replicated(std::size_t chunk) const { return replicated_[chunk]; }
 
  private:
-  bool answer_one_query() const;  // answers one query waiting here, if there is one
-  void send(std::vector<std::byte> message, int destination, int tag) const;
-  void progress_sends() const;    // frees the buffers of sends that completed
+  struct Waiter;
+  bool answer_one_query() const;    // answers one query waiting here, if there is one
+  bool receive_one_answer() const;  // gives one answer that arrived to its round, if one did
+  void send(std::vector<std::byte> message, int destination, int tag, bool answer = false) const;
+  void progress_sends() const;      // frees the buffers of sends that completed
+  // The thread that keeps the exchange moving while every worker is busy or every round is
+  // suspended: takes in answers (resuming their rounds) and answers queries, sleeping a
+  // little when nothing came.
+  void poll_until_stopped();
 
   const MpiSession& session_;
   ChunkSet& chunks_;
@@ -80,7 +97,16 @@ class ChunkExchange final : public ChunkRouter {
   mutable std::vector<Outgoing*> outbox_;
   mutable std::atomic<std::uint64_t> queries_sent_{0}, rays_sent_{0}, bytes_sent_{0};
   mutable std::atomic<std::uint64_t> queries_answered_{0}, rays_answered_{0};
-  mutable std::atomic<std::uint64_t> wait_nanoseconds_{0};
+  mutable std::atomic<std::uint64_t> wait_nanoseconds_{0}, rounds_suspended_{0}, rounds_suspended_now_{0};
+  // Rounds waiting for answers, by the reply tag their queries carry (each round its own).
+  mutable std::mutex waiters_mutex_;
+  mutable std::unordered_map<int, Waiter*> waiters_;
+  mutable std::atomic<std::uint64_t> next_reply_{0};
+  struct AnswerChannel;  // the communicator answers travel on
+  std::unique_ptr<AnswerChannel> answers_;
+  bool rounds_suspend_ = false;  // rounds run as tasks may be suspended (not under ASan; WAVETRACE_SUSPEND_ROUNDS=0)
+  std::atomic<bool> stop_polling_{false};
+  std::thread poller_;
 };
 
 }  // namespace wavetrace

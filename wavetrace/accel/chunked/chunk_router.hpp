@@ -24,10 +24,13 @@ class ChunkRouter {
   // One round: slots [chunk_start[c], chunk_start[c + 1]) of `rays` are due at chunk c. For
   // every chunk not local, writes into the same slots of `hits` what that chunk's accelerator
   // would have (primitive ids the chunk's own), running `local_work` (the local chunks'
-  // queries) while the answers travel.
+  // queries) while the answers travel. With `may_suspend`, a caller running as a TBB task
+  // may be suspended until its answers are in, its thread free for other tasks meanwhile,
+  // and resumed on any thread of the arena: such a caller keeps nothing in thread-local
+  // state across the call.
   virtual void answer_elsewhere(ChunkQuery query, const RayBatch& rays, HitBatch& hits,
-                                std::span<const std::uint32_t> chunk_start,
-                                const std::function<void()>& local_work) const = 0;
+                                std::span<const std::uint32_t> chunk_start, const std::function<void()>& local_work,
+                                bool may_suspend) const = 0;
   // Called between the local chunks' queries of a round: a chance to answer the rays others
   // wait for without keeping them waiting a whole round.
   virtual void meanwhile() const {}

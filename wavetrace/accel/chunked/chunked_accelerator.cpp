@@ -9,6 +9,8 @@
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <memory>
+#include <mutex>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -63,6 +65,38 @@ struct RoundScratch {
     order.resize(rays);
     chunk_start.assign(chunks + 1, 0);
   }
+};
+
+// Scratch for calls that may be suspended mid-round: taken for a call, given back after it.
+class RoundScratchPool {
+ public:
+  std::unique_ptr<RoundScratch> take() {
+    std::lock_guard lock(mutex_);
+    if (free_.empty()) return std::make_unique<RoundScratch>();
+    std::unique_ptr<RoundScratch> scratch = std::move(free_.back());
+    free_.pop_back();
+    return scratch;
+  }
+  void give(std::unique_ptr<RoundScratch> scratch) {
+    std::lock_guard lock(mutex_);
+    free_.push_back(std::move(scratch));
+  }
+
+ private:
+  std::mutex mutex_;
+  std::vector<std::unique_ptr<RoundScratch>> free_;
+};
+
+// One call's scratch from `pool` (none when `pool` is null), given back when the call ends.
+struct PooledScratch {
+  explicit PooledScratch(RoundScratchPool* from) : pool(from), scratch(from != nullptr ? from->take() : nullptr) {}
+  ~PooledScratch() {
+    if (pool != nullptr) pool->give(std::move(scratch));
+  }
+  PooledScratch(const PooledScratch&) = delete;
+  PooledScratch& operator=(const PooledScratch&) = delete;
+  RoundScratchPool* pool;
+  std::unique_ptr<RoundScratch> scratch;
 };
 
 // Chunks built at the same time: one per worker thread, as many as half the memory the
@@ -372,9 +406,14 @@ class ChunkedAccelerator final : public Accelerator, public ChunkSet {
   void trace(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe, ChunkQuery kind, Query&& query,
              std::uint64_t* rays_due = nullptr) const {
     if (streamed_to_ != nullptr) throw std::logic_error(kStreamedIsNotTraced);
-    thread_local RoundScratch scratch;
     const std::uint32_t n = range.size();
     if (n == 0) return;
+    // A routed call may be suspended while its rays travel (ChunkRouter::answer_elsewhere):
+    // its thread runs other calls meanwhile, and it may resume on another thread, so its
+    // scratch is its own, from a pool, not the thread's.
+    thread_local RoundScratch thread_scratch;
+    const PooledScratch pooled(router_ != nullptr ? &scratch_pool_ : nullptr);
+    RoundScratch& scratch = pooled.scratch != nullptr ? *pooled.scratch : thread_scratch;
     scratch.reserve(n, chunks_.size());
     scratch.visits.clear();
     for (std::uint32_t r = 0; r < n; ++r) {
@@ -442,7 +481,8 @@ class ChunkedAccelerator final : public Accelerator, public ChunkSet {
         }
       };
       if (router_ != nullptr) {
-        router_->answer_elsewhere(kind, sub_rays, sub_hits, scratch.chunk_start, local_chunks);
+        // An observed walk stays on its thread: its probe counts reads to that thread's slot.
+        router_->answer_elsewhere(kind, sub_rays, sub_hits, scratch.chunk_start, local_chunks, !Probe::kRecords);
       } else {
         local_chunks();
       }
@@ -474,6 +514,7 @@ class ChunkedAccelerator final : public Accelerator, public ChunkSet {
   std::vector<Chunk> chunks_;
   StoredArray<BvhNode> top_;
   const ChunkRouter* router_ = nullptr;  // data-parallel: who answers the chunks not held here
+  mutable RoundScratchPool scratch_pool_;  // the routed calls' scratch
   BuildReport build_;
   const SectionWriter* streamed_to_ = nullptr;  // set when every chunk went to this writer as it was built
   std::string streamed_prefix_;
