@@ -90,6 +90,21 @@ TEST(Config, BadInputNamesTheKey) {
   expect_config_error([&] { config.load_file("/nonexistent/config.toml"); }, "/nonexistent/config.toml");
 }
 
+// The distributed render's keys, refused as every key is: by name, with the value and what is allowed.
+TEST(Config, DistributeKeysNameTheirBadValues) {
+  Config config;
+  expect_config_error([&] { config.set("distribute.replicate=1.5"); }, "distribute.replicate = 1.5 is out of range [0, 1]");
+  expect_config_error([&] { config.set("distribute.replicate=-0.1"); }, "distribute.replicate = -0.1 is out of range");
+  expect_config_error([&] { config.set("distribute.replicate=nan"); }, "distribute.replicate = nan is out of range");
+  expect_config_error([&] { config.set("distribute.replicate=most"); }, "distribute.replicate");
+  expect_config_error([&] { config.set("distribute.balance=work"); },
+                      "distribute.balance = 'work' is not one of: triangles, rays");
+  expect_config_error([&] { config.set("distribute.mode=mesh"); }, "distribute.mode = 'mesh' is not one of: image, data");
+  expect_config_error([&] { config.set("distribute.range_rays=-5"); }, "distribute.range_rays = -5 is out of range");
+  config.set("distribute.replicate=0.25");
+  config.set("distribute.balance=rays");
+}
+
 TEST(Config, FileErrorsNameTheFile) {
   const std::string path = testing::write_temp_file("bad.toml", "[render]\nmax_depth = -3\n");
   Config config;
