@@ -107,16 +107,21 @@ struct ChunkExchange::Waiter {
   tbb::task::suspend_point point{};
 #endif
 
-  // The last answer is in: wake the round (it may not have finished suspending yet).
+  // The last answer is in: wake the round (it may not have finished suspending yet). Once
+  // `answered` is set a round that was not parked may leave and its waiter go, so nothing of
+  // the waiter is touched after it; a parked one cannot leave before it is resumed.
   void finish() {
 #if __TBB_RESUMABLE_TASKS
-    std::unique_lock lock(mutex);
-    done = true;
-    const bool resume = parked;
-    const tbb::task::suspend_point resume_point = point;
+    bool resume = false;
+    tbb::task::suspend_point resume_point{};
+    {
+      std::lock_guard lock(mutex);
+      done = true;
+      resume = parked;
+      resume_point = point;
+    }
     answered.store(true, std::memory_order_release);
-    lock.unlock();
-    if (resume) tbb::task::resume(resume_point);  // after which this waiter may be gone
+    if (resume) tbb::task::resume(resume_point);
 #else
     answered.store(true, std::memory_order_release);
 #endif
@@ -270,6 +275,18 @@ void ChunkExchange::answer_elsewhere(ChunkQuery query, const RayBatch& rays, Hit
       throw std::logic_error("chunk exchange: more rounds waiting at once than reply tags");
     }
   }
+  // The last answer unregisters the round; a round left by an exception unregisters itself,
+  // so that no later answer writes into a stack that is gone.
+  struct Unregister {
+    const ChunkExchange& exchange;
+    int tag;
+    const Waiter* waiter;
+    ~Unregister() {
+      std::lock_guard lock(exchange.waiters_mutex_);
+      const auto found = exchange.waiters_.find(tag);
+      if (found != exchange.waiters_.end() && found->second == waiter) exchange.waiters_.erase(found);
+    }
+  } unregister{*this, reply_tag, &waiter};
   // One query per owner with rays due this round, its groups in chunk order.
   for (int owner = 0; owner < session_.ranks(); ++owner) {
     const std::uint32_t count = waiter.rays[std::size_t(owner)];
@@ -304,9 +321,8 @@ void ChunkExchange::answer_elsewhere(ChunkQuery query, const RayBatch& rays, Hit
   const Clock::time_point start = Clock::now();
 #if __TBB_RESUMABLE_TASKS
   // Suspended only inside a task of an arena, with the poller there to resume it should every
-  // worker be idle.
-  // A suspended round holds its scratch (about 130 KB a batch of 1,024 rays) and a stack:
-  // past kMaxSuspendedRounds at once, a round waits on its thread as it would without.
+  // worker be idle. A suspended round holds its scratch (about 130 KB a batch of 1,024 rays)
+  // and a stack: past kMaxSuspendedRounds at once, a round waits on its thread as without.
   const bool suspend = rounds_suspend_ && may_suspend && poller_.joinable() &&
                        tbb::this_task_arena::current_thread_index() != tbb::task_arena::not_initialized;
   if (suspend && !waiter.answered.load(std::memory_order_acquire)) {
