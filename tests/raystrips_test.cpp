@@ -144,8 +144,54 @@ TEST_P(Stripifiers, CoverEveryTriangleWithItsOwnCornersAndRespectTheLengthLimit)
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Both, Stripifiers, ::testing::Values(StripifierKind::dual_path, StripifierKind::openmesh),
+INSTANTIATE_TEST_SUITE_P(All, Stripifiers,
+                         ::testing::Values(StripifierKind::dual_path, StripifierKind::openmesh,
+                                           StripifierKind::longest_of_three),
                          [](const auto& info) { return to_string(info.param); });
+
+TEST(LongestOfThreeStripifier, MakesOpenMeshsStripsVertexForVertexWhereOpenMeshHoldsTheSubMesh) {
+  // Sub-meshes as a raystrips build cuts them (runs of 256 triangles in the mesh's order), of
+  // manifold pieces: OpenMesh refuses no face of them, so its strips are the algorithm's.
+  std::size_t compared = 0, turns = 0;
+  for (const char* source : {"builtin:sphere:20k", "builtin:room:20k"}) {
+    const Scene scene = make_builtin_scene(source);
+    for (std::uint32_t first = 0; first + 256 <= scene.mesh.triangle_count(); first += 4096) {
+      std::vector<std::uint32_t> triangles(256);
+      for (std::uint32_t k = 0; k < 256; ++k) triangles[k] = first + k;
+      const std::vector<TriangleStrip> ours = stripify(scene.mesh, triangles, StripifierKind::longest_of_three, 1000);
+      const std::vector<TriangleStrip> theirs = stripify(scene.mesh, triangles, StripifierKind::openmesh, 1000);
+      ASSERT_EQ(ours.size(), theirs.size()) << source << " from triangle " << first;
+      for (std::size_t s = 0; s < ours.size(); ++s) {
+        ASSERT_EQ(ours[s].vertices, theirs[s].vertices) << source << " from triangle " << first << " strip " << s;
+        ASSERT_EQ(ours[s].triangles, theirs[s].triangles) << source << " from triangle " << first << " strip " << s;
+        turns += std::count(ours[s].triangles.begin(), ours[s].triangles.end(), kNoTriangle);
+      }
+      compared += ours.size();
+    }
+  }
+  EXPECT_GT(compared, 20u);
+  EXPECT_GT(turns, 0u) << "no strip began with a swap: the flip was not exercised";
+}
+
+TEST(LongestOfThreeStripifier, TreatsANonManifoldOrFlippedEdgeAsABoundary) {
+  // Three triangles on the edge (0, 1), and a fourth wound against its neighbour across (1, 2)
+  // (both run 1 -> 2).
+  TriangleMesh mesh;
+  mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {1, 1, 0}};
+  mesh.triangles = {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}, {1, 2, 5}};
+  const std::vector<std::uint32_t> all = {0, 1, 2, 3};
+  const std::vector<TriangleStrip> strips = stripify(mesh, all, StripifierKind::longest_of_three, 100);
+  std::vector<int> seen(all.size(), 0);
+  for (const TriangleStrip& strip : strips) {
+    ASSERT_EQ(strip.vertices.size(), strip.triangles.size() + 2);
+    for (const std::uint32_t t : strip.triangles) {
+      if (t != kNoTriangle) ++seen[t];
+    }
+  }
+  EXPECT_EQ(seen, std::vector<int>(all.size(), 1));
+  // No edge is shared by exactly two triangles wound against each other, so none is crossed.
+  EXPECT_EQ(strips.size(), all.size());
+}
 
 
 class RayStripsAgreesWithEmbree : public ::testing::TestWithParam<std::string> {};

@@ -111,26 +111,7 @@ std::vector<TriangleStrip> stripify_openmesh(const TriangleMesh& mesh, std::span
     if (!covered[f]) strips.push_back(single_triangle_strip(mesh, face_triangle[f]));
   }
 
-  // Strips longer than the format allows are cut; the pieces overlap in two vertices.
-  std::vector<TriangleStrip> result;
-  for (TriangleStrip& strip : strips) {
-    if (strip.triangles.size() <= max_triangles) {
-      result.push_back(std::move(strip));
-      continue;
-    }
-    for (std::size_t first = 0; first < strip.triangles.size(); first += max_triangles) {
-      const std::size_t count = std::min<std::size_t>(max_triangles, strip.triangles.size() - first);
-      TriangleStrip piece;
-      piece.vertices.assign(strip.vertices.begin() + first, strip.vertices.begin() + first + count + 2);
-      piece.triangles.assign(strip.triangles.begin() + first, strip.triangles.begin() + first + count);
-      result.push_back(std::move(piece));
-    }
-  }
-  // A strip of swaps only (possible after cutting) adds nothing.
-  std::erase_if(result, [](const TriangleStrip& strip) {
-    return std::all_of(strip.triangles.begin(), strip.triangles.end(), [](std::uint32_t t) { return t == kNoTriangle; });
-  });
-  return result;
+  return cut_long_strips(std::move(strips), max_triangles);
 }
 
 }  // namespace wavetrace

@@ -110,7 +110,7 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> cut_submeshes(const BuildTr
 //        0     4  run_triangles, uint32 (traversal's span size)
 //        4     4  packet_min_active, uint32
 //        8     4  packets, uint32 (0 or 1)
-//       12     4  stripifier, uint32 (0: ours, 1: openmesh; build notes only)
+//       12     4  stripifier, uint32 (0: dual_path, 1: openmesh, 2: longest_of_three; build notes only)
 //       16     4  submesh_triangles, uint32 (build notes only)
 //       20     4  strips_per_leaf, uint32 (build notes only)
 //       24     4  width of the top, uint32 (2 or 8)
@@ -170,6 +170,9 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
       self.root_ = state.root;
       self.stats_ = state.stats;
       if (state.options.width != 2 && state.options.width != 8) a.fail("raystrips.state", "holds a top width other than 2 or 8");
+      if (state.options.stripifier > static_cast<std::uint32_t>(StripifierKind::longest_of_three)) {
+        a.fail("raystrips.state", "names a stripifier this version does not know");
+      }
       if (state.options.width == 2 && self.nodes_.empty()) a.fail("raystrips.nodes", "is empty: no raystrips structure was saved");
       // Every top and every strip a traversal reads is checked (tree_check.hpp, strip_check.hpp).
       const std::span<const std::byte> strip_bytes(self.strip_bytes_.data(), self.strip_bytes_.size());

@@ -21,7 +21,7 @@ struct RayStripsOptions {
   // OpenMesh's by default: on builtin:sphere:1M its strips are shorter (14.6 triangles
   // against 33.4) but hardly ever turn (2% repeats against 31%), so the kd-tree boxes are
   // tighter and tracing is 1.3x faster at about the same bytes per triangle.
-  StripifierKind stripifier = StripifierKind::openmesh;
+  StripifierKind stripifier = StripifierKind::longest_of_three;
   // Most strips in one leaf of the top BVH; 1 is the paper's partition step (a leaf per
   // strip). The SAH decides below this bound. 1 .. 16.
   std::uint32_t strips_per_leaf = 1;
