@@ -18,7 +18,9 @@
 #include "wavetrace/memory/simulated_pager.hpp"
 #include "wavetrace/scene/builtin_scenes.hpp"
 #include "wavetrace/setup/config.hpp"
+#include "wavetrace/setup/plan_render.hpp"
 #include "wavetrace/setup/render_setup.hpp"
+#include "wavetrace/setup/world_setup.hpp"
 #include "wavetrace/pipeline/tracing_arena.hpp"
 #include "accel_agreement.hpp"
 #include "accel_options.hpp"
@@ -151,6 +153,38 @@ TEST(ChunkedWorld, AWholeSceneIsCutWhereItsStreamIs) {
   validate_and_clean(mesh, "test mesh", &starts);
   EXPECT_EQ(mesh.triangles.size(), 4u);
   EXPECT_EQ(starts, (std::vector<std::size_t>{0, 1, 3}));
+}
+
+// A chunked build's chunks keep copies of their meshes, so a type that reads its mesh in place
+// (bvh) streams its scene when it will be chunked, and keeps it whole when it will not; the
+// structure traces the same either way.
+TEST(ChunkedWorld, ABvhBuiltInChunksStreamsItsScene) {
+  const auto loaded = [](std::int64_t chunk_triangles) {
+    Config config;
+    config.set("scene.source=builtin:room:20000");
+    config.set("accel.type=bvh");
+    config.set("accel.bvh.width=8");
+    config.set("build.chunk_triangles=" + std::to_string(chunk_triangles));
+    const RenderPlan plan = plan_render(config);
+    SceneForWorld world = load_scene_for_world(plan, /*keep_mesh=*/false);
+    auto accelerator = build_world_accelerator(world.scene, world.accelerator.options);
+    return std::make_pair(std::move(world), std::move(accelerator));
+  };
+  const auto [chunked_world, chunked] = loaded(4096);
+  const auto [whole_world, whole] = loaded(1 << 20);
+  EXPECT_TRUE(chunked_world.scene.streamed());
+  EXPECT_FALSE(whole_world.scene.streamed());
+  const RaySet rays = make_ray_set(RaySetKind::diffuse, whole_world.scene, *whole, 4000);
+  const auto from_whole = trace_ray_set(*whole, rays);
+  const auto from_chunks = trace_ray_set(*chunked, rays);
+  std::size_t hits = 0;
+  for (std::size_t b = 0; b < rays.batches.size(); ++b) {
+    for (std::size_t i = 0; i < rays.batches[b]->count; ++i) {
+      ASSERT_EQ(from_whole[b]->primitive[i], from_chunks[b]->primitive[i]);
+      hits += from_whole[b]->is_hit(i);
+    }
+  }
+  EXPECT_GT(hits, 1000u);
 }
 
 // build.chunks_at_once caps the chunks in flight: each build lingers so that two threads

@@ -146,6 +146,11 @@ bool holds_own_geometry(std::string_view type) {
   const AcceleratorType* row = find_accelerator_type(type);
   return row != nullptr && row->holds_own_geometry;
 }
+bool reads_whole_mesh(const AcceleratorOptions& options, std::uint64_t triangles) {
+  const AcceleratorType& type = accelerator_type(options.type);
+  const bool chunked = type.builds_in_chunks && triangles > options.chunk_triangles;  // as build_for_world decides
+  return !type.holds_own_geometry && !chunked;
+}
 double estimated_bytes_per_triangle(const AcceleratorOptions& options) {
   return accelerator_type(options.type).bytes_per_triangle(options);
 }

@@ -105,6 +105,10 @@ std::unique_ptr<Accelerator> load_accelerator(SectionLoader& in);
 bool saves_structure(std::string_view type);
 bool builds_in_chunks(std::string_view type);
 bool holds_own_geometry(std::string_view type);
+// Whether the world's structure over `triangles` would read the scene's whole mesh in place
+// (make_world_accelerator): a type that holds no geometry of its own and is built whole. A
+// chunked build's chunks keep copies of their meshes, so its scene may be streamed.
+bool reads_whole_mesh(const AcceleratorOptions& options, std::uint64_t triangles);
 double estimated_bytes_per_triangle(const AcceleratorOptions& options);
 double estimated_build_bytes_per_triangle(std::string_view type);
 

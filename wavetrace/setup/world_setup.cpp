@@ -48,7 +48,14 @@ void check_scene_fits(const RenderPlan& plan, bool structure_to_file) {
 
 SceneForWorld load_scene_for_world(const RenderPlan& plan, bool keep_mesh, bool structure_to_file) {
   SceneRequest request = plan.scene;
-  request.streamed = (plan.accel_goal.automatic || holds_own_geometry(plan.accelerator.type)) && !keep_mesh;
+  // Streamed where the structure may not need the whole mesh: auto decides after the scene's
+  // pass; a builtin's size, known before it is made, says whether a chunked build's will.
+  const std::optional<std::size_t> known_triangles =
+      plan.scene.subdivide == 0 ? requested_triangle_count(plan.scene.source) : std::nullopt;
+  const bool whole_mesh_read = !plan.accel_goal.automatic &&
+                               (known_triangles ? reads_whole_mesh(plan.accelerator, *known_triangles)
+                                                : !holds_own_geometry(plan.accelerator.type));
+  request.streamed = !whole_mesh_read && !keep_mesh;
   RenderPlan checked = plan;
   checked.scene = request;
   check_scene_fits(checked, structure_to_file);
@@ -58,7 +65,7 @@ SceneForWorld load_scene_for_world(const RenderPlan& plan, bool keep_mesh, bool 
   const TriangleSource& triangles = scene.streamed() ? *scene.stream : static_cast<const TriangleSource&>(whole);
   ResolvedAccelerator resolved =
       resolve_accelerator(plan.accelerator, plan.accel_goal, triangles, camera, plan.image, scene.streamed());
-  if (scene.streamed() && !holds_own_geometry(resolved.options.type)) {
+  if (scene.streamed() && reads_whole_mesh(resolved.options, triangles.triangle_count())) {
     request.streamed = false;
     scene = load_scene(request);
   }
