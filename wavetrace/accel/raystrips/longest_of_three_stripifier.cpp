@@ -6,6 +6,7 @@
 // time in a raystrips build (53.8 thread-seconds at room:64M). On a sub-mesh OpenMesh holds
 // whole, these are its strips, vertex for vertex (tested).
 #include <algorithm>
+#include <limits>
 #include <stdexcept>
 
 #include "wavetrace/accel/raystrips/stripify.hpp"
@@ -64,6 +65,7 @@ class LongestOfThree {
 
  private:
   static constexpr std::uint8_t kProcessed = 1, kUsed = 2;
+  static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};  // no edge: its two vertices would be one
 
   // One strip grown from a half-edge: the vertices and triangles met going back (front_*,
   // in the order met; they come first in the strip, reversed) and going on (back_*), and
@@ -79,32 +81,35 @@ class LongestOfThree {
   std::uint32_t to(std::uint32_t h) const { return corners(h / 3)[int(next(h) % 3)]; }
 
   // Half-edges a -> b and b -> a are opposite where they are the edge's only two, as in a
-  // mesh OpenMesh holds; any other edge is a boundary to the walk.
+  // mesh OpenMesh holds; any other edge is a boundary to the walk. The edges meet in an
+  // open-addressing table (a sub-mesh is a few hundred triangles: sorting its half-edges
+  // took most of the stripifier's time).
   void pair_half_edges() {
-    struct Record {
-      std::uint64_t edge;  // low vertex << 32 | high vertex
-      std::uint32_t half_edge;
+    struct Slot {
+      std::uint64_t edge = kEmpty;  // low vertex << 32 | high vertex
+      std::uint32_t first = 0, second = 0;
+      std::uint32_t count = 0;
     };
-    std::vector<Record> records;
-    records.reserve(opposite_.size());
+    std::size_t size = 16;
+    while (size < 2 * opposite_.size()) size *= 2;
+    std::vector<Slot> table(size);
     for (std::uint32_t h = 0; h < opposite_.size(); ++h) {
       if (state_[h / 3] & kProcessed) continue;
       const std::uint32_t a = from(h), b = to(h);
-      records.push_back({std::uint64_t(std::min(a, b)) << 32 | std::max(a, b), h});
+      const std::uint64_t edge = std::uint64_t(std::min(a, b)) << 32 | std::max(a, b);
+      std::size_t at = std::size_t((edge * 0x9E3779B97F4A7C15ull) >> 40) & (size - 1);
+      while (table[at].edge != kEmpty && table[at].edge != edge) at = (at + 1) & (size - 1);
+      Slot& slot = table[at];
+      if (slot.count == 0) slot.edge = edge, slot.first = h;
+      if (slot.count == 1) slot.second = h;
+      ++slot.count;
     }
-    std::sort(records.begin(), records.end(),
-              [](const Record& x, const Record& y) { return x.edge != y.edge ? x.edge < y.edge : x.half_edge < y.half_edge; });
-    for (std::size_t i = 0; i < records.size();) {
-      std::size_t j = i + 1;
-      while (j < records.size() && records[j].edge == records[i].edge) ++j;
-      if (j - i == 2) {
-        const std::uint32_t h = records[i].half_edge, g = records[i + 1].half_edge;
-        if (from(h) == to(g)) {  // opposite directions: the two triangles agree on their winding
-          opposite_[h] = g;
-          opposite_[g] = h;
-        }
+    for (const Slot& slot : table) {
+      // Opposite directions: the two triangles agree on their winding.
+      if (slot.count == 2 && from(slot.first) == to(slot.second)) {
+        opposite_[slot.first] = slot.second;
+        opposite_[slot.second] = slot.first;
       }
-      i = j;
     }
   }
 
