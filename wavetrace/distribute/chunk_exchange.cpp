@@ -256,11 +256,16 @@ void ChunkExchange::answer_elsewhere(ChunkQuery query, const RayBatch& rays, Hit
   waiter.hits = &hits;
   waiter.slots.resize(std::size_t(session_.ranks()));
   waiter.rays.assign(std::size_t(session_.ranks()), 0);
+  // Per owner, its chunks' groups in chunk order: (chunk, rays) pairs, as the query lists them.
+  std::vector<std::vector<std::uint32_t>> groups(std::size_t(session_.ranks()));
   for (std::size_t c = 0; c + 1 < chunk_start.size(); ++c) {
     const std::uint32_t n = chunk_start[c + 1] - chunk_start[c];
     if (n == 0 || owner_[c] == session_.rank() || replicated_[c]) continue;
-    waiter.slots[std::size_t(owner_[c])].emplace_back(chunk_start[c], n);
-    waiter.rays[std::size_t(owner_[c])] += n;
+    const auto owner = std::size_t(owner_[c]);
+    waiter.slots[owner].emplace_back(chunk_start[c], n);
+    waiter.rays[owner] += n;
+    groups[owner].push_back(static_cast<std::uint32_t>(c));
+    groups[owner].push_back(n);
   }
   for (int owner = 0; owner < session_.ranks(); ++owner) waiter.pending += waiter.rays[std::size_t(owner)] > 0 ? 1 : 0;
   if (waiter.pending == 0) {
@@ -291,27 +296,25 @@ void ChunkExchange::answer_elsewhere(ChunkQuery query, const RayBatch& rays, Hit
   for (int owner = 0; owner < session_.ranks(); ++owner) {
     const std::uint32_t count = waiter.rays[std::size_t(owner)];
     if (count == 0) continue;
-    std::vector<std::uint32_t> groups;
-    for (std::size_t c = 0; c + 1 < chunk_start.size(); ++c) {
-      const std::uint32_t n = chunk_start[c + 1] - chunk_start[c];
-      if (n == 0 || !asks(c, owner)) continue;
-      groups.push_back(static_cast<std::uint32_t>(c));
-      groups.push_back(n);
-    }
+    const std::vector<std::uint32_t>& owner_groups = groups[std::size_t(owner)];
     std::vector<std::byte> message;
-    message.reserve(16 + groups.size() * 4 + std::size_t(count) * 33);
+    message.reserve(16 + owner_groups.size() * 4 + std::size_t(count) * 33);
     Writer out{message};
     out.put32(static_cast<std::uint32_t>(query));
     out.put32(static_cast<std::uint32_t>(reply_tag));
-    out.put32(static_cast<std::uint32_t>(groups.size() / 2));
+    out.put32(static_cast<std::uint32_t>(owner_groups.size() / 2));
     out.put32(count);
-    out.put(groups.data(), groups.size());
+    out.put(owner_groups.data(), owner_groups.size());
     for (const float* column : {rays.origin_x, rays.origin_y, rays.origin_z, rays.direction_x, rays.direction_y,
                                 rays.direction_z, rays.tmin, rays.tmax}) {
-      for (std::size_t g = 0; g < groups.size(); g += 2) out.put(column + chunk_start[groups[g]], groups[g + 1]);
+      for (std::size_t g = 0; g < owner_groups.size(); g += 2) {
+        out.put(column + chunk_start[owner_groups[g]], owner_groups[g + 1]);
+      }
     }
     static_assert(sizeof(RayKind) == 1);
-    for (std::size_t g = 0; g < groups.size(); g += 2) out.put(rays.kind + chunk_start[groups[g]], groups[g + 1]);
+    for (std::size_t g = 0; g < owner_groups.size(); g += 2) {
+      out.put(rays.kind + chunk_start[owner_groups[g]], owner_groups[g + 1]);
+    }
     send(std::move(message), owner, kQuery);
     queries_sent_.fetch_add(1, std::memory_order_relaxed);
     rays_sent_.fetch_add(count, std::memory_order_relaxed);

@@ -90,8 +90,6 @@ class ChunkExchange final : public ChunkRouter {
   ChunkSet& chunks_;
   std::vector<int> owner_;
   std::vector<bool> replicated_;  // answered by every rank (never asked of its owner)
-  // Whether this round asks `rank` about `chunk`: its owner, and not a chunk every rank holds.
-  bool asks(std::size_t chunk, int rank) const { return owner_[chunk] == rank && !replicated_[chunk]; }
   struct Outgoing;
   mutable std::mutex outbox_mutex_;
   mutable std::vector<Outgoing*> outbox_;
