@@ -185,6 +185,21 @@ TEST(ChunkedWorld, ABvhBuiltInChunksStreamsItsScene) {
     }
   }
   EXPECT_GT(hits, 1000u);
+
+  // A mesh file's name says nothing of its size, however short or with a colon in it: the
+  // file's own error, not one about a builtin's count.
+  for (const char* missing : {"x.ply", "no:such:mesh.ply"}) {
+    Config config;
+    config.set(std::string("scene.source=") + missing);
+    config.set("accel.type=bvh");
+    const RenderPlan plan = plan_render(config);
+    try {
+      load_scene_for_world(plan, /*keep_mesh=*/false);
+      ADD_FAILURE() << missing << " loaded";
+    } catch (const SceneError& error) {
+      EXPECT_NE(std::string(error.what()).find(missing), std::string::npos) << error.what();
+    }
+  }
 }
 
 // build.chunks_at_once caps the chunks in flight: each build lingers so that two threads

@@ -50,8 +50,9 @@ SceneForWorld load_scene_for_world(const RenderPlan& plan, bool keep_mesh, bool 
   SceneRequest request = plan.scene;
   // Streamed where the structure may not need the whole mesh: auto decides after the scene's
   // pass; a builtin's size, known before it is made, says whether a chunked build's will.
-  const std::optional<std::size_t> known_triangles =
-      plan.scene.subdivide == 0 ? requested_triangle_count(plan.scene.source) : std::nullopt;
+  const std::optional<std::size_t> known_triangles = is_builtin_scene(plan.scene.source) && plan.scene.subdivide == 0
+                                                         ? builtin_triangle_count(plan.scene.source)
+                                                         : std::nullopt;
   const bool whole_mesh_read = !plan.accel_goal.automatic &&
                                (known_triangles ? reads_whole_mesh(plan.accelerator, *known_triangles)
                                                 : !holds_own_geometry(plan.accelerator.type));
