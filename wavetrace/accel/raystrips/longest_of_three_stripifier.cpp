@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <limits>
 #include <stdexcept>
+#include <string>
 
 #include "wavetrace/accel/raystrips/stripify.hpp"
 
@@ -185,6 +186,10 @@ std::vector<TriangleStrip> stripify_longest_of_three(const TriangleMesh& mesh, s
                                                      std::uint32_t max_triangles) {
   if (max_triangles < 1) throw std::invalid_argument("a strip needs room for one triangle");
   if (triangles.empty()) return {};
+  if (triangles.size() > (kNone - 3) / 3) {
+    throw std::length_error("a sub-mesh of " + std::to_string(triangles.size()) +
+                            " triangles is beyond the stripifier's 32-bit half-edge ids");
+  }
   return cut_long_strips(LongestOfThree(mesh, triangles).run(), max_triangles);
 }
 
