@@ -82,6 +82,31 @@ TEST(HmqPackedStream, RoundTripsEveryWidthWithByteAlignedGroups) {
   EXPECT_EQ(stream_shape(17).group_bytes, 7u);
 }
 
+#if WAVETRACE_AVX2
+// The eight-lane reader every leaf decode uses, value for value against the scalar one, at
+// every width it takes and at counts that end inside, at and past a block of eight.
+TEST(HmqPackedStream, LaneReaderReadsWhatTheScalarReaderReads) {
+  std::mt19937 random(11);
+  for (std::uint32_t bits = 1; bits <= kLaneStreamBits; ++bits) {
+    for (const std::uint32_t count : {1u, 7u, 8u, 9u, 16u, 42u, 64u}) {
+      std::vector<std::uint32_t> values(count);
+      for (auto& v : values) v = static_cast<std::uint32_t>(random() & ((std::uint64_t{1} << bits) - 1));
+      LargeArray<std::byte> out;
+      append_stream(out, values, bits);
+      out.resize(out.size() + 8);
+      for (std::uint32_t first = 0; first < count; first += 8) {
+        alignas(32) std::uint32_t lanes[8];
+        _mm256_store_si256(reinterpret_cast<__m256i*>(lanes), read_stream_lanes(out.data(), bits, first, count));
+        for (std::uint32_t lane = 0; lane < 8; ++lane) {
+          const std::uint32_t expected = first + lane < count ? values[first + lane] : 0u;
+          EXPECT_EQ(lanes[lane], expected) << bits << " bits, value " << first + lane << " of " << count;
+        }
+      }
+    }
+  }
+}
+#endif
+
 TEST(HmqGlobalGrid, FromBitsOrEpsilonBoundsTheVertexError) {
   const Bounds3 bounds{{-1.0f, -2.0f, 0.0f}, {3.0f, 2.0f, 0.5f}};
   const GlobalGrid sixteen = grid_from_bits(bounds, 16);

@@ -61,6 +61,10 @@ template <typename Probe>
 #if WAVETRACE_AVX2
   const StripLayoutEntry& layout = *decoded.layout;
   const __m256i index_mask = _mm256_set1_epi32(63);  // lanes past the last triangle gather in bounds
+  // Most leaves hold at most 16 vertices (and slots): their columns fit two registers each,
+  // and a corner is picked out of them by two permutes instead of a gather from memory.
+  const bool few_vertices = decoded.header.vertex_count <= 16;
+  const bool few_slots = layout.slots <= 16;
   for (std::uint32_t base = 0; base < layout.triangles; base += 8) {
     __m128i first_bytes = _mm_setzero_si128();
     std::memcpy(&first_bytes, layout.first_slot.data() + base, 8);
@@ -69,11 +73,30 @@ template <typename Probe>
     for (int c = 0; c < 3; ++c) {
       __m256i vertex = _mm256_and_si256(_mm256_add_epi32(first_slot, _mm256_set1_epi32(c)), index_mask);
       if (decoded.header.indexed) {
-        vertex = _mm256_and_si256(_mm256_i32gather_epi32(reinterpret_cast<const int*>(decoded.slot_vertex), vertex, 4),
-                                  index_mask);
+        const int* slot_vertex = reinterpret_cast<const int*>(decoded.slot_vertex);
+        if (few_slots) {
+          const __m256i high = _mm256_cmpgt_epi32(vertex, _mm256_set1_epi32(7));
+          vertex = _mm256_blendv_epi8(
+              _mm256_permutevar8x32_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(slot_vertex)), vertex),
+              _mm256_permutevar8x32_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(slot_vertex + 8)), vertex),
+              high);
+        } else {
+          vertex = _mm256_i32gather_epi32(slot_vertex, vertex, 4);
+        }
+        vertex = _mm256_and_si256(vertex, index_mask);
       }
-      for (int axis = 0; axis < 3; ++axis) {
-        _mm256_store_ps(lanes.corner[c][axis], _mm256_i32gather_ps(decoded.position[axis], vertex, 4));
+      if (few_vertices) {
+        const __m256 high = _mm256_castsi256_ps(_mm256_cmpgt_epi32(vertex, _mm256_set1_epi32(7)));
+        for (int axis = 0; axis < 3; ++axis) {
+          const float* column = decoded.position[axis];
+          _mm256_store_ps(lanes.corner[c][axis],
+                          _mm256_blendv_ps(_mm256_permutevar8x32_ps(_mm256_load_ps(column), vertex),
+                                           _mm256_permutevar8x32_ps(_mm256_load_ps(column + 8), vertex), high));
+        }
+      } else {
+        for (int axis = 0; axis < 3; ++axis) {
+          _mm256_store_ps(lanes.corner[c][axis], _mm256_i32gather_ps(decoded.position[axis], vertex, 4));
+        }
       }
     }
   }

@@ -6,6 +6,8 @@
 // to 8 bytes from a group's start, so the buffer holding streams keeps 8 bytes of slack.
 #pragma once
 
+#include "wavetrace/build_config.hpp"  // WAVETRACE_AVX2
+
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -14,6 +16,10 @@
 #include <vector>
 
 #include "wavetrace/memory/cache_aligned_allocator.hpp"
+
+#if WAVETRACE_AVX2
+#include <immintrin.h>
+#endif
 
 namespace wavetrace::hmq {
 
@@ -41,6 +47,40 @@ constexpr std::size_t stream_bytes(std::uint32_t bits, std::uint32_t count) {
   const StreamShape shape = stream_shape(bits);
   return std::size_t(count / shape.per_group) * shape.group_bytes + ((count % shape.per_group) * bits + 7) / 8;
 }
+
+// Where value i (< 64) of a stream of `bits` (1 .. 32) bits starts, in bits from the stream's
+// start: the group's start, (i / per_group) * group_bytes bytes in, and (i % per_group) * bits.
+inline constexpr auto kStreamBitOffsets = [] {
+  std::array<std::array<std::uint16_t, 64>, 33> offsets{};
+  for (std::uint32_t bits = 1; bits <= 32; ++bits) {
+    const StreamShape shape = compute_stream_shape(bits);
+    for (std::uint32_t i = 0; i < 64; ++i) {
+      offsets[bits][i] = static_cast<std::uint16_t>(i / shape.per_group * shape.group_bytes * 8 + i % shape.per_group * bits);
+    }
+  }
+  return offsets;
+}();
+
+// The widest values read_stream_lanes takes: a value and its bit offset within its first byte
+// fit one 4-byte load.
+inline constexpr std::uint32_t kLaneStreamBits = 25;
+
+#if WAVETRACE_AVX2
+// Values first .. first + 7 of a stream of `bits` (1 .. kLaneStreamBits) bits in eight lanes,
+// each from one 4-byte load at its first byte; lanes at or past `count` read nothing and hold
+// 0. A value's load ends at most 3 bytes past its stream, within a record's 8 bytes of slack.
+[[gnu::always_inline]] inline __m256i read_stream_lanes(const std::byte* data, std::uint32_t bits, std::uint32_t first,
+                                                        std::uint32_t count) {
+  const __m256i offset = _mm256_cvtepu16_epi32(
+      _mm_loadu_si128(reinterpret_cast<const __m128i*>(kStreamBitOffsets[bits].data() + first)));
+  const __m256i index = _mm256_add_epi32(_mm256_set1_epi32(int(first)), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+  const __m256i live = _mm256_cmpgt_epi32(_mm256_set1_epi32(int(count)), index);
+  const __m256i word = _mm256_mask_i32gather_epi32(_mm256_setzero_si256(), reinterpret_cast<const int*>(data),
+                                                   _mm256_srli_epi32(offset, 3), live, 1);
+  const __m256i value = _mm256_srlv_epi32(word, _mm256_and_si256(offset, _mm256_set1_epi32(7)));
+  return _mm256_and_si256(value, _mm256_set1_epi32(int((std::uint32_t{1} << bits) - 1)));
+}
+#endif
 
 // Appends the stream to `out`; every value must fit in `bits` (0 .. 32) bits.
 inline void append_stream(LargeArray<std::byte>& out, std::span<const std::uint32_t> values, std::uint32_t bits) {
