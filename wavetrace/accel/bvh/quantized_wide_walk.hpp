@@ -11,6 +11,7 @@
 #include <bit>
 #include <cstdint>
 #include <limits>
+#include <type_traits>
 
 #include <immintrin.h>
 
@@ -97,13 +98,22 @@ namespace quantized_wide {
 
 }  // namespace quantized_wide
 
+// A leaf_address for walks whose leaves are not worth prefetching.
+struct NoLeafPrefetch {
+  const void* operator()(std::uint32_t) const { return nullptr; }
+};
+
 // `visit_leaf(reference, box)` handles a leaf (its reference without the leaf bit, its
 // decoded box) and returns true to end the walk (an any-hit query found one); it may shrink
-// `tmax`, which prunes what is left on the stack.
-template <KernelIsa kIsa, typename Probe, typename VisitLeaf>
+// `tmax`, which prunes what is left on the stack. `leaf_address(reference)`, where it gives
+// one, is where the leaf's data starts: with the nodes of the inner children, its first two
+// lines are asked for as soon as a node's children are entered, before the walk goes down the
+// nearest, so that the others are in cache when it comes back for them.
+template <KernelIsa kIsa, typename Probe, typename VisitLeaf, typename LeafAddress = NoLeafPrefetch>
 [[gnu::always_inline]] inline void walk_quantized_wide(const QuantizedWideNode* nodes, const Bounds3& root_frame,
                                                        const SingleRay& ray, const float& tmax, Probe& probe,
-                                                       QuantizedWideStack& stack, VisitLeaf&& visit_leaf) {
+                                                       QuantizedWideStack& stack, VisitLeaf&& visit_leaf,
+                                                       LeafAddress&& leaf_address = {}) {
   using namespace quantized_wide;
   const glm::vec3 &origin = ray.origin, &inverse = ray.box.inverse_direction;
   const __m256 origin_lanes[3] = {_mm256_set1_ps(origin.x), _mm256_set1_ps(origin.y), _mm256_set1_ps(origin.z)};
@@ -130,9 +140,22 @@ template <KernelIsa kIsa, typename Probe, typename VisitLeaf>
         continue;
       }
       if (entered_mask != 0) {  // nearest first, by sorting
+        const __m256i references = child_references(node);
+        if constexpr (!std::is_same_v<std::remove_cvref_t<LeafAddress>, NoLeafPrefetch>) {
+          alignas(32) std::uint32_t reference[8];
+          _mm256_store_si256(reinterpret_cast<__m256i*>(reference), references);
+          for (unsigned mask = entered_mask; mask != 0; mask &= mask - 1) {
+            const std::uint32_t child = reference[std::countr_zero(mask)];
+            const char* line = child & kWideLeafReference
+                                   ? static_cast<const char*>(static_cast<const void*>(leaf_address(child & ~kWideLeafReference)))
+                                   : reinterpret_cast<const char*>(nodes + child);
+            _mm_prefetch(line, _MM_HINT_T0);
+            _mm_prefetch(line + 64, _MM_HINT_T0);
+          }
+        }
         const __m256i order = lane_sort::nearest_last_for<kIsa>(near, entered_mask);
         _mm256_storeu_si256(reinterpret_cast<__m256i*>(stack.reference + top),
-                            _mm256_permutevar8x32_epi32(child_references(node), order));
+                            _mm256_permutevar8x32_epi32(references, order));
         _mm256_storeu_ps(stack.distance + top, _mm256_permutevar8x32_ps(near, order));
         for (int b = 0; b < 6; ++b) _mm256_storeu_ps(stack.bound[b] + top, _mm256_permutevar8x32_ps(bound[b], order));
         top += static_cast<std::uint32_t>(std::popcount(entered_mask));

@@ -354,7 +354,7 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
         test_leaf_record<kAnyHit>(leaves + std::size_t(units) * kUnit, grid_, Box{box.lower, box.upper}, ray.sheared,
                                   ray.tmin, tmax, best, probe);
         return kAnyHit && best.found;
-      });
+      }, [&](std::uint32_t units) { return leaves + std::size_t(units) * kUnit; });
       write_leaf_hit<!kAnyHit>(best, hits, i);
     });
   }
