@@ -192,6 +192,26 @@ TEST(HmqNodes, PairedDecodeAndBoxTestAreBitIdenticalToTheScalarOnes) {
   }
 }
 
+// A leaf's box is re-snapped at every visit, in lanes: the lines GlobalGrid's scalar rounding
+// gives, inside the grid, far outside it, at infinities and at NaN (a crafted world file's box).
+TEST(HmqLeaf, SnappingABoxOutwardGivesTheScalarLinesEvenForCraftedBoxes) {
+  const GlobalGrid grid = grid_from_bits(Bounds3{glm::vec3(-3.0f, 0.5f, 10.0f), glm::vec3(7.0f, 2.0f, 11.0f)}, 16);
+  std::mt19937 random(5);
+  std::uniform_real_distribution<float> coordinate(-20.0f, 20.0f);
+  std::vector<float> values = {0.0f, -3.0f, 7.0f, 1e30f, -1e30f, std::numeric_limits<float>::infinity(),
+                               -std::numeric_limits<float>::infinity(), std::numeric_limits<float>::quiet_NaN()};
+  for (int i = 0; i < 200; ++i) values.push_back(coordinate(random));
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    const Box box{glm::vec3(values[i], values[(i + 1) % values.size()], values[(i + 2) % values.size()]),
+                  glm::vec3(values[(i + 3) % values.size()], values[(i + 4) % values.size()], values[(i + 5) % values.size()])};
+    const GridBox snapped = snap_outward(grid, box);
+    for (int axis = 0; axis < 3; ++axis) {
+      EXPECT_EQ(snapped.lower[axis], grid.floor_line(box.lower[axis], axis)) << "box " << i << " axis " << axis;
+      EXPECT_EQ(snapped.upper[axis], grid.ceil_line(box.upper[axis], axis)) << "box " << i << " axis " << axis;
+    }
+  }
+}
+
 TEST(HmqLeaf, RecordDecodesToTheSnappedVerticesIdsAndCorners) {
   const Scene scene = make_builtin_scene("builtin:sphere:2000");
   const GlobalGrid grid = grid_from_bits(scene.mesh.bounds(), 12);

@@ -14,6 +14,10 @@
 #include "wavetrace/accel/hmq/strip_table.hpp"
 #include "wavetrace/scene/triangle_mesh.hpp"
 
+#if WAVETRACE_AVX2
+#include <immintrin.h>
+#endif
+
 namespace wavetrace::hmq {
 
 // What the encoder reads: the mesh's triangles and every vertex's global grid point.
@@ -26,12 +30,30 @@ struct QuantizedMesh {
 struct GridBox {
   glm::ivec3 lower, upper;
 };
+// Every leaf a ray visits is re-snapped: with AVX2 the six lines in two SSE passes, with
+// GlobalGrid::floor_line's and ceil_line's float operations and clamp (NaN included: maxps
+// returns its second operand, -2^30, as to_line does), so the lines are the encoder's.
 inline GridBox snap_outward(const GlobalGrid& grid, const Box& box) {
   GridBox snapped;
+#if WAVETRACE_AVX2
+  const __m128 origin = _mm_setr_ps(grid.origin.x, grid.origin.y, grid.origin.z, 0.0f);
+  const __m128 inverse_cell = _mm_setr_ps(grid.inverse_cell.x, grid.inverse_cell.y, grid.inverse_cell.z, 0.0f);
+  const __m128 limit = _mm_set1_ps(1073741824.0f);  // 2^30
+  auto lines = [&](const glm::vec3& corner, auto round, glm::ivec3& out) {
+    const __m128 scaled = _mm_mul_ps(_mm_sub_ps(_mm_setr_ps(corner.x, corner.y, corner.z, 0.0f), origin), inverse_cell);
+    const __m128 clamped = _mm_min_ps(_mm_max_ps(round(scaled), _mm_sub_ps(_mm_setzero_ps(), limit)), limit);
+    alignas(16) std::int32_t line[4];
+    _mm_store_si128(reinterpret_cast<__m128i*>(line), _mm_cvttps_epi32(clamped));
+    out = {line[0], line[1], line[2]};
+  };
+  lines(box.lower, [](__m128 x) { return _mm_floor_ps(x); }, snapped.lower);
+  lines(box.upper, [](__m128 x) { return _mm_ceil_ps(x); }, snapped.upper);
+#else
   for (int axis = 0; axis < 3; ++axis) {
     snapped.lower[axis] = grid.floor_line(box.lower[axis], axis);
     snapped.upper[axis] = grid.ceil_line(box.upper[axis], axis);
   }
+#endif
   return snapped;
 }
 

@@ -59,11 +59,6 @@ StripTable::StripTable() {
   for (std::uint32_t total = 1; total <= kMaxLeafTriangles; ++total) partitions(total, total);
 }
 
-const StripTable& StripTable::instance() {
-  static const StripTable table;
-  return table;
-}
-
 std::uint32_t StripTable::find(std::span<const std::uint32_t> lengths) const {
   std::uint32_t total = 0;
   for (const std::uint32_t length : lengths) {

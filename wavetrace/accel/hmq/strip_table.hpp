@@ -28,7 +28,11 @@ struct StripLayoutEntry {
 
 class StripTable {
  public:
-  static const StripTable& instance();
+  // Inline, as every leaf a ray visits asks for it: a guard check, not a call.
+  static const StripTable& instance() {
+    static const StripTable table;
+    return table;
+  }
 
   std::size_t size() const { return entries_.size(); }
   const StripLayoutEntry& entry(std::uint32_t index) const { return entries_[index]; }
