@@ -82,6 +82,19 @@ TEST(HmqPackedStream, RoundTripsEveryWidthWithByteAlignedGroups) {
   EXPECT_EQ(stream_shape(17).group_bytes, 7u);
 }
 
+// A decoder steps from stream to stream by stream_bytes, which for up to 64 values reads where
+// the last one ends from the offset table: the bytes the encoder appends, at every width and count.
+TEST(HmqPackedStream, StreamBytesAreTheBytesAppendedAtEveryWidthAndCount) {
+  for (std::uint32_t bits = 0; bits <= 32; ++bits) {
+    for (std::uint32_t count = 0; count <= 70; ++count) {
+      const std::vector<std::uint32_t> values(count, bits == 0 ? 0u : 1u);
+      LargeArray<std::byte> out;
+      append_stream(out, values, bits);
+      EXPECT_EQ(stream_bytes(bits, count), out.size()) << bits << " bits, " << count << " values";
+    }
+  }
+}
+
 #if WAVETRACE_AVX2
 // The eight-lane reader every leaf decode uses, value for value against the scalar one, at
 // every width it takes and at counts that end inside, at and past a block of eight.

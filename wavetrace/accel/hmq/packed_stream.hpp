@@ -42,12 +42,6 @@ inline constexpr auto kStreamShapes = [] {
 
 constexpr StreamShape stream_shape(std::uint32_t bits) { return kStreamShapes[bits]; }
 
-constexpr std::size_t stream_bytes(std::uint32_t bits, std::uint32_t count) {
-  if (bits == 0) return 0;
-  const StreamShape shape = stream_shape(bits);
-  return std::size_t(count / shape.per_group) * shape.group_bytes + ((count % shape.per_group) * bits + 7) / 8;
-}
-
 // Where value i (< 64) of a stream of `bits` (1 .. 32) bits starts, in bits from the stream's
 // start: the group's start, (i / per_group) * group_bytes bytes in, and (i % per_group) * bits.
 inline constexpr auto kStreamBitOffsets = [] {
@@ -60,6 +54,16 @@ inline constexpr auto kStreamBitOffsets = [] {
   }
   return offsets;
 }();
+
+// Bytes a stream of `count` values takes. Up to 64 values (every stream of a leaf record) from
+// where its last value ends: a decoder steps from stream to stream by it, and the division
+// by per_group the general formula needs would sit in that chain once a stream.
+constexpr std::size_t stream_bytes(std::uint32_t bits, std::uint32_t count) {
+  if (bits == 0 || count == 0) return 0;
+  if (count <= 64 && bits <= 32) return (std::size_t(kStreamBitOffsets[bits][count - 1]) + bits + 7) / 8;
+  const StreamShape shape = stream_shape(bits);
+  return std::size_t(count / shape.per_group) * shape.group_bytes + ((count % shape.per_group) * bits + 7) / 8;
+}
 
 // The widest values read_stream_lanes takes: a value and its bit offset within its first byte
 // fit one 4-byte load.
