@@ -521,7 +521,7 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
         const std::byte* strip_data = strip_bytes_.data() + std::size_t(leaf_words[leaf]) * 4;
         const std::byte* end = strip_bytes_.data() + std::size_t(leaf_words[leaf + 1]) * 4;
         return trace_strips<kAnyHit>(ray, box, strip_data, end, near, far, positions, probe);
-      });
+      }, [&](std::uint32_t leaf) { return strip_bytes_.data() + std::size_t(leaf_words[leaf]) * 4; });
       write_hit<!kAnyHit>(ray, hits, i, &probe);
     });
   }
