@@ -108,7 +108,7 @@ struct NoLeafPrefetch {
 // `tmax`, which prunes what is left on the stack. `leaf_address(reference)`, where it gives
 // one, is where the leaf's data starts: with the nodes of the inner children, its first two
 // lines are asked for as soon as a node's children are entered, before the walk goes down the
-// nearest, so that the others are in cache when it comes back for them.
+// nearest, so that the others are in cache when it comes back for them (plain walks only).
 template <KernelIsa kIsa, typename Probe, typename VisitLeaf, typename LeafAddress = NoLeafPrefetch>
 [[gnu::always_inline]] inline void walk_quantized_wide(const QuantizedWideNode* nodes, const Bounds3& root_frame,
                                                        const SingleRay& ray, const float& tmax, Probe& probe,
@@ -141,7 +141,9 @@ template <KernelIsa kIsa, typename Probe, typename VisitLeaf, typename LeafAddre
       }
       if (entered_mask != 0) {  // nearest first, by sorting
         const __m256i references = child_references(node);
-        if constexpr (!std::is_same_v<std::remove_cvref_t<LeafAddress>, NoLeafPrefetch>) {
+        // Not in probed walks: finding a leaf's address may read the world (Ray-Strips' leaf
+        // words), and a read no probe announced would fault a paged world's page in.
+        if constexpr (!Probe::kRecords && !std::is_same_v<std::remove_cvref_t<LeafAddress>, NoLeafPrefetch>) {
           alignas(32) std::uint32_t reference[8];
           _mm256_store_si256(reinterpret_cast<__m256i*>(reference), references);
           for (unsigned mask = entered_mask; mask != 0; mask &= mask - 1) {
