@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
+#include <tbb/global_control.h>
 
 #include "wavetrace/accel/chunked/chunked_accelerator.hpp"
 #include "wavetrace/accel/registry.hpp"
@@ -63,6 +64,12 @@ int run_build(const BuildArguments& args) {
   if (!is_world_file(args.out)) throw ConfigError(fmt::format("--out {}: a world file is named *.wtw", args.out));
   RenderPlan plan = plan_render(config);
   if (is_world_file(plan.scene.source)) throw ConfigError(fmt::format("{} is already a world", plan.scene.source));
+  // Every parallel phase, ours and Embree's, on at most --threads threads: the builds run in
+  // TBB's default arena, which would otherwise take every core.
+  std::optional<tbb::global_control> thread_limit;
+  if (plan.pipeline.threads > 0) {
+    thread_limit.emplace(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(plan.pipeline.threads));
+  }
   const bool with_proxy = args.proxy || plan.needs_proxy();
   // A world that builds in chunks is written chunk by chunk as it is built and never held
   // whole, so that it may be larger than memory; not with a proxy, whose quality is measured
@@ -126,6 +133,7 @@ int run_build(const BuildArguments& args) {
     const nlohmann::json stats = {{"scene", {{"source", plan.scene.source}, {"name", scene.name},
                                              {"triangles", scene.triangle_count}}},
                                   {"accel", type},
+                                  {"threads", tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)},
                                   {"scene_seconds", info.scene_seconds},
                                   {"build_seconds", info.build_seconds},
                                   {"build_phases", build_phases_json(accelerator->build().phases)},

@@ -6,6 +6,8 @@
 #include "wavetrace/scene/load_scene.hpp"
 #include "wavetrace/scene/builtin_scenes.hpp"
 #include "wavetrace/scene/mesh_report.hpp"
+#include "wavetrace/scene/shape_generator.hpp"
+#include "wavetrace/scene/shapes.hpp"
 #include "wavetrace/scene/subdivide.hpp"
 #include "test_support.hpp"
 
@@ -30,6 +32,28 @@ TEST(BuiltinScenes, SphereIsClosedManifoldAndFacesOutward) {
     EXPECT_EQ(report.connected_components, 1u) << source;
     EXPECT_EQ(report.degenerate_triangles, 0u) << source;
     EXPECT_GT(signed_volume(sphere.mesh), 2.0) << source;  // about 4/3 pi for radius ~1
+  }
+}
+
+// Every triangle's corners are neighbours on the lattice: a vertex id mapped back to the
+// wrong lattice row or column would put a corner far across its face. On the unit sphere a
+// lattice edge is at most the icosahedron's edge (1.0515) over n, stretched by at most
+// 1 / 0.7947 (the faces' inradius) when projected.
+TEST(BuiltinScenes, SphereVerticesLieOnTheLatticeTheirIdsName) {
+  for (const std::size_t n : {3u, 4u, 5u, 8u, 37u, 211u}) {
+    const auto shape = smooth_sphere_shape(20 * n * n, glm::vec3(0.0f), 1.0f);
+    ASSERT_EQ(shape->triangle_count(), 20 * n * n);
+    const float longest = 1.0515f / 0.7947f / float(n) * 1.01f;
+    std::vector<std::uint64_t> corners(3 * shape->triangle_count());
+    shape->corners(0, shape->triangle_count(), corners.data());
+    std::size_t too_long = 0;
+    for (std::size_t t = 0; t < shape->triangle_count(); ++t) {
+      for (int k = 0; k < 3; ++k) {
+        const glm::vec3 a = shape->position(corners[3 * t + k]), b = shape->position(corners[3 * t + (k + 1) % 3]);
+        if (!(glm::distance(a, b) <= longest) || glm::distance(a, b) < 0.1f / float(n)) ++too_long;
+      }
+    }
+    EXPECT_EQ(too_long, 0u) << "n = " << n;
   }
 }
 

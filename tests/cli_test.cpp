@@ -98,6 +98,16 @@ TEST(Cli, BuildStatsNameEachPhaseOfTheBuild) {
   }
 }
 
+// --threads bounds the build itself, which runs outside the render's arena.
+TEST(Cli, BuildRunsOnTheThreadsItIsGiven) {
+  const std::string dir = temp_dir();
+  const auto result = run_wavetrace("build builtin:room:20k --accel hmq:width=8 --threads 1 --out " + dir +
+                                    "/one_thread.wtw --stats " + dir + "/one_thread.json");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  std::ifstream file(dir + "/one_thread.json");
+  EXPECT_EQ(nlohmann::json::parse(file).at("threads").get<int>(), 1);
+}
+
 TEST(Cli, ExportedPlyRendersStreamedInChunksAsTheBuiltinDoes) {
   const std::string dir = temp_dir();
   const auto exported = run_wavetrace("export builtin:sphere:20k --out " + dir + "/sphere.ply");

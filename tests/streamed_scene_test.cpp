@@ -29,6 +29,8 @@ TEST(ShapeGenerator, AnyRangeIsTheWholeShapesTrianglesToTheBit) {
   const glm::vec3 offset(0.25f, -1.0f, 3.0f);
   std::vector<std::pair<std::string, std::unique_ptr<ShapeGenerator>>> shapes;
   shapes.emplace_back("sphere", displaced_sphere_shape(20000, glm::vec3(1.0f), 0.5f, 3));
+  // 148,842 vertex keys: a range's keys fall in several blocks of 2^16, the edge vertices' and its face's.
+  shapes.emplace_back("large sphere", displaced_sphere_shape(300000, glm::vec3(1.0f), 0.5f, 4));
   shapes.emplace_back("soup", soup_shape(5000, 1));
   shapes.emplace_back("terrain", terrain_shape(20000, 3.0f, 0.4f, 2));
   shapes.emplace_back("strands", strands_shape(24000, 0.5f, 0.3f, 0.004f, 1));
@@ -48,6 +50,16 @@ TEST(ShapeGenerator, AnyRangeIsTheWholeShapesTrianglesToTheBit) {
         const std::size_t first = total * k / pieces, count = total * (k + 1) / pieces - first;
         const TriangleMesh part = generate_range(*shape, first, count, offset);
         expect_same_triangles(whole, first, part, name + " in " + std::to_string(pieces));
+        // The range's vertices are its distinct corner keys in ascending order, as a world
+        // file stores them.
+        std::vector<std::uint64_t> keys(3 * count);
+        shape->corners(first, count, keys.data());
+        std::sort(keys.begin(), keys.end());
+        keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+        ASSERT_EQ(part.vertex_count(), keys.size()) << name << " in " << pieces;
+        for (std::size_t v = 0; v < keys.size(); ++v) {
+          ASSERT_EQ(part.positions[v], shape->position(keys[v]) + offset) << name << " in " << pieces << " vertex " << v;
+        }
         if (shape->material_count() > 1) {
           ASSERT_EQ(part.material_of_triangle.size(), count);
           for (std::size_t t = 0; t < count; ++t) ASSERT_EQ(part.material_of_triangle[t], whole.material_of_triangle[first + t]);

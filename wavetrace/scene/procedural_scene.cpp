@@ -57,14 +57,21 @@ TriangleMesh ProceduralScene::extract_objects(std::size_t first, std::size_t cou
     }
     const auto vertex_offset = static_cast<std::uint32_t>(mesh.positions.size());
     const std::size_t triangle_offset = mesh.triangles.size();
-    mesh.positions.insert(mesh.positions.end(), part.positions.begin(), part.positions.end());
-    mesh.triangles.resize(triangle_offset + part.triangles.size());
-    tbb::parallel_for(std::size_t{0}, part.triangles.size(),
-                      [&](std::size_t t) { mesh.triangles[triangle_offset + t] = part.triangles[t] + vertex_offset; });
+    if (triangle_offset == 0 && vertex_offset == 0) {
+      // The first object's part is the mesh so far: moved, not copied (a chunk is most often
+      // one object's, and copying it, zeroing first, ran on one thread).
+      mesh.positions = std::move(part.positions);
+      mesh.triangles = std::move(part.triangles);
+    } else {
+      mesh.positions.insert(mesh.positions.end(), part.positions.begin(), part.positions.end());
+      mesh.triangles.resize(triangle_offset + part.triangles.size());
+      tbb::parallel_for(std::size_t{0}, part.triangles.size(),
+                        [&](std::size_t t) { mesh.triangles[triangle_offset + t] = part.triangles[t] + vertex_offset; });
+    }
     if (with_materials) {
       mesh.material_of_triangle.resize(mesh.triangles.size());
-      for (std::size_t t = 0; t < part.triangles.size(); ++t) {
-        mesh.material_of_triangle[triangle_offset + t] = object.materials[part.material(t)];
+      for (std::size_t t = triangle_offset; t < mesh.triangles.size(); ++t) {
+        mesh.material_of_triangle[t] = object.materials[part.material(t - triangle_offset)];
       }
     }
   }

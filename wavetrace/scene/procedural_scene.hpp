@@ -31,6 +31,7 @@ class ProceduralScene final : public TriangleSource {
   std::vector<std::size_t> object_starts() const override;
   // Vertices shared inside one object stay shared; material_of_triangle stays empty.
   TriangleMesh extract(std::size_t first, std::size_t count) const override;
+  bool extracts_concurrently() const override { return true; }  // shapes generate any range from any thread
 
   MaterialRuns material_runs() const override;
   // Every object that has a wanted material, whole, without generating the rest.

@@ -37,15 +37,20 @@ void fill_materials(const ShapeGenerator& shape, std::size_t first, TriangleMesh
                     [&](std::size_t t) { mesh.material_of_triangle[t] = shape.material(first + t); });
 }
 
-// A dense shape's range: its keys lie in [0, vertex_count), so a table over the keys' span
-// marks the used ones and numbers them in key order by a prefix sum, as sorting the keys,
-// dropping repeats and searching each corner did (a third of a room's chunked build). Only
-// where the span is at most kDenseSpanPerKey times the keys (a table of 16 bytes a key or
-// less); false, and nothing done, where it is not (a chunk of a shape far larger than it:
-// an icosphere's corner and edge vertices are numbered before every face's).
+// A dense shape's range: its keys lie in [0, vertex_count) in a few clusters (a chunk of an
+// icosphere uses a stretch of one face's interior and some of the edge vertices, which are
+// numbered before every face's). Each block of 2^16 keys that holds any of them gets a slice
+// of a table that marks the used keys and numbers them in key order by a prefix sum, as
+// sorting the keys, dropping repeats and searching each corner did (a third of a room's
+// chunked build, and most of a billion-triangle room's extraction while one table had to span
+// the edge vertices and the face together). Only where the slices hold at most
+// kDenseSpanPerKey entries a key (16 bytes a key), or 2^20 in all; false, and nothing done,
+// where they would not.
 constexpr std::size_t kDenseSpanPerKey = 4;
+constexpr int kKeyBlockBits = 16;
+constexpr std::uint64_t kKeyBlockMask = (std::uint64_t{1} << kKeyBlockBits) - 1;
 
-bool renumber_dense_keys(const ShapeGenerator& shape, const LargeArray<std::uint64_t>& keys, const glm::vec3& offset,
+bool renumber_dense_keys(const ShapeGenerator& shape, const UnfilledLargeArray<std::uint64_t>& keys, const glm::vec3& offset,
                          TriangleMesh& mesh) {
   // Not a structured binding: lambdas below capture the two, which clang 14 refuses.
   const std::pair<std::uint64_t, std::uint64_t> key_span = tbb::parallel_reduce(
@@ -60,23 +65,43 @@ bool renumber_dense_keys(const ShapeGenerator& shape, const LargeArray<std::uint
       },
       [](auto a, const auto& b) { return std::pair(std::min(a.first, b.first), std::max(a.second, b.second)); });
   const std::uint64_t lowest = key_span.first, highest = key_span.second;
-  const std::size_t span = highest - lowest + 1;  // at most the shape's vertex count
-  if (span > kDenseSpanPerKey * keys.size()) return false;
-  LargeArray<std::uint32_t> number(span, 0);
+  const std::size_t blocks = ((highest - lowest) >> kKeyBlockBits) + 1;
+  if (blocks > keys.size()) return false;
+  // Marked blocks, then each used block's slice, plus one.
+  std::vector<std::uint32_t> slice_of_block(blocks, 0);
   tbb::parallel_for(std::size_t{0}, keys.size(), [&](std::size_t k) {
-    std::atomic_ref<std::uint32_t>(number[keys[k] - lowest]).store(1, std::memory_order_relaxed);
+    std::atomic_ref<std::uint32_t>(slice_of_block[(keys[k] - lowest) >> kKeyBlockBits]).store(1, std::memory_order_relaxed);
+  });
+  std::vector<std::uint64_t> block_first_key;  // by slice
+  for (std::size_t block = 0; block < blocks; ++block) {
+    if (slice_of_block[block] == 0) continue;
+    block_first_key.push_back(lowest + (std::uint64_t(block) << kKeyBlockBits));
+    slice_of_block[block] = static_cast<std::uint32_t>(block_first_key.size());
+  }
+  const std::size_t entries = block_first_key.size() << kKeyBlockBits;
+  if (entries > std::max(kDenseSpanPerKey * keys.size(), std::size_t{1} << 20)) return false;
+  LargeArray<std::uint32_t> number(entries, 0);
+  const auto entry = [&](std::uint64_t key) -> std::uint32_t& {
+    const std::uint64_t from_lowest = key - lowest;
+    const std::size_t slice = slice_of_block[from_lowest >> kKeyBlockBits] - 1;
+    return number[(slice << kKeyBlockBits) | (from_lowest & kKeyBlockMask)];
+  };
+  tbb::parallel_for(std::size_t{0}, keys.size(), [&](std::size_t k) {
+    std::atomic_ref<std::uint32_t>(entry(keys[k])).store(1, std::memory_order_relaxed);
   });
   std::uint32_t used = 0;
   for (std::uint32_t& slot : number) {  // marked slots become their vertex's number, plus one
     if (slot != 0) slot = ++used;
   }
+  mesh.positions.reserve(used + 1);  // the read slack TriangleMesh users expect, without a copy
   mesh.positions.resize(used);
-  tbb::parallel_for(std::size_t{0}, span, [&](std::size_t k) {
-    if (number[k] != 0) mesh.positions[number[k] - 1] = shape.position(lowest + k) + offset;
+  tbb::parallel_for(std::size_t{0}, entries, [&](std::size_t e) {
+    if (number[e] == 0) return;
+    const std::uint64_t key = block_first_key[e >> kKeyBlockBits] + (e & kKeyBlockMask);
+    mesh.positions[number[e] - 1] = shape.position(key) + offset;
   });
   tbb::parallel_for(std::size_t{0}, mesh.triangles.size(), [&](std::size_t t) {
-    mesh.triangles[t] = glm::uvec3(number[keys[3 * t] - lowest] - 1, number[keys[3 * t + 1] - lowest] - 1,
-                                   number[keys[3 * t + 2] - lowest] - 1);
+    mesh.triangles[t] = glm::uvec3(entry(keys[3 * t]) - 1, entry(keys[3 * t + 1]) - 1, entry(keys[3 * t + 2]) - 1);
   });
   return true;
 }
@@ -95,6 +120,7 @@ TriangleMesh generate_range(const ShapeGenerator& shape, std::size_t first, std:
     if (shape.vertex_count() > std::numeric_limits<std::uint32_t>::max()) {
       throw SceneError(fmt::format("a shape of {} vertices is beyond 32-bit indices", shape.vertex_count()));
     }
+    mesh.positions.reserve(shape.vertex_count() + 1);
     mesh.positions.resize(shape.vertex_count());
     tbb::parallel_for(std::size_t{0}, mesh.positions.size(),
                       [&](std::size_t v) { mesh.positions[v] = shape.position(v) + offset; });
@@ -108,7 +134,7 @@ TriangleMesh generate_range(const ShapeGenerator& shape, std::size_t first, std:
     fill_materials(shape, first, mesh);
     return mesh;
   }
-  LargeArray<std::uint64_t> keys(3 * count);
+  UnfilledLargeArray<std::uint64_t> keys(3 * count);  // every key written by the blocks, in parallel
   for_each_block(first, count, [&](std::size_t begin, std::size_t size) { shape.corners(begin, size, keys.data() + 3 * (begin - first)); });
   if (shape.vertex_count() > 0 && renumber_dense_keys(shape, keys, offset, mesh)) {
     fill_materials(shape, first, mesh);
@@ -121,6 +147,7 @@ TriangleMesh generate_range(const ShapeGenerator& shape, std::size_t first, std:
   if (unique > std::numeric_limits<std::uint32_t>::max()) {
     throw SceneError(fmt::format("a chunk of {} vertices is beyond 32-bit indices", unique));
   }
+  mesh.positions.reserve(unique + 1);
   mesh.positions.resize(unique);
   tbb::parallel_for(std::size_t{0}, unique, [&](std::size_t v) { mesh.positions[v] = shape.position(vertices[v]) + offset; });
   const std::uint64_t* sorted = vertices.data();

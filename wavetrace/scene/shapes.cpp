@@ -3,6 +3,7 @@
 // globally shared vertices, so it is closed.
 #include "wavetrace/scene/shapes.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <optional>
@@ -93,13 +94,10 @@ class IcosphereLattice {
     }
     id -= 30 * std::size_t(n_ - 1);
     const std::size_t face = id / interior_per_face();
-    std::uint32_t local = static_cast<std::uint32_t>(id % interior_per_face());
-    std::uint32_t i = 1;
-    while (local >= n_ - 1 - i) {
-      local -= n_ - 1 - i;
-      ++i;
-    }
-    const std::uint32_t j = local + 1;
+    const std::size_t local = id % interior_per_face();
+    const std::uint32_t row = interior_row(local);
+    const std::uint32_t i = row + 1;
+    const auto j = static_cast<std::uint32_t>(local - interior_row_start(row) + 1);
     const glm::uvec3& corners = ico.faces[face];
     const glm::vec3 a = ico.corners[corners.x], b = ico.corners[corners.y], c = ico.corners[corners.z];
     return glm::normalize(a + (b - a) * (float(i) / n_) + (c - a) * (float(j) / n_));
@@ -107,6 +105,20 @@ class IcosphereLattice {
 
  private:
   std::size_t interior_per_face() const { return n_ < 3 ? 0 : std::size_t(n_ - 1) * (n_ - 2) / 2; }
+  // Interior row r (lattice row i = r + 1) holds n - 2 - r points and starts at
+  // r (2n - 3 - r) / 2 within its face: the inverse of vertex()'s numbering.
+  std::size_t interior_row_start(std::size_t row) const { return row * (2 * std::size_t(n_) - 3 - row) / 2; }
+  // The row of a face's interior point, from the quadratic's root and then exact by integer
+  // steps: walking the rows one by one cost O(n) a vertex, most of a billion-triangle
+  // room's generation.
+  std::uint32_t interior_row(std::size_t local) const {
+    const double b = 2.0 * double(n_) - 3.0;
+    const double root = 0.5 * (b - std::sqrt(std::max(0.0, b * b - 8.0 * double(local))));
+    auto row = static_cast<std::size_t>(std::clamp(root, 0.0, double(n_ - 3)));
+    while (row > 0 && interior_row_start(row) > local) --row;
+    while (row + 1 <= n_ - 3 && interior_row_start(row + 1) <= local) ++row;
+    return static_cast<std::uint32_t>(row);
+  }
   std::uint32_t edge_vertex(std::uint32_t from, std::uint32_t to, std::uint32_t steps_from_start) const {
     const std::uint32_t edge = icosahedron().edge_of.at(std::minmax(from, to));
     const std::uint32_t steps = from < to ? steps_from_start : n_ - steps_from_start;

@@ -22,6 +22,9 @@ class TriangleSource {
   // Triangles [first, first + count) as a mesh of their own: vertices renumbered from 0,
   // triangle i of the result is triangle first + i of the source, material_of_triangle empty.
   virtual TriangleMesh extract(std::size_t first, std::size_t count) const = 0;
+  // Whether several ranges may be extracted at once, from several threads (a file read in
+  // order may not be).
+  virtual bool extracts_concurrently() const { return false; }
   // Each triangle's material (scene indices); a source without materials has only material 0.
   virtual MaterialRuns material_runs() const { return MaterialRuns::from_triangles({}, triangle_count()); }
   // Every triangle whose material is `wanted` (by index), with material_of_triangle: what
@@ -40,6 +43,7 @@ class MeshTriangleSource final : public TriangleSource {
   Bounds3 bounds() const override { return mesh_.bounds(); }
   std::vector<std::size_t> object_starts() const override { return object_starts_; }
   TriangleMesh extract(std::size_t first, std::size_t count) const override;
+  bool extracts_concurrently() const override { return true; }
 
  private:
   const TriangleMesh& mesh_;

@@ -184,10 +184,17 @@ class ChunkedAccelerator final : public Accelerator, public ChunkSet {
     std::size_t finished_bytes = 0;
     for (std::size_t wave_begin = 0; wave_begin < ranges.size();) {
       const std::size_t wave_end = std::min(ranges.size(), wave_begin + chunks_built_at_once(chunk_triangles, at_once_limit));
-      // Extracted one after another (a PLY file's faces are read in order), then built at once.
-      std::vector<std::unique_ptr<const TriangleMesh>> meshes;
-      for (std::size_t c = wave_begin; c < wave_end; ++c) {
-        meshes.push_back(std::make_unique<const TriangleMesh>(source.extract(ranges[c].first, ranges[c].count)));
+      // Extracted, at once where the source allows (the serial parts of one chunk's
+      // extraction, a third of it, overlap another's) and else one after another (a PLY
+      // file's faces are read in order), then built at once.
+      std::vector<std::unique_ptr<const TriangleMesh>> meshes(wave_end - wave_begin);
+      const auto extract = [&](std::size_t c) {
+        meshes[c - wave_begin] = std::make_unique<const TriangleMesh>(source.extract(ranges[c].first, ranges[c].count));
+      };
+      if (source.extracts_concurrently()) {
+        tbb::parallel_for(wave_begin, wave_end, extract);
+      } else {
+        for (std::size_t c = wave_begin; c < wave_end; ++c) extract(c);
       }
       clock.lap(build_.phases, "extract");
       tbb::parallel_for(wave_begin, wave_end, [&](std::size_t c) {
