@@ -1,4 +1,6 @@
 // Procedural scenes: triangle counts, closedness where promised, orientation, determinism.
+#include <cstring>
+
 #include <gtest/gtest.h>
 
 #include <glm/geometric.hpp>
@@ -6,6 +8,7 @@
 #include "wavetrace/scene/load_scene.hpp"
 #include "wavetrace/scene/builtin_scenes.hpp"
 #include "wavetrace/scene/mesh_report.hpp"
+#include "wavetrace/scene/noise.hpp"
 #include "wavetrace/scene/shape_generator.hpp"
 #include "wavetrace/scene/shapes.hpp"
 #include "wavetrace/scene/subdivide.hpp"
@@ -55,6 +58,38 @@ TEST(BuiltinScenes, SphereVerticesLieOnTheLatticeTheirIdsName) {
     }
     EXPECT_EQ(too_long, 0u) << "n = " << n;
   }
+}
+
+// The fractal sum in SIMD lanes is the scalar sum to the bit: in lattice order (the cached
+// cells), at random, across cell boundaries and negative coordinates, with the seed and the
+// octave count changing between calls.
+TEST(Noise, FractalSumInLanesIsTheScalarSum) {
+  std::uint64_t state = 12345;
+  const auto next_unit = [&] {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return float(state >> 40) / float(1 << 24);
+  };
+  std::size_t differing = 0, compared = 0;
+  const auto compare = [&](const glm::vec3& point, int octaves, std::uint32_t seed) {
+    const float lanes = fractal_noise(point, octaves, seed), scalar = fractal_noise_scalar(point, octaves, seed);
+    ++compared;
+    if (std::memcmp(&lanes, &scalar, sizeof(float)) != 0) ++differing;
+  };
+  for (int octaves = 1; octaves <= 9; ++octaves) {
+    for (std::uint32_t seed : {0u, 7u, 4242u}) {
+      for (int i = 0; i < 2000; ++i) {  // a lattice walk: neighbouring points share cells
+        compare(glm::vec3(-1.3f + 0.0011f * float(i), 0.37f, 0.25f * float(i % 7)), octaves, seed);
+      }
+      for (int i = 0; i < 2000; ++i) {
+        const glm::vec3 point(next_unit() * 40.0f - 20.0f, next_unit() * 6.0f - 3.0f, next_unit() * 400.0f - 200.0f);
+        compare(point, octaves, seed);
+        compare(point, octaves == 1 ? 8 : octaves - 1, seed + 1);  // another shape in between
+      }
+      compare(glm::vec3(0.0f), octaves, seed);
+      compare(glm::vec3(-0.0f, 1.0f, -2.0f), octaves, seed);
+    }
+  }
+  EXPECT_EQ(differing, 0u) << "of " << compared;
 }
 
 TEST(BuiltinScenes, SoupSharesNoVertex) {
