@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <optional>
 #include <map>
@@ -265,27 +266,22 @@ class StrandsShape final : public ShapeGenerator {
     const std::size_t s = id / kVerticesPerStrand;
     const std::uint32_t ring = static_cast<std::uint32_t>(id % kVerticesPerStrand) / kSides;
     const std::uint32_t side = static_cast<std::uint32_t>(id % kSides);
-    const UnitPair jitter = unit_pair(random_bits(std::uint32_t(s), seed_, 0, RandomPurpose::scene_generation));
-    const UnitPair bend = unit_pair(random_bits(std::uint32_t(s), seed_, 1, RandomPurpose::scene_generation));
-    // Row r of the face's columns x columns cells maps to a band parallel to the face's
-    // edge BC (the square-root parametrization keeps the spread uniform).
-    const std::size_t k = s % per_face_;
-    const float x = (float(k / columns_) + jitter.first) / float(columns_);
-    const float y = (float(k % columns_) + jitter.second) / float(columns_);
-    const Icosahedron& ico = icosahedron();
-    const glm::uvec3& face = ico.faces[s / per_face_];
-    const float root = std::sqrt(std::min(x, 1.0f));
-    const glm::vec3 normal = glm::normalize(ico.corners[face.x] * (1.0f - root) + ico.corners[face.y] * (root * (1.0f - y)) +
-                                            ico.corners[face.z] * (root * y));
-    const glm::vec3 tangent = glm::normalize(glm::cross(normal, std::fabs(normal.y) < 0.9f ? glm::vec3(0, 1, 0)
-                                                                                          : glm::vec3(1, 0, 0)));
-    const glm::vec3 bitangent = glm::cross(normal, tangent);
-    const glm::vec3 sway = tangent * (bend.first - 0.5f) + bitangent * (bend.second - 0.5f);
+    // A strand's 15 vertices come one after another and share its frame: made once a strand
+    // (a thread's last), and each side's cosine and sine once (the same float calls).
+    thread_local StrandFrame last;
+    if (last.instance != instance_ || last.strand != s) last = frame(s);
+    static const std::array<std::array<float, 2>, kSides> around = [] {
+      std::array<std::array<float, 2>, kSides> table{};
+      for (std::uint32_t side = 0; side < kSides; ++side) {
+        const float angle = 2.0f * 3.14159265f * float(side) / kSides;
+        table[side] = {std::cos(angle), std::sin(angle)};
+      }
+      return table;
+    }();
     const float along = float(ring) / kSegments;
-    const glm::vec3 center = normal * (radius_ + length_ * along) + sway * (length_ * along * along);
+    const glm::vec3 center = last.normal * (radius_ + length_ * along) + last.sway * (length_ * along * along);
     const float ring_width = width_ * (1.0f - 0.7f * along);
-    const float angle = 2.0f * 3.14159265f * float(side) / kSides;
-    return center + (tangent * std::cos(angle) + bitangent * std::sin(angle)) * ring_width;
+    return center + (last.tangent * around[side][0] + last.bitangent * around[side][1]) * ring_width;
   }
   void corners(std::size_t first, std::size_t count, std::uint64_t* out) const override {
     for (std::size_t t = first; t < first + count; ++t) {
@@ -302,9 +298,37 @@ class StrandsShape final : public ShapeGenerator {
   }
 
  private:
+  struct StrandFrame {
+    std::uint64_t instance = 0;  // 0: none
+    std::size_t strand = 0;
+    glm::vec3 normal, tangent, bitangent, sway;
+  };
+  StrandFrame frame(std::size_t s) const {
+    const UnitPair jitter = unit_pair(random_bits(std::uint32_t(s), seed_, 0, RandomPurpose::scene_generation));
+    const UnitPair bend = unit_pair(random_bits(std::uint32_t(s), seed_, 1, RandomPurpose::scene_generation));
+    // Row r of the face's columns x columns cells maps to a band parallel to the face's
+    // edge BC (the square-root parametrization keeps the spread uniform).
+    const std::size_t k = s % per_face_;
+    const float x = (float(k / columns_) + jitter.first) / float(columns_);
+    const float y = (float(k % columns_) + jitter.second) / float(columns_);
+    const Icosahedron& ico = icosahedron();
+    const glm::uvec3& face = ico.faces[s / per_face_];
+    const float root = std::sqrt(std::min(x, 1.0f));
+    const glm::vec3 normal = glm::normalize(ico.corners[face.x] * (1.0f - root) + ico.corners[face.y] * (root * (1.0f - y)) +
+                                            ico.corners[face.z] * (root * y));
+    const glm::vec3 tangent = glm::normalize(glm::cross(normal, std::fabs(normal.y) < 0.9f ? glm::vec3(0, 1, 0)
+                                                                                          : glm::vec3(1, 0, 0)));
+    const glm::vec3 bitangent = glm::cross(normal, tangent);
+    const glm::vec3 sway = tangent * (bend.first - 0.5f) + bitangent * (bend.second - 0.5f);
+    return StrandFrame{instance_, s, normal, tangent, bitangent, sway};
+  }
+
   std::size_t strands_, per_face_, columns_;
   float radius_, length_, width_;
   std::uint32_t seed_;
+  // Names this shape in threads' cached frames (an address may be reused by a later shape).
+  inline static std::atomic<std::uint64_t> instances_{0};
+  std::uint64_t instance_ = ++instances_;
 };
 
 // A mesh small enough to be listed: quads and the stadium's box.
