@@ -76,9 +76,9 @@ namespace {
 
 // The octaves of one fractal sum side by side, an octave a lane (AVX2, which the build's
 // x86-64-v3 has): each lane does the scalar gradient_noise's operations in its order, without
-// contraction (-ffp-contract=off), so the sum is the scalar one to the bit. Generation is
-// most of a procedural scene's build; octaves, each a dependent chain of lerps, were most of
-// generation.
+// contraction (-ffp-contract=off), so the sum is the scalar one to the bit. The octaves, each
+// a dependent chain of lerps, were a sixth of a room's chunked build (generated twice: the
+// bounds pass, then each chunk).
 constexpr int kOctaveLanes = 8;
 
 // The last lattice cell of every octave, and the gradient indices of its eight corners, for
