@@ -72,6 +72,28 @@ TEST(ShapeGenerator, AnyRangeIsTheWholeShapesTrianglesToTheBit) {
   }
 }
 
+// Bounds over a known box skip the positions their shape's bound puts inside it, and give the
+// known box extended by every vertex all the same, whether the box cuts through the shape near
+// its surface, holds it whole or misses it.
+TEST(ShapeGenerator, BoundsBeyondAKnownBoxAreEveryVertexsBounds) {
+  const glm::vec3 offset(0.25f, -1.0f, 3.0f);
+  for (const std::uint32_t seed : {3u, 11u}) {
+    const auto sphere = displaced_sphere_shape(30000, glm::vec3(1.0f), 0.5f, seed);
+    const Bounds3 whole = generated_bounds(*sphere, offset);
+    const glm::vec3 center = (whole.lower + whole.upper) * 0.5f, half = whole.extent() * 0.5f;
+    for (const float scale : {0.8f, 0.97f, 0.999f, 1.0f, 1.5f}) {
+      for (const glm::vec3 shift : {glm::vec3(0.0f), glm::vec3(0.1f, -0.05f, 0.0f), glm::vec3(3.0f)}) {
+        const Bounds3 known{center + shift - half * scale, center + shift + half * scale};
+        Bounds3 expected = known, skipping = known;
+        expected.extend(whole);
+        skipping.extend(generated_bounds(*sphere, offset, &known));
+        EXPECT_EQ(skipping.lower, expected.lower) << "seed " << seed << " scale " << scale;
+        EXPECT_EQ(skipping.upper, expected.upper) << "seed " << seed << " scale " << scale;
+      }
+    }
+  }
+}
+
 TEST(ShapeGenerator, StrandsOfAChunkGrowFromOnePatchOfTheSphere) {
   // The chunked build relies on runs of a shape being spatially compact.
   const auto strands = strands_shape(240000, 1.0f, 0.1f, 0.004f, 1);

@@ -13,7 +13,9 @@ ProceduralScene::ProceduralScene(std::vector<ProceduralObject> objects) : object
   starts_.push_back(0);
   for (const ProceduralObject& object : objects_) {
     starts_.push_back(starts_.back() + object.shape->triangle_count());
-    bounds_.extend(generated_bounds(*object.shape, object.offset));
+    // The objects before (in order, as before) bound this one's positions: a displaced
+    // shape inside the room computes only those that might reach past them.
+    bounds_.extend(generated_bounds(*object.shape, object.offset, &bounds_));
   }
 }
 

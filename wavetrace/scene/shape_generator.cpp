@@ -9,6 +9,8 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <glm/geometric.hpp>
+#include <glm/vector_relational.hpp>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 #include <tbb/parallel_sort.h>
@@ -162,19 +164,35 @@ TriangleMesh generate_range(const ShapeGenerator& shape, std::size_t first, std:
   return mesh;
 }
 
-Bounds3 generated_bounds(const ShapeGenerator& shape, const glm::vec3& offset) {
+Bounds3 generated_bounds(const ShapeGenerator& shape, const glm::vec3& offset, const Bounds3* known) {
   const bool dense = shape.vertex_count() > 0;
   const std::size_t items = dense ? shape.vertex_count() : shape.triangle_count();
+  // Strictly inside by a margin, so that a vertex left out can equal no side of `known` (not
+  // even as a zero of the other sign) and rounding in a bound cannot matter.
+  Bounds3 inner;
+  if (known != nullptr && !known->empty()) {
+    const glm::vec3 margin(1e-4f * glm::length(known->extent()) + 1e-30f);
+    inner = Bounds3{known->lower + margin, known->upper - margin};
+  }
+  const auto add = [&](std::uint64_t key, Bounds3& box) {
+    if (!inner.empty()) {
+      if (const std::optional<Bounds3> bound = shape.position_bound(key)) {
+        const glm::vec3 lower = bound->lower + offset, upper = bound->upper + offset;
+        if (glm::all(glm::greaterThan(lower, inner.lower)) && glm::all(glm::lessThan(upper, inner.upper))) return;
+      }
+    }
+    box.extend(shape.position(key) + offset);
+  };
   return tbb::parallel_reduce(
       tbb::blocked_range<std::size_t>(0, items, 4096), Bounds3{},
       [&](const tbb::blocked_range<std::size_t>& range, Bounds3 box) {
         if (dense) {
-          for (std::size_t v = range.begin(); v != range.end(); ++v) box.extend(shape.position(v) + offset);
+          for (std::size_t v = range.begin(); v != range.end(); ++v) add(v, box);
           return box;
         }
         std::vector<std::uint64_t> keys(3 * range.size());
         shape.corners(range.begin(), range.size(), keys.data());
-        for (const std::uint64_t key : keys) box.extend(shape.position(key) + offset);
+        for (const std::uint64_t key : keys) add(key, box);
         return box;
       },
       [](Bounds3 a, const Bounds3& b) {

@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -27,6 +28,9 @@ class ShapeGenerator {
   // out[3 * (t - first) + k]. Called from several threads on disjoint ranges.
   virtual void corners(std::size_t first, std::size_t count, std::uint64_t* out) const = 0;
   virtual glm::vec3 position(std::uint64_t key) const = 0;
+  // A box sure to hold position(key), where one is much cheaper than the position (a displaced
+  // shape's bound on its displacement); nullopt where none is.
+  virtual std::optional<Bounds3> position_bound(std::uint64_t key) const { return std::nullopt; }
   // The shape's own material index of a triangle (see material_count).
   virtual std::uint32_t material(std::size_t triangle) const { return 0; }
   virtual std::uint32_t material_count() const { return 1; }
@@ -42,7 +46,11 @@ TriangleMesh generate_range(const ShapeGenerator& shape, std::size_t first, std:
                             const glm::vec3& offset = glm::vec3(0.0f));
 TriangleMesh generate_mesh(const ShapeGenerator& shape, const glm::vec3& offset = glm::vec3(0.0f));
 
-// The box of every vertex the shape generates, moved by `offset` (parallel).
-Bounds3 generated_bounds(const ShapeGenerator& shape, const glm::vec3& offset = glm::vec3(0.0f));
+// The box of every vertex the shape generates, moved by `offset` (parallel). With `known`,
+// the box of those vertices only that position_bound does not put strictly inside `known`:
+// extended by it, it is `known` extended by every vertex, to the bit (a vertex left out lies
+// strictly inside), and displaced shapes inside a room skip most of their positions.
+Bounds3 generated_bounds(const ShapeGenerator& shape, const glm::vec3& offset = glm::vec3(0.0f),
+                         const Bounds3* known = nullptr);
 
 }  // namespace wavetrace

@@ -149,6 +149,18 @@ class SphereShape final : public ShapeGenerator {
         kDisplacementAmplitude * fractal_noise(direction * kDisplacementFrequency, kDisplacementOctaves, *seed_);
     return center_ + direction * (radius_ * (1.0f + displacement));
   }
+  // |gradient noise| <= 2 (a corner's gradient has two unit components, its offsets are
+  // within 1, the lerps' weights within [0, 1]) and the octaves' amplitudes sum below 1, so
+  // the displacement is within 0.24 of the radius: 0.25 leaves room for rounding.
+  std::optional<Bounds3> position_bound(std::uint64_t id) const override {
+    static_assert(kDisplacementAmplitude * 2.0f < 0.25f);
+    if (!seed_) return std::nullopt;
+    const glm::vec3 direction = lattice_.direction(id);
+    Bounds3 bound;
+    bound.extend(center_ + direction * (radius_ * 0.75f));
+    bound.extend(center_ + direction * (radius_ * 1.25f));
+    return bound;
+  }
   // Face f holds n^2 triangles in rows; row i has n-i "up" and n-i-1 "down" triangles,
   // interleaved up, down, up, ..., and starts at i (2n - i) within the face.
   void corners(std::size_t first, std::size_t count, std::uint64_t* out) const override {
