@@ -235,6 +235,48 @@ TEST(Grid, BuildIsTheSameOnAnyThreadCountAndEveryListAscends) {
   }
 }
 
+// Listing a triangle only in the cells it overlaps changes the lists, never a closest hit: the
+// same triangle, distance and barycentrics as the paper's bounding-box lists, for every ray.
+TEST(Grid, ListsOfTheCellsATriangleOverlapsFindTheHitsOfBoundingBoxLists) {
+  for (const char* source : {"builtin:fur:20k", "builtin:room:30k", "builtin:stadium:2000"}) {
+    const Scene scene = make_builtin_scene(source);
+    for (const std::uint32_t macrocells : {0u, 6u}) {
+      HashedGridOptions exact, boxes;
+      exact.macrocell_factor = boxes.macrocell_factor = macrocells;
+      boxes.bounding_box_lists = true;
+      const auto exact_grid = make_hashed_grid_accelerator(scene.mesh, exact);
+      const auto box_grid = make_hashed_grid_accelerator(scene.mesh, boxes);
+      EXPECT_LT(exact_grid->memory().hierarchy, box_grid->memory().hierarchy) << source;
+      for (const RaySetKind kind : {RaySetKind::primary, RaySetKind::diffuse, RaySetKind::random, RaySetKind::shadow}) {
+        const RaySet rays = make_ray_set(kind, scene, *box_grid, 5000);
+        const auto expected = trace_ray_set(*box_grid, rays);
+        const auto actual = trace_ray_set(*exact_grid, rays);
+        for (std::size_t b = 0; b < rays.batches.size(); ++b) {
+          for (std::size_t i = 0; i < rays.batches[b]->count; ++i) {
+            // Any hit: whichever occluder comes first, which the lists may change.
+            ASSERT_EQ(actual[b]->is_hit(i), expected[b]->is_hit(i)) << source << " " << to_string(kind) << " ray " << i;
+            if (rays.any_hit() || !expected[b]->is_hit(i)) continue;
+            ASSERT_EQ(actual[b]->primitive[i], expected[b]->primitive[i]) << source << " " << to_string(kind) << " ray " << i;
+            ASSERT_EQ(actual[b]->t[i], expected[b]->t[i]) << source << " " << to_string(kind) << " ray " << i;
+            ASSERT_EQ(actual[b]->u[i], expected[b]->u[i]) << source << " " << to_string(kind) << " ray " << i;
+            ASSERT_EQ(actual[b]->v[i], expected[b]->v[i]) << source << " " << to_string(kind) << " ray " << i;
+          }
+        }
+      }
+    }
+  }
+  const Scene fur = make_builtin_scene("builtin:fur:20k");
+  HashedGridOptions boxes;
+  boxes.bounding_box_lists = true;
+  const auto entries = [](const Accelerator& grid) {
+    const std::string notes = grid.build_notes();
+    return std::stod(notes.substr(notes.rfind("H, ") + 3));
+  };
+  // The fur's strands cross many cells: their boxes hold several times the cells they meet.
+  EXPECT_GT(entries(*make_hashed_grid_accelerator(fur.mesh, boxes)),
+            2.0 * entries(*make_hashed_grid_accelerator(fur.mesh, HashedGridOptions{})));
+}
+
 TEST(ArrayGrid, NestsCrowdedCellsAndItsGuardStopsRefinement) {
   const Scene scene = make_builtin_scene("builtin:sphere:50k");
   const auto nested = make_array_grid_accelerator(scene.mesh, ArrayGridOptions{});

@@ -19,6 +19,7 @@
 #include "wavetrace/accel/ray_loop.hpp"
 #include "wavetrace/kernels/checked_narrowing.hpp"
 #include "wavetrace/kernels/ray_box.hpp"
+#include "wavetrace/kernels/triangle_cell_runs.hpp"
 #include "wavetrace/kernels/triangle_intersect.hpp"
 #include "wavetrace/memory/cache_aligned_allocator.hpp"
 #include "wavetrace/kernels/nearest_hit.hpp"
@@ -36,7 +37,8 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
   friend class ProbedAccelerator<HashedGridAccelerator>;
 
  public:
-  HashedGridAccelerator(const TriangleMesh& mesh, const HashedGridOptions& options) : mesh_(mesh) {
+  HashedGridAccelerator(const TriangleMesh& mesh, const HashedGridOptions& options)
+      : mesh_(mesh), bounding_box_lists_(options.bounding_box_lists) {
     PhaseClock clock;
     choose_resolution(options);
     clock.lap(build_.phases, "bounds");
@@ -170,16 +172,28 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
   }
 
   // Calls row_run(t, y, z, x_lower, x_upper) for each row of cells (y, z) that triangle t of a
-  // slab overlaps, within the slab's layers, triangles in ascending order; slabs in parallel.
-  template <typename RowRun>
+  // slab overlaps (its bounding box does, with kBoundingBoxes or bounding-box lists), within
+  // the slab's layers, triangles in ascending order; slabs in parallel.
+  template <bool kBoundingBoxes = false, typename RowRun>
   void for_each_slab_row_run(RowRun&& row_run) const {
+    const CellGridFrame frame{glm::dvec3(bounds_.lower), glm::dvec3(cell_size_), glm::dvec3(cell_size_ * 1e-3f)};
     tbb::parallel_for(std::size_t{0}, slab_starts_.size() - 1, [&](std::size_t slab) {
       const std::uint32_t z_first = std::uint32_t(slab) * slab_layers_;
       const std::uint32_t z_last = std::min(cells_.z - 1, z_first + slab_layers_ - 1);
       for (std::size_t k = slab_starts_[slab]; k < slab_starts_[slab + 1]; ++k) {
-        const CellRange r = range_of(slab_triangles_[k]);
-        for (std::uint32_t z = std::max(r.lower.z, z_first); z <= std::min(r.upper.z, z_last); ++z) {
-          for (std::uint32_t y = r.lower.y; y <= r.upper.y; ++y) row_run(slab_triangles_[k], y, z, r.lower.x, r.upper.x);
+        const std::uint32_t t = slab_triangles_[k];
+        const CellRange r = range_of(t);
+        if (kBoundingBoxes || bounding_box_lists_) {
+          for (std::uint32_t z = std::max(r.lower.z, z_first); z <= std::min(r.upper.z, z_last); ++z) {
+            for (std::uint32_t y = r.lower.y; y <= r.upper.y; ++y) row_run(t, y, z, r.lower.x, r.upper.x);
+          }
+        } else {
+          const glm::uvec3& tri = mesh_.triangles[t];
+          for_each_triangle_cell_run(mesh_.positions[tri.x], mesh_.positions[tri.y], mesh_.positions[tri.z], frame,
+                                     r.lower, r.upper, z_first, z_last,
+                                     [&](std::uint32_t y, std::uint32_t z, std::uint32_t x_first, std::uint32_t x_last) {
+                                       row_run(t, y, z, x_first, x_last);
+                                     });
         }
       }
     });
@@ -188,8 +202,9 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
   void mark_cells() {
     const std::size_t cell_count = std::size_t(cells_.x) * cells_.y * cells_.z;
     domain_.assign((cell_count + 63) / 64, 0);
-    // A row run's bits a word at a time; atomic since a word may straddle two slabs' layers.
-    for_each_slab_row_run([&](std::uint32_t, std::uint32_t y, std::uint32_t z, std::uint32_t x_lower, std::uint32_t x_upper) {
+    // By bounding boxes whatever the lists (the header says why); a row run's bits a word at
+    // a time, atomic since a word may straddle two slabs' layers.
+    for_each_slab_row_run<true>([&](std::uint32_t, std::uint32_t y, std::uint32_t z, std::uint32_t x_lower, std::uint32_t x_upper) {
       const std::size_t first = cell_index(x_lower, y, z), last = cell_index(x_upper, y, z);
       for (std::size_t word = first / 64; word <= last / 64; ++word) {
         std::uint64_t bits = ~std::uint64_t{0};
@@ -393,6 +408,7 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
   }
 
   const TriangleMesh& mesh_;
+  bool bounding_box_lists_ = false;
   Bounds3 bounds_;
   glm::vec3 upper_{0.0f};
   glm::uvec3 cells_{1};
