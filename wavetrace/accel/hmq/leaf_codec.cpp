@@ -7,6 +7,8 @@
 #include <bit>
 #include <stdexcept>
 
+#include <immintrin.h>
+
 namespace wavetrace::hmq {
 namespace {
 
@@ -55,16 +57,31 @@ LeafStrips strips_of_leaf(const TriangleMesh& mesh, std::span<const std::uint32_
   const std::size_t count = triangles.size();
   std::array<glm::uvec3, kMaxLeafTriangles> corners;
   for (std::size_t i = 0; i < count; ++i) corners[i] = mesh.triangles[triangles[i]];
+  // The corners again by position, a lane a triangle (16 lanes, those past the leaf masked off),
+  // so that an edge is compared with every triangle at once: the edge tests were a third of
+  // the encoding, one corner at a time.
+  alignas(32) std::uint32_t corner_lanes[3][16] = {};
+  for (std::size_t i = 0; i < count; ++i) {
+    for (int k = 0; k < 3; ++k) corner_lanes[k][i] = corners[i][k];
+  }
+  static_assert(kMaxLeafTriangles <= 16);
+  const std::uint32_t leaf_lanes = (1u << count) - 1u;
   // The leaf's triangles sharing the edge (a, b): two of their corners are a or b.
   const auto across = [&](std::uint32_t a, std::uint32_t b) {
+    if (a == b) return 0u;
+    const __m256i edge_a = _mm256_set1_epi32(int(a)), edge_b = _mm256_set1_epi32(int(b));
     std::uint32_t mask = 0;
-    if (a == b) return mask;
-    for (std::size_t j = 0; j < count; ++j) {
-      int found = 0;
-      for (int k = 0; k < 3; ++k) found += corners[j][k] == a || corners[j][k] == b;
-      if (found == 2) mask |= 1u << j;
+    for (int half = 0; half < 2; ++half) {
+      __m256i found = _mm256_setzero_si256();  // corners equal to a or b (a != b: one test at most is true)
+      for (int k = 0; k < 3; ++k) {
+        const __m256i corner = _mm256_load_si256(reinterpret_cast<const __m256i*>(corner_lanes[k] + 8 * half));
+        found = _mm256_sub_epi32(found, _mm256_cmpeq_epi32(corner, edge_a));
+        found = _mm256_sub_epi32(found, _mm256_cmpeq_epi32(corner, edge_b));
+      }
+      const __m256i two = _mm256_cmpeq_epi32(found, _mm256_set1_epi32(2));
+      mask |= std::uint32_t(_mm256_movemask_ps(_mm256_castsi256_ps(two))) << (8 * half);
     }
-    return mask;
+    return mask & leaf_lanes;
   };
   std::array<std::array<std::uint32_t, 3>, kMaxLeafTriangles> edge_neighbours;  // triangle i itself left out
   for (std::size_t i = 0; i < count; ++i) {
