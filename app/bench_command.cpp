@@ -136,6 +136,7 @@ struct ReorderArguments {
   std::string size = "320x240";
   int spp = 4;
   int threads = 0;
+  int repeat = 1;
   std::string json;
   std::vector<std::string> assignments;
 };
@@ -171,7 +172,7 @@ int run_reorder(const ReorderArguments& args) {
       throw ConfigError(fmt::format("--heuristics: {}", error.what()));
     }
   }
-  const ReorderBenchReport report = run_reorder_bench(config, heuristics);
+  const ReorderBenchReport report = run_reorder_bench(config, heuristics, args.repeat);
   fmt::print("{}", to_table(report));
   if (!args.json.empty()) write_text(args.json, to_json(report).dump(2) + "\n");
   return 0;
@@ -339,6 +340,8 @@ void add_bench_command(CLI::App& app, int& exit_code) {
   add_spp_option(*reorder, reorder_args->spp);
   add_size_option(*reorder, reorder_args->size);
   add_threads_option(*reorder, reorder_args->threads);
+  reorder->add_option("--repeat", reorder_args->repeat,
+                      "rounds of every heuristic, interleaved (each heuristic's render of median time is reported)");
   reorder->add_option("--json", reorder_args->json, "write results as JSON");
   add_set_option(*reorder, reorder_args->assignments, "memory.budget=20%");
   reorder->callback([reorder_args, &exit_code] { exit_code = run_reorder(*reorder_args); });

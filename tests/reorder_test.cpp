@@ -358,6 +358,28 @@ TEST(Reordering, HitPointHeuristicCutsPageFaultsAgainstNone) {
   EXPECT_TRUE(hph.image_identical);
 }
 
+// Rounds: each heuristic rendered that many times in turn, one result each, the images
+// compared across every round; no round is an error, as the command line says.
+TEST(Reordering, BenchmarkRoundsReportOneRenderPerHeuristic) {
+  Config config;
+  for (const char* setting : {"scene.source=builtin:room:20k", "accel.type=bvh", "render.width=32", "render.height=24",
+                              "render.spp=1", "render.threads=2", "render.max_depth=3", "proxy.accel=bvh"}) {
+    config.set(setting);
+  }
+  const ReorderBenchReport report = run_reorder_bench(config, {ReorderHeuristic::none, ReorderHeuristic::hph}, 3);
+  EXPECT_EQ(report.rounds, 3);
+  ASSERT_EQ(report.results.size(), 2u);
+  EXPECT_EQ(report.results[0].heuristic, "none");
+  EXPECT_EQ(report.results[1].heuristic, "hph");
+  for (const ReorderBenchResult& result : report.results) {
+    EXPECT_TRUE(result.image_identical) << result.heuristic;
+    EXPECT_GT(result.render_seconds, 0.0);
+  }
+  EXPECT_EQ(to_json(report)["rounds"], 3);
+  EXPECT_NE(to_table(report).find("the median of 3 rounds"), std::string::npos);
+  EXPECT_THROW(run_reorder_bench(config, {ReorderHeuristic::none}, 0), ConfigError);
+}
+
 struct Rendered {
   RenderOutput output;
   std::uint64_t approx_in = 0, approx_out = 0, traced = 0;

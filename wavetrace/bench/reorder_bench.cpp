@@ -2,6 +2,8 @@
 #include "wavetrace/bench/json_fields.hpp"
 #include "wavetrace/bench/reorder_bench.hpp"
 
+#include <algorithm>
+
 #include <fmt/format.h>
 
 #include "wavetrace/bench/render_world.hpp"
@@ -19,8 +21,9 @@ const StageStats* find_stage(const PipelineRun& run, std::string_view name) {
 
 }  // namespace
 
-ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<ReorderHeuristic>& heuristics) {
+ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<ReorderHeuristic>& heuristics, int rounds) {
   if (heuristics.empty()) throw ConfigError("--heuristics names no heuristic");
+  if (rounds < 1) throw ConfigError("--repeat must be at least 1");
   const RenderPlan base = plan_render(heuristic_variant(config, heuristics.front()));
   if (base.rules.max_depth < 3) {
     throw ConfigError(fmt::format("render.max_depth = {}: the reorder benchmark path traces to depth 3 or more",
@@ -68,75 +71,92 @@ ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<Reo
   if (base.memory.cache) report.memory += (base.memory.budget ? ", cache " : "cache ") + base.memory.cache->name;
 
   std::vector<float> first_image;
-  for (ReorderHeuristic heuristic : heuristics) {
-    const RenderPlan plan = plan_render(heuristic_variant(config, heuristic));
-    const RenderOutput output = render_image(plan, world, camera);
-    report.threads = output.run.threads;
+  // Every round renders every heuristic in the given order. The first sorting render pays the
+  // first touch of the sort's buffers and of the pool's extra batches, which later renders
+  // find warm in the heap: with one round, a heuristic's place in the list shows in its time.
+  std::vector<std::vector<ReorderBenchResult>> rounds_of(heuristics.size());
+  for (int round = 0; round < rounds; ++round) {
+    for (std::size_t h = 0; h < heuristics.size(); ++h) {
+      const ReorderHeuristic heuristic = heuristics[h];
+      const RenderPlan plan = plan_render(heuristic_variant(config, heuristic));
+      const RenderOutput output = render_image(plan, world, camera);
+      report.threads = output.run.threads;
 
-    ReorderBenchResult result;
-    result.heuristic = to_string(heuristic);
-    result.render_seconds = output.seconds();
-    result.closest_mrays_per_s = output.closest_mrays_per_s;
-    result.shadow_mrays_per_s = output.any_mrays_per_s;
-    const double thread_seconds = output.seconds() * output.run.threads;
-    if (const StageStats* trace = find_stage(output.run, "trace")) {
-      result.trace_seconds = trace->seconds;
-      result.trace_mrays_per_s = trace->mrays_per_s();
-      result.rays_traced = trace->rays_in;
-      if (trace->pager) {
-        result.page_faults = trace->pager->counters.faults;
-        result.bytes_loaded = trace->pager->counters.bytes_loaded;
-        result.simulated_io_seconds = trace->pager->counters.simulated_io_seconds;
-      }
-      if (trace->cache) result.cache_misses = trace->cache->counters.misses;
-      if (trace->disk) {
-        result.disk_faults = trace->disk->counters.faults;
-        result.disk_bytes_read = trace->disk->counters.bytes_read;
-        result.disk_read_seconds = trace->disk->counters.read_seconds;
-        result.disk_wait_seconds = trace->disk->counters.wait_seconds;
-        result.disk_reads_in_flight_max = trace->disk->reads_in_flight_max;
-        result.disk_prefetched = trace->disk->prefetched;
-        result.disk_prefetch_hits = trace->disk->prefetch_hits;
-        if (trace->disk->ray_windows.windows > 0) result.disk_pages_per_1000_rays = trace->disk->pages_per_window();
-        result.disk_faults_by_part = trace->disk->faults_by_part;
-      }
-    }
-    if (const StageStats* approx = find_stage(output.run, "approx_hit")) {
-      result.approx_hit_seconds = approx->seconds;
-      result.rays_retired_by_approx_hit = approx->rays_in - approx->rays_out;
-      // The proxy's traffic counts too: it is the price of the ordering.
-      if (approx->pager && result.page_faults) {
-        *result.page_faults += approx->pager->counters.faults;
-        *result.bytes_loaded += approx->pager->counters.bytes_loaded;
-        *result.simulated_io_seconds += approx->pager->counters.simulated_io_seconds;
-      }
-      if (approx->cache && result.cache_misses) *result.cache_misses += approx->cache->counters.misses;
-    }
-    if (const StageStats* zsort = find_stage(output.run, "zsort")) {
-      result.sort_seconds = zsort->seconds;
-      result.spill = zsort->spill;
-    }
-    if (output.photons) {
-      // The photon pass is traced and reordered as the camera pass is: its stages count too
-      // (and [memory]'s counters above already hold both passes').
-      result.photon_seconds = output.photons->run.seconds + output.photons->map_seconds;
-      for (const StageStats& stage : output.photons->run.stages) {
-        if (stage.name == "trace") {
-          result.trace_seconds += stage.seconds;
-          result.rays_traced += stage.rays_in;
+      ReorderBenchResult result;
+      result.heuristic = to_string(heuristic);
+      result.render_seconds = output.seconds();
+      result.closest_mrays_per_s = output.closest_mrays_per_s;
+      result.shadow_mrays_per_s = output.any_mrays_per_s;
+      const double thread_seconds = output.seconds() * output.run.threads;
+      if (const StageStats* trace = find_stage(output.run, "trace")) {
+        result.trace_seconds = trace->seconds;
+        result.trace_mrays_per_s = trace->mrays_per_s();
+        result.rays_traced = trace->rays_in;
+        if (trace->pager) {
+          result.page_faults = trace->pager->counters.faults;
+          result.bytes_loaded = trace->pager->counters.bytes_loaded;
+          result.simulated_io_seconds = trace->pager->counters.simulated_io_seconds;
         }
-        if (stage.name == "approx_hit") {
-          result.approx_hit_seconds += stage.seconds;
-          result.rays_retired_by_approx_hit += stage.rays_in - stage.rays_out;
+        if (trace->cache) result.cache_misses = trace->cache->counters.misses;
+        if (trace->disk) {
+          result.disk_faults = trace->disk->counters.faults;
+          result.disk_bytes_read = trace->disk->counters.bytes_read;
+          result.disk_read_seconds = trace->disk->counters.read_seconds;
+          result.disk_wait_seconds = trace->disk->counters.wait_seconds;
+          result.disk_reads_in_flight_max = trace->disk->reads_in_flight_max;
+          result.disk_prefetched = trace->disk->prefetched;
+          result.disk_prefetch_hits = trace->disk->prefetch_hits;
+          if (trace->disk->ray_windows.windows > 0) result.disk_pages_per_1000_rays = trace->disk->pages_per_window();
+          result.disk_faults_by_part = trace->disk->faults_by_part;
         }
-        if (stage.name == "zsort") result.sort_seconds += stage.seconds;
       }
-      result.trace_mrays_per_s = result.trace_seconds > 0.0 ? double(result.rays_traced) / result.trace_seconds * 1e-6 : 0.0;
+      if (const StageStats* approx = find_stage(output.run, "approx_hit")) {
+        result.approx_hit_seconds = approx->seconds;
+        result.rays_retired_by_approx_hit = approx->rays_in - approx->rays_out;
+        // The proxy's traffic counts too: it is the price of the ordering.
+        if (approx->pager && result.page_faults) {
+          *result.page_faults += approx->pager->counters.faults;
+          *result.bytes_loaded += approx->pager->counters.bytes_loaded;
+          *result.simulated_io_seconds += approx->pager->counters.simulated_io_seconds;
+        }
+        if (approx->cache && result.cache_misses) *result.cache_misses += approx->cache->counters.misses;
+      }
+      if (const StageStats* zsort = find_stage(output.run, "zsort")) {
+        result.sort_seconds = zsort->seconds;
+        result.spill = zsort->spill;
+      }
+      if (output.photons) {
+        // The photon pass is traced and reordered as the camera pass is: its stages count too
+        // (and [memory]'s counters above already hold both passes').
+        result.photon_seconds = output.photons->run.seconds + output.photons->map_seconds;
+        for (const StageStats& stage : output.photons->run.stages) {
+          if (stage.name == "trace") {
+            result.trace_seconds += stage.seconds;
+            result.rays_traced += stage.rays_in;
+          }
+          if (stage.name == "approx_hit") {
+            result.approx_hit_seconds += stage.seconds;
+            result.rays_retired_by_approx_hit += stage.rays_in - stage.rays_out;
+          }
+          if (stage.name == "zsort") result.sort_seconds += stage.seconds;
+        }
+        result.trace_mrays_per_s = result.trace_seconds > 0.0 ? double(result.rays_traced) / result.trace_seconds * 1e-6 : 0.0;
+      }
+      result.overhead_share = (result.approx_hit_seconds + result.sort_seconds) / thread_seconds;
+      if (first_image.empty()) first_image = output.image;
+      result.image_identical = output.image == first_image;
+      rounds_of[h].push_back(std::move(result));
     }
-    result.overhead_share = (result.approx_hit_seconds + result.sort_seconds) / thread_seconds;
-    if (first_image.empty()) first_image = output.image;
-    result.image_identical = output.image == first_image;
-    report.results.push_back(result);
+  }
+  report.rounds = rounds;
+  for (std::vector<ReorderBenchResult>& results : rounds_of) {
+    // The render of median time, whole: its stage seconds and counters belong together.
+    std::sort(results.begin(), results.end(),
+              [](const ReorderBenchResult& a, const ReorderBenchResult& b) { return a.render_seconds < b.render_seconds; });
+    ReorderBenchResult median = results[(results.size() - 1) / 2];
+    median.image_identical =
+        std::all_of(results.begin(), results.end(), [](const ReorderBenchResult& r) { return r.image_identical; });
+    report.results.push_back(std::move(median));
   }
   return report;
 }
@@ -184,6 +204,7 @@ nlohmann::json to_json(const ReorderBenchReport& report) {
           {"curve", report.curve},
           {"image", report.image},
           {"threads", report.threads},
+          {"rounds", report.rounds},
           {"proxy", json_or_null(report.proxy)},
           {"memory", report.memory},
           {"world_bytes", report.world_bytes},
@@ -192,8 +213,9 @@ nlohmann::json to_json(const ReorderBenchReport& report) {
 }
 
 std::string to_table(const ReorderBenchReport& report) {
-  std::string table = fmt::format("{}: {} triangles; {} on {}; {} curve; {} threads; memory {}\n", report.scene,
-                                  report.triangles, report.image, report.accel, report.curve, report.threads, report.memory);
+  std::string table = fmt::format("{}: {} triangles; {} on {}; {} curve; {} threads; memory {}{}\n", report.scene,
+                                  report.triangles, report.image, report.accel, report.curve, report.threads, report.memory,
+                                  report.rounds > 1 ? fmt::format("; the median of {} rounds", report.rounds) : "");
   if (report.proxy) table += "proxy: " + *report.proxy + "\n";
   const bool disk = !report.results.empty() && report.results.front().disk_faults.has_value();
   table += fmt::format("{:<11} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>8} {:>9} {:>10} {:>9} {:>11} {:>11} {:>9} {:>10}",

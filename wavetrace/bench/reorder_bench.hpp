@@ -55,6 +55,7 @@ struct ReorderBenchReport {
   std::string curve;
   std::string image;  // WxH, spp, depth
   int threads = 0;
+  int rounds = 1;  // renders of each heuristic, interleaved; the one of median time is reported
   std::optional<std::string> proxy;  // method, triangles, quality
   std::string memory;                // pager and cache settings, or "off"
   std::uint64_t world_bytes = 0;     // the world file's size, when the scene is one
@@ -63,8 +64,10 @@ struct ReorderBenchReport {
 };
 
 // `config` holds every other setting (scene, accel, render, proxy, memory); each heuristic
-// gets reorder.heuristic and the chain it needs. Throws ConfigError for a depth under 3.
-ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<ReorderHeuristic>& heuristics);
+// gets reorder.heuristic and the chain it needs; `rounds` times over, the heuristics in
+// turn. Throws ConfigError for a depth under 3 or no round.
+ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<ReorderHeuristic>& heuristics,
+                                     int rounds = 1);
 
 nlohmann::json to_json(const ReorderBenchReport& report);
 std::string to_table(const ReorderBenchReport& report);
