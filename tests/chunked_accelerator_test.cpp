@@ -107,10 +107,15 @@ TEST(ChunkedWorld, HmqChunksShareOneGlobalGrid) {
   EXPECT_EQ(chunked->represented_mesh(scene.mesh)->positions, whole->represented_mesh(scene.mesh)->positions);
 }
 
+// Unprobed, a world of a few dozen chunks lists a ray's chunks by testing all their boxes in
+// lanes; probed, by walking the top BVH (whose nodes the probe reads): the hits must agree.
 TEST(ChunkedWorld, ProbedAnswersAsUnprobedAndReadsOnlyItsWorld) {
   const Scene scene = make_builtin_scene("builtin:room:50k");
   const auto chunked = build_world_accelerator(scene, options_for("hmq", 4096));
   ASSERT_TRUE(chunked->probed());
+  const std::size_t chunk_count = std::stoul(chunked->build_notes());
+  EXPECT_GT(chunk_count, 8u);
+  EXPECT_LE(chunk_count, 32u);  // listed in lanes
   const RaySet rays = make_ray_set(RaySetKind::diffuse, scene, *chunked, 4000);
   const auto plain = trace_ray_set(*chunked, rays);
   SimulatedPager pager(chunked->memory_spans(), 16384, MemoryBudget{}, io_preset("nvme"));

@@ -144,6 +144,7 @@ class ChunkedAccelerator final : public Accelerator, public ChunkSet {
       chunks_[c].memory = chunks_[c].accelerator->memory();
       in.file()->chunk_checked();
     }
+    lay_out_chunk_boxes();
   }
 
   void save(SectionWriter& out, const std::string& prefix) const override {
@@ -242,6 +243,7 @@ class ChunkedAccelerator final : public Accelerator, public ChunkSet {
       streamed_prefix_ = stream->prefix;
     }
     build_top();
+    lay_out_chunk_boxes();
     clock.lap(build_.phases, "top");
     build_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
@@ -386,6 +388,19 @@ class ChunkedAccelerator final : public Accelerator, public ChunkSet {
     top_ = StoredArray<BvhNode>(std::move(top));
   }
 
+  // The chunks' boxes by coordinate, padded to whole lanes with boxes no ray enters.
+  void lay_out_chunk_boxes() {
+    chunk_boxes_ = {};
+    if (chunks_.size() > kChunksInLanes) return;
+    for (std::size_t c = 0; c < kChunksInLanes; ++c) {
+      const Bounds3 box = c < chunks_.size() ? chunks_[c].bounds : Bounds3{};
+      for (int axis = 0; axis < 3; ++axis) {
+        chunk_boxes_.lower[axis][c] = box.lower[axis];
+        chunk_boxes_.upper[axis][c] = box.upper[axis];
+      }
+    }
+  }
+
   // The chunks ray i enters within [tmin, tmax], nearest first, appended to `visits`.
   template <typename Probe>
   void list_chunks(const RayBatch& rays, std::uint32_t i, std::vector<ChunkVisit>& visits, Probe& probe) const {
@@ -394,11 +409,31 @@ class ChunkedAccelerator final : public Accelerator, public ChunkSet {
     const BoxRay box_ray = make_box_ray(origin, direction);
     const float tmin = rays.tmin[i], tmax = rays.tmax[i];
     const std::size_t begin = visits.size();
-    walk_bvh(top_.data(), box_ray, tmin, tmax, probe, [&](const BvhNode& leaf) {
-      const float distance = intersect_box(box_ray, leaf.lower, leaf.upper, tmin, tmax);
-      if (distance != kInfinity) visits.push_back({distance, leaf.first});
-      return false;
-    });
+    if (!Probe::kRecords && chunks_.size() <= kChunksInLanes) {
+      // Every box at once (the slab test of intersect_box, lane by lane): for a few dozen
+      // chunks cheaper than walking the top BVH a box at a time. Ties leave in chunk order
+      // where the walk left them in its own; a ray's nearest hit does not depend on it.
+      alignas(64) float entry[kChunksInLanes];
+      for (std::size_t c = 0; c < kChunksInLanes; ++c) {
+        float near = tmin, far = tmax;
+        clip_slab((chunk_boxes_.lower[0][c] - origin.x) * box_ray.inverse_direction.x,
+                  (chunk_boxes_.upper[0][c] - origin.x) * box_ray.inverse_direction.x, near, far);
+        clip_slab((chunk_boxes_.lower[1][c] - origin.y) * box_ray.inverse_direction.y,
+                  (chunk_boxes_.upper[1][c] - origin.y) * box_ray.inverse_direction.y, near, far);
+        clip_slab((chunk_boxes_.lower[2][c] - origin.z) * box_ray.inverse_direction.z,
+                  (chunk_boxes_.upper[2][c] - origin.z) * box_ray.inverse_direction.z, near, far);
+        entry[c] = near <= far ? near : kInfinity;
+      }
+      for (std::uint32_t c = 0; c < chunks_.size(); ++c) {
+        if (entry[c] != kInfinity) visits.push_back({entry[c], c});
+      }
+    } else {
+      walk_bvh(top_.data(), box_ray, tmin, tmax, probe, [&](const BvhNode& leaf) {
+        const float distance = intersect_box(box_ray, leaf.lower, leaf.upper, tmin, tmax);
+        if (distance != kInfinity) visits.push_back({distance, leaf.first});
+        return false;
+      });
+    }
     // Rays enter few chunks: an insertion sort.
     for (std::size_t a = begin + 1; a < visits.size(); ++a) {
       const ChunkVisit visit = visits[a];
@@ -520,6 +555,12 @@ class ChunkedAccelerator final : public Accelerator, public ChunkSet {
 
   std::vector<Chunk> chunks_;
   StoredArray<BvhNode> top_;
+  // Up to this many chunks are listed by testing all their boxes in lanes (list_chunks).
+  static constexpr std::size_t kChunksInLanes = 32;
+  struct ChunkBoxLanes {
+    alignas(64) float lower[3][kChunksInLanes];
+    alignas(64) float upper[3][kChunksInLanes];
+  } chunk_boxes_{};
   const ChunkRouter* router_ = nullptr;  // data-parallel: who answers the chunks not held here
   mutable RoundScratchPool scratch_pool_;  // the routed calls' scratch
   BuildReport build_;
