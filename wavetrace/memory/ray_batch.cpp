@@ -23,7 +23,6 @@ class ColumnCarver {
 // The bytes of a list of columns of `capacity` elements, each slice 64-byte aligned.
 #define WAVETRACE_SLICE_BYTES(type, name) +align_up(sizeof(type) * capacity)
 #define WAVETRACE_CARVE(type, name) name = carve.next<type>();
-#define WAVETRACE_COPY(type, name) name[to] = source.name[from];
 
 }  // namespace
 
@@ -49,24 +48,11 @@ void RayBatch::enable_sort_key() {
   WAVETRACE_SORT_KEY_COLUMNS(WAVETRACE_CARVE)
 }
 
-void RayBatch::copy_ray(std::size_t to, const RayBatch& source, std::size_t from) {
-  WAVETRACE_RAY_COLUMNS(WAVETRACE_COPY)
-  if (source.has_approx_hit()) {
-    enable_approx_hit();
-    WAVETRACE_APPROX_HIT_COLUMNS(WAVETRACE_COPY)
-  }
-  if (source.has_sort_key()) {
-    enable_sort_key();
-    WAVETRACE_SORT_KEY_COLUMNS(WAVETRACE_COPY)
-  }
-}
 
 HitBatch::HitBatch(std::size_t capacity)
     : capacity_(capacity), storage_(0 WAVETRACE_HIT_COLUMNS(WAVETRACE_SLICE_BYTES)) {
   ColumnCarver carve(storage_.data(), capacity);
   WAVETRACE_HIT_COLUMNS(WAVETRACE_CARVE)
 }
-
-void HitBatch::copy_hit(std::size_t to, const HitBatch& source, std::size_t from) { WAVETRACE_HIT_COLUMNS(WAVETRACE_COPY) }
 
 }  // namespace wavetrace

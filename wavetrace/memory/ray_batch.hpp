@@ -46,6 +46,7 @@ inline constexpr std::uint8_t continues = 1u << 2;  // shade kept the path going
   X(float, normal_z) X(std::uint32_t, material)
 
 #define WAVETRACE_COLUMN_POINTER(type, name) type* name = nullptr;
+#define WAVETRACE_COPY_COLUMN(type, name) name[to] = source.name[from];
 #define WAVETRACE_COLUMN_BYTES(type, name) +sizeof(type)
 
 // A half-open range of ray indices inside one batch: the unit accelerators answer.
@@ -108,7 +109,18 @@ class RayBatch {
   }
 
   // Copies every present column of ray `from` of `source` into slot `to` of this batch.
-  void copy_ray(std::size_t to, const RayBatch& source, std::size_t from);
+  // Inline: zsort's gather and the chunked walk's rounds call it once a ray.
+  void copy_ray(std::size_t to, const RayBatch& source, std::size_t from) {
+    WAVETRACE_RAY_COLUMNS(WAVETRACE_COPY_COLUMN)
+    if (source.has_approx_hit()) {
+      if (!has_approx_hit()) enable_approx_hit();
+      WAVETRACE_APPROX_HIT_COLUMNS(WAVETRACE_COPY_COLUMN)
+    }
+    if (source.has_sort_key()) {
+      if (!has_sort_key()) enable_sort_key();
+      WAVETRACE_SORT_KEY_COLUMNS(WAVETRACE_COPY_COLUMN)
+    }
+  }
 
   RayRange all() const { return {0, static_cast<std::uint32_t>(count)}; }
 
@@ -158,8 +170,8 @@ class HitBatch {
   }
   glm::vec3 point(std::size_t ray) const { return {point_x[ray], point_y[ray], point_z[ray]}; }
   glm::vec3 normal(std::size_t ray) const { return {normal_x[ray], normal_y[ray], normal_z[ray]}; }
-  // Copies every column of hit `from` of `source` into slot `to`.
-  void copy_hit(std::size_t to, const HitBatch& source, std::size_t from);
+  // Copies every column of hit `from` of `source` into slot `to` (inline, as copy_ray).
+  void copy_hit(std::size_t to, const HitBatch& source, std::size_t from) { WAVETRACE_HIT_COLUMNS(WAVETRACE_COPY_COLUMN) }
 
  private:
   std::size_t capacity_;
