@@ -107,29 +107,32 @@ TEST(ChunkedWorld, HmqChunksShareOneGlobalGrid) {
   EXPECT_EQ(chunked->represented_mesh(scene.mesh)->positions, whole->represented_mesh(scene.mesh)->positions);
 }
 
-// Unprobed, a world of a few dozen chunks lists a ray's chunks by testing all their boxes in
-// lanes; probed, by walking the top BVH (whose nodes the probe reads): the hits must agree.
+// Unprobed, a world of up to a thousand chunks lists a ray's chunks by testing their boxes in
+// lanes (more than 16 chunks: each block of 16's box first); probed, by walking the top BVH
+// (whose nodes the probe reads): the hits must agree.
 TEST(ChunkedWorld, ProbedAnswersAsUnprobedAndReadsOnlyItsWorld) {
   const Scene scene = make_builtin_scene("builtin:room:50k");
-  const auto chunked = build_world_accelerator(scene, options_for("hmq", 4096));
-  ASSERT_TRUE(chunked->probed());
-  const std::size_t chunk_count = std::stoul(chunked->build_notes());
-  EXPECT_GT(chunk_count, 8u);
-  EXPECT_LE(chunk_count, 32u);  // listed in lanes
-  const RaySet rays = make_ray_set(RaySetKind::diffuse, scene, *chunked, 4000);
-  const auto plain = trace_ray_set(*chunked, rays);
-  SimulatedPager pager(chunked->memory_spans(), 16384, MemoryBudget{}, io_preset("nvme"));
-  TracingArena arena(1);
-  std::vector<std::unique_ptr<HitBatch>> probed;
-  arena.execute([&] { probed = trace_ray_set_probed(*chunked, rays, MemoryObservers{&pager, nullptr}); });
-  for (std::size_t b = 0; b < rays.batches.size(); ++b) {
-    for (std::size_t i = 0; i < rays.batches[b]->count; ++i) {
-      ASSERT_EQ(plain[b]->primitive[i], probed[b]->primitive[i]);
-      ASSERT_EQ(plain[b]->t[i], probed[b]->t[i]);
+  for (const std::size_t chunk_triangles : {4096, 1024}) {
+    const auto chunked = build_world_accelerator(scene, options_for("hmq", chunk_triangles));
+    ASSERT_TRUE(chunked->probed());
+    const std::size_t chunk_count = std::stoul(chunked->build_notes());
+    EXPECT_GT(chunk_count, chunk_triangles == 1024 ? 32u : 8u);  // one block of lanes, and several
+    EXPECT_LE(chunk_count, 1024u);
+    const RaySet rays = make_ray_set(RaySetKind::diffuse, scene, *chunked, 4000);
+    const auto plain = trace_ray_set(*chunked, rays);
+    SimulatedPager pager(chunked->memory_spans(), 16384, MemoryBudget{}, io_preset("nvme"));
+    TracingArena arena(1);
+    std::vector<std::unique_ptr<HitBatch>> probed;
+    arena.execute([&] { probed = trace_ray_set_probed(*chunked, rays, MemoryObservers{&pager, nullptr}); });
+    for (std::size_t b = 0; b < rays.batches.size(); ++b) {
+      for (std::size_t i = 0; i < rays.batches[b]->count; ++i) {
+        ASSERT_EQ(plain[b]->primitive[i], probed[b]->primitive[i]) << chunk_triangles;
+        ASSERT_EQ(plain[b]->t[i], probed[b]->t[i]) << chunk_triangles;
+      }
     }
+    EXPECT_GT(pager.counters(0).accesses, 4000u);
+    EXPECT_EQ(pager.outside_accesses(), 0u);
   }
-  EXPECT_GT(pager.counters(0).accesses, 4000u);
-  EXPECT_EQ(pager.outside_accesses(), 0u);
 }
 
 // A scene kept whole (as it is when a proxy is wanted) is cut where the same scene streamed

@@ -388,16 +388,58 @@ class ChunkedAccelerator final : public Accelerator, public ChunkSet {
     top_ = StoredArray<BvhNode>(std::move(top));
   }
 
-  // The chunks' boxes by coordinate, padded to whole lanes with boxes no ray enters.
-  void lay_out_chunk_boxes() {
-    chunk_boxes_ = {};
-    if (chunks_.size() > kChunksInLanes) return;
-    for (std::size_t c = 0; c < kChunksInLanes; ++c) {
-      const Bounds3 box = c < chunks_.size() ? chunks_[c].bounds : Bounds3{};
+  // Up to this many chunks are listed by testing their boxes in lanes (list_chunks), blocks
+  // of kLanes chunks at a time, each block's box first.
+  static constexpr std::size_t kLanes = 16;
+  static constexpr std::size_t kMostChunksInLanes = kLanes * kLanes * 4;
+  struct BoxLanes {
+    LargeArray<float> lower[3], upper[3];
+    std::size_t size() const { return lower[0].size(); }
+    bool empty() const { return lower[0].empty(); }
+    void resize(std::size_t boxes) {  // every box empty
       for (int axis = 0; axis < 3; ++axis) {
-        chunk_boxes_.lower[axis][c] = box.lower[axis];
-        chunk_boxes_.upper[axis][c] = box.upper[axis];
+        lower[axis].assign(boxes, kInfinity);
+        upper[axis].assign(boxes, -kInfinity);
       }
+    }
+    Bounds3 get(std::size_t i) const {
+      return {glm::vec3(lower[0][i], lower[1][i], lower[2][i]), glm::vec3(upper[0][i], upper[1][i], upper[2][i])};
+    }
+    void set(std::size_t i, const Bounds3& box) {
+      for (int axis = 0; axis < 3; ++axis) lower[axis][i] = box.lower[axis], upper[axis][i] = box.upper[axis];
+    }
+  };
+  // The chunks' boxes by coordinate in blocks of kLanes, and each block's box, padded with
+  // empty boxes (whose lanes are never read back).
+  void lay_out_chunk_boxes() {
+    chunk_lanes_ = {};
+    block_lanes_ = {};
+    if (chunks_.size() > kMostChunksInLanes) return;
+    const std::size_t blocks = (chunks_.size() + kLanes - 1) / kLanes;
+    chunk_lanes_.resize(blocks * kLanes);
+    block_lanes_.resize((blocks + kLanes - 1) / kLanes * kLanes);
+    for (std::size_t c = 0; c < chunks_.size(); ++c) {
+      chunk_lanes_.set(c, chunks_[c].bounds);
+      Bounds3 block = block_lanes_.get(c / kLanes);
+      block.extend(chunks_[c].bounds);
+      block_lanes_.set(c / kLanes, block);
+    }
+  }
+
+  // Entry distances (or +inf) of the ray into boxes [first, first + kLanes) of `boxes`: the
+  // slab test of intersect_box, lane by lane, so the same distance the walk finds.
+  static void enter_lanes(const BoxLanes& boxes, std::size_t first, const glm::vec3& origin, const BoxRay& ray,
+                          float tmin, float tmax, float* entry) {
+    for (std::size_t k = 0; k < kLanes; ++k) {
+      const std::size_t c = first + k;
+      float near = tmin, far = tmax;
+      clip_slab((boxes.lower[0][c] - origin.x) * ray.inverse_direction.x,
+                (boxes.upper[0][c] - origin.x) * ray.inverse_direction.x, near, far);
+      clip_slab((boxes.lower[1][c] - origin.y) * ray.inverse_direction.y,
+                (boxes.upper[1][c] - origin.y) * ray.inverse_direction.y, near, far);
+      clip_slab((boxes.lower[2][c] - origin.z) * ray.inverse_direction.z,
+                (boxes.upper[2][c] - origin.z) * ray.inverse_direction.z, near, far);
+      entry[k] = near <= far ? near : kInfinity;
     }
   }
 
@@ -409,23 +451,22 @@ class ChunkedAccelerator final : public Accelerator, public ChunkSet {
     const BoxRay box_ray = make_box_ray(origin, direction);
     const float tmin = rays.tmin[i], tmax = rays.tmax[i];
     const std::size_t begin = visits.size();
-    if (!Probe::kRecords && chunks_.size() <= kChunksInLanes) {
-      // Every box at once (the slab test of intersect_box, lane by lane): for a few dozen
-      // chunks cheaper than walking the top BVH a box at a time. Ties leave in chunk order
+    if (!Probe::kRecords && !chunk_lanes_.empty()) {
+      // Boxes in lanes: for up to a thousand chunks cheaper than walking the top BVH a box at
+      // a time. A ray enters a chunk's box only if it enters its block's (the block's box
+      // holds it, and the slab arithmetic is monotonic in the box). Ties leave in chunk order
       // where the walk left them in its own; a ray's nearest hit does not depend on it.
-      alignas(64) float entry[kChunksInLanes];
-      for (std::size_t c = 0; c < kChunksInLanes; ++c) {
-        float near = tmin, far = tmax;
-        clip_slab((chunk_boxes_.lower[0][c] - origin.x) * box_ray.inverse_direction.x,
-                  (chunk_boxes_.upper[0][c] - origin.x) * box_ray.inverse_direction.x, near, far);
-        clip_slab((chunk_boxes_.lower[1][c] - origin.y) * box_ray.inverse_direction.y,
-                  (chunk_boxes_.upper[1][c] - origin.y) * box_ray.inverse_direction.y, near, far);
-        clip_slab((chunk_boxes_.lower[2][c] - origin.z) * box_ray.inverse_direction.z,
-                  (chunk_boxes_.upper[2][c] - origin.z) * box_ray.inverse_direction.z, near, far);
-        entry[c] = near <= far ? near : kInfinity;
-      }
-      for (std::uint32_t c = 0; c < chunks_.size(); ++c) {
-        if (entry[c] != kInfinity) visits.push_back({entry[c], c});
+      alignas(64) float block_entry[kLanes], entry[kLanes];
+      const std::size_t blocks = chunk_lanes_.size() / kLanes;
+      for (std::size_t first_block = 0; first_block < blocks; first_block += kLanes) {
+        if (blocks > 1) enter_lanes(block_lanes_, first_block, origin, box_ray, tmin, tmax, block_entry);
+        for (std::size_t b = first_block; b < std::min(blocks, first_block + kLanes); ++b) {
+          if (blocks > 1 && block_entry[b - first_block] == kInfinity) continue;
+          enter_lanes(chunk_lanes_, b * kLanes, origin, box_ray, tmin, tmax, entry);
+          for (std::size_t k = 0; k < kLanes && b * kLanes + k < chunks_.size(); ++k) {
+            if (entry[k] != kInfinity) visits.push_back({entry[k], std::uint32_t(b * kLanes + k)});
+          }
+        }
       }
     } else {
       walk_bvh(top_.data(), box_ray, tmin, tmax, probe, [&](const BvhNode& leaf) {
@@ -555,12 +596,7 @@ class ChunkedAccelerator final : public Accelerator, public ChunkSet {
 
   std::vector<Chunk> chunks_;
   StoredArray<BvhNode> top_;
-  // Up to this many chunks are listed by testing all their boxes in lanes (list_chunks).
-  static constexpr std::size_t kChunksInLanes = 32;
-  struct ChunkBoxLanes {
-    alignas(64) float lower[3][kChunksInLanes];
-    alignas(64) float upper[3][kChunksInLanes];
-  } chunk_boxes_{};
+  BoxLanes chunk_lanes_, block_lanes_;  // list_chunks' boxes in lanes: empty past kMostChunksInLanes
   const ChunkRouter* router_ = nullptr;  // data-parallel: who answers the chunks not held here
   mutable RoundScratchPool scratch_pool_;  // the routed calls' scratch
   BuildReport build_;
