@@ -79,6 +79,33 @@ TEST(RayBox, SoaVersionMatchesScalar) {
   }
 }
 
+TEST(RayBox, ManyBoxesInLanesMatchScalar) {
+  constexpr std::size_t n = 37;
+  float lower[3][n], upper[3][n], entry[n];
+  for (std::size_t k = 0; k < n; ++k) {
+    const UnitPair a = unit_pair(random_bits(std::uint32_t(k), 1, 0, RandomPurpose::benchmark));
+    const UnitPair b = unit_pair(random_bits(std::uint32_t(k), 1, 1, RandomPurpose::benchmark));
+    const glm::vec3 low(2 * a.first - 1, 2 * a.second - 1, k % 3 == 0 ? 0.5f : a.first);
+    const glm::vec3 high = low + glm::vec3(b.first, k % 4 == 0 ? 0.0f : b.second, 0.5f);  // some flat
+    for (int axis = 0; axis < 3; ++axis) lower[axis][k] = low[axis], upper[axis][k] = high[axis];
+  }
+  const float* const lowers[3] = {lower[0], lower[1], lower[2]};
+  const float* const uppers[3] = {upper[0], upper[1], upper[2]};
+  for (const glm::vec3 direction : {glm::vec3(0.1f, 0.2f, 1.0f), glm::vec3(0.0f, -0.3f, 1.0f), glm::vec3(-1, 0, 0)}) {
+    const BoxRay ray = make_box_ray(glm::vec3(0.1f, -0.2f, -2.0f), direction);
+    for (const float tmax : {kInf, 2.5f}) {
+      intersect_boxes_soa(ray, lowers, uppers, n, 0.0f, tmax, entry);
+      std::size_t entered = 0;
+      for (std::size_t k = 0; k < n; ++k) {
+        const glm::vec3 low(lower[0][k], lower[1][k], lower[2][k]), high(upper[0][k], upper[1][k], upper[2][k]);
+        EXPECT_EQ(entry[k], intersect_box(ray, low, high, 0.0f, tmax)) << k;
+        entered += entry[k] != kInf;
+      }
+      if (direction.z > 0.0f && tmax == kInf) EXPECT_GT(entered, 0u);
+    }
+  }
+}
+
 TEST(Watertight, SharedEdgeAndVertexAreNeverMissed) {
   // A fan of triangles around (0.3, 0.3, 0) covering a hexagon; rays exactly through the
   // centre (a shared vertex) and exactly through points of each shared edge.

@@ -75,4 +75,21 @@ inline void intersect_box_soa(const float* origin_x, const float* origin_y, cons
   }
 }
 
+// One ray against `count` boxes in SoA columns (lower[axis][k], upper[axis][k]): the same test
+// as intersect_box, box by box, entry distances (or +inf) to `entry`. A plain loop the
+// compiler vectorizes: a chunked world lists a ray's chunks with it.
+inline void intersect_boxes_soa(const BoxRay& ray, const float* const lower[3], const float* const upper[3],
+                                std::size_t count, float tmin, float tmax, float* entry) {
+  for (std::size_t k = 0; k < count; ++k) {
+    float near = tmin, far = tmax;
+    clip_slab((lower[0][k] - ray.origin.x) * ray.inverse_direction.x,
+              (upper[0][k] - ray.origin.x) * ray.inverse_direction.x, near, far);
+    clip_slab((lower[1][k] - ray.origin.y) * ray.inverse_direction.y,
+              (upper[1][k] - ray.origin.y) * ray.inverse_direction.y, near, far);
+    clip_slab((lower[2][k] - ray.origin.z) * ray.inverse_direction.z,
+              (upper[2][k] - ray.origin.z) * ray.inverse_direction.z, near, far);
+    entry[k] = near <= far ? near : std::numeric_limits<float>::infinity();
+  }
+}
+
 }  // namespace wavetrace

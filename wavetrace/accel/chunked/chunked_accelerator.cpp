@@ -426,21 +426,14 @@ class ChunkedAccelerator final : public Accelerator, public ChunkSet {
     }
   }
 
-  // Entry distances (or +inf) of the ray into boxes [first, first + kLanes) of `boxes`: the
-  // slab test of intersect_box, lane by lane, so the same distance the walk finds.
-  static void enter_lanes(const BoxLanes& boxes, std::size_t first, const glm::vec3& origin, const BoxRay& ray,
-                          float tmin, float tmax, float* entry) {
-    for (std::size_t k = 0; k < kLanes; ++k) {
-      const std::size_t c = first + k;
-      float near = tmin, far = tmax;
-      clip_slab((boxes.lower[0][c] - origin.x) * ray.inverse_direction.x,
-                (boxes.upper[0][c] - origin.x) * ray.inverse_direction.x, near, far);
-      clip_slab((boxes.lower[1][c] - origin.y) * ray.inverse_direction.y,
-                (boxes.upper[1][c] - origin.y) * ray.inverse_direction.y, near, far);
-      clip_slab((boxes.lower[2][c] - origin.z) * ray.inverse_direction.z,
-                (boxes.upper[2][c] - origin.z) * ray.inverse_direction.z, near, far);
-      entry[k] = near <= far ? near : kInfinity;
-    }
+  // Entry distances (or +inf) of the ray into boxes [first, first + kLanes) of `boxes`.
+  static void enter_lanes(const BoxLanes& boxes, std::size_t first, const BoxRay& ray, float tmin, float tmax,
+                          float* entry) {
+    const float* const lower[3] = {boxes.lower[0].data() + first, boxes.lower[1].data() + first,
+                                   boxes.lower[2].data() + first};
+    const float* const upper[3] = {boxes.upper[0].data() + first, boxes.upper[1].data() + first,
+                                   boxes.upper[2].data() + first};
+    intersect_boxes_soa(ray, lower, upper, kLanes, tmin, tmax, entry);
   }
 
   // The chunks ray i enters within [tmin, tmax], nearest first, appended to `visits`.
@@ -459,10 +452,10 @@ class ChunkedAccelerator final : public Accelerator, public ChunkSet {
       alignas(64) float block_entry[kLanes], entry[kLanes];
       const std::size_t blocks = chunk_lanes_.size() / kLanes;
       for (std::size_t first_block = 0; first_block < blocks; first_block += kLanes) {
-        if (blocks > 1) enter_lanes(block_lanes_, first_block, origin, box_ray, tmin, tmax, block_entry);
+        if (blocks > 1) enter_lanes(block_lanes_, first_block, box_ray, tmin, tmax, block_entry);
         for (std::size_t b = first_block; b < std::min(blocks, first_block + kLanes); ++b) {
           if (blocks > 1 && block_entry[b - first_block] == kInfinity) continue;
-          enter_lanes(chunk_lanes_, b * kLanes, origin, box_ray, tmin, tmax, entry);
+          enter_lanes(chunk_lanes_, b * kLanes, box_ray, tmin, tmax, entry);
           for (std::size_t k = 0; k < kLanes && b * kLanes + k < chunks_.size(); ++k) {
             if (entry[k] != kInfinity) visits.push_back({entry[k], std::uint32_t(b * kLanes + k)});
           }
