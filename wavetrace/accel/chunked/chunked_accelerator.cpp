@@ -589,7 +589,10 @@ class ChunkedAccelerator final : public Accelerator, public ChunkSet {
 
   std::vector<Chunk> chunks_;
   StoredArray<BvhNode> top_;
-  BoxLanes chunk_lanes_, block_lanes_;  // list_chunks' boxes in lanes: empty past kMostChunksInLanes
+  // list_chunks' boxes in lanes, empty past kMostChunksInLanes: made at build and load, never
+  // saved, and left out of memory() and memory_spans() (24 KB at most; the probed walks whose
+  // reads the pager counts walk top_).
+  BoxLanes chunk_lanes_, block_lanes_;
   const ChunkRouter* router_ = nullptr;  // data-parallel: who answers the chunks not held here
   mutable RoundScratchPool scratch_pool_;  // the routed calls' scratch
   BuildReport build_;
