@@ -11,6 +11,7 @@
 
 #include "wavetrace/scene/builtin_scenes.hpp"
 #include "wavetrace/setup/accel_choice.hpp"
+#include "wavetrace/accel/grid/hashed_grid.hpp"
 #include "wavetrace/setup/render_setup.hpp"
 #include "test_support.hpp"
 
@@ -63,8 +64,9 @@ TEST(AccelChoice, ABudgetThatExcludesUncompressedStructuresGetsACompactOne) {
   EXPECT_EQ(lossy.spec, "hmq:width=8:epsilon=0.01");
   EXPECT_FALSE(candidate(lossy, "embree").fits);
   EXPECT_FALSE(candidate(lossy, "bvh").fits);
-  // Exact only: HMQ is out, the strips are the compact exact method.
-  const AccelChoice exact = choose(sphere, world_budget(8), 0.0);
+  // Exact only: HMQ is out, the strips are the compact exact method (at 8 MB mlgrid, listing
+  // each triangle in the cells it overlaps, squeezes in too: about 39.8 MB of 40).
+  const AccelChoice exact = choose(sphere, world_budget(6), 0.0);
   EXPECT_EQ(exact.spec, "raystrips:width=8");
   EXPECT_FALSE(candidate(exact, "hmq").meets_error);
   EXPECT_THROW(choose(sphere, world_budget(1), 0.01), ConfigError);
@@ -91,6 +93,22 @@ TEST(AccelChoice, ASoupNeverGetsRayStrips) {
       EXPECT_NE(on_sphere.options.type, "embree") << budget << ": " << error.what();
     }
   }
+}
+
+// The list entries auto counts on its sample are the grid's own, for either kind of list (a
+// scene this small is sampled whole).
+TEST(AccelChoice, TheGridEntriesItCountsAreTheBuiltGridsOwn) {
+  const Scene fur = make_builtin_scene("builtin:fur:20k");
+  const SceneTraits traits = measure_scene_traits(MeshTriangleSource(fur.mesh), kSmallChunk);
+  const auto entries = [&](bool boxes) {
+    HashedGridOptions options;
+    options.bounding_box_lists = boxes;
+    const std::string notes = make_hashed_grid_accelerator(fur.mesh, options)->build_notes();
+    return std::stod(notes.substr(notes.rfind("H, ") + 3));
+  };
+  EXPECT_NEAR(traits.grid_entries_per_triangle, entries(false), 0.02 * entries(false));
+  EXPECT_NEAR(traits.grid_box_entries_per_triangle, entries(true), 0.02 * entries(true));
+  EXPECT_GT(traits.grid_box_entries_per_triangle, 2.0 * traits.grid_entries_per_triangle);  // strands
 }
 
 TEST(AccelChoice, AStadiumNeverGetsAHashedGrid) {

@@ -22,6 +22,7 @@
 
 #include "wavetrace/accel/chunked/chunked_accelerator.hpp"
 #include "wavetrace/accel/grid/hashed_grid.hpp"
+#include "wavetrace/kernels/triangle_cell_runs.hpp"
 #include "wavetrace/accel/hmq/global_grid.hpp"
 #include "wavetrace/kernels/triangle_distance.hpp"
 #include "wavetrace/memory/simulated_pager.hpp"
@@ -69,10 +70,11 @@ std::string gigabytes(double bytes) {
   return bytes < 1e9 ? fmt::format("{:.1f} MB", bytes * 1e-6) : fmt::format("{:.2f} GB", bytes * 1e-9);
 }
 
-// The hashed grid's cells and lists, its mesh apart: a triangle index per cell its box
-// overlaps and the hash's slots. Measured (mlgrid, bytes a triangle against entries a
-// triangle): sphere:1M 25.7 at 4.5, bunny00 subdivided twice 22.6 at 3.8, room:1M 47.6 at
-// 9.4, room:8M 117.6 at 27.4 (its walls span many cells); about 8 + 4 x entries, with a margin.
+// The hashed grid's cells and lists, its mesh apart: a triangle index per cell it overlaps
+// (its box overlaps, with the paper's lists) and the hash's slots. Measured (mlgrid, bytes a
+// triangle against entries a triangle), boxes: sphere:1M 25.7 at 4.5, bunny00 subdivided twice
+// 22.6 at 3.8, room:1M 47.6 at 9.4, room:8M 117.6 at 27.4 (its strands' boxes span many
+// cells); the cells a triangle overlaps: room:8M 30.3 at 5.6. About 8 + 4 x entries, with a margin.
 constexpr double kGridBytesPerTriangle = 10.0;
 constexpr double kGridBytesPerEntry = 4.4;
 
@@ -154,7 +156,10 @@ SceneTraits measure_scene_traits(const TriangleSource& source, std::size_t chunk
 
   std::vector<std::uint64_t> cells;
   cells.reserve(traits.triangles / stride + 1);
-  std::atomic<std::uint64_t> cells_spanned{0};  // by the sampled triangles' boxes
+  // The cells the sampled triangles overlap, and those their boxes do (grown by the slack the
+  // grid's build grows them by).
+  std::atomic<std::uint64_t> cells_spanned{0}, box_cells_spanned{0};
+  const CellGridFrame frame{glm::dvec3(traits.bounds.lower), cell_size, cell_size * 1e-3};
   // Plan 0 in chunks of chunk_triangles, then each smaller chunking asked for (an empty plan:
   // never chunked at that size).
   std::vector<std::size_t> plan_sizes = {chunk_triangles};
@@ -189,22 +194,31 @@ SceneTraits measure_scene_traits(const TriangleSource& source, std::size_t chunk
       return static_cast<std::uint64_t>(std::clamp(index, 0.0, double(grid.cells[axis] - 1)));
     };
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, samples), [&](const tbb::blocked_range<std::size_t>& range) {
-      std::uint64_t overlapped = 0;
+      std::uint64_t overlapped = 0, box_overlapped = 0;
       for (std::size_t s = range.begin(); s != range.end(); ++s) {
         const glm::uvec3 t = chunk.triangles[first_sample + s * stride];
         const glm::dvec3 a(chunk.positions[t.x]), b(chunk.positions[t.y]), c(chunk.positions[t.z]);
         const glm::dvec3 centroid = (a + b + c) / 3.0;
         const glm::dvec3 lower = glm::min(a, glm::min(b, c)), upper = glm::max(a, glm::max(b, c));
         glm::u64vec3 cell;
+        glm::uvec3 box_lower, box_upper;
         std::uint64_t spanned = 1;
         for (int axis = 0; axis < 3; ++axis) {
           cell[axis] = cell_index(centroid[axis], axis);
-          spanned *= cell_index(upper[axis], axis) - cell_index(lower[axis], axis) + 1;
+          box_lower[axis] = std::uint32_t(cell_index(lower[axis] - frame.slack[axis], axis));
+          box_upper[axis] = std::uint32_t(cell_index(upper[axis] + frame.slack[axis], axis));
+          spanned *= box_upper[axis] - box_lower[axis] + 1;
         }
         cells[filled + s] = (cell.z * grid.cells.y + cell.y) * grid.cells.x + cell.x;
-        overlapped += spanned;
+        box_overlapped += spanned;
+        for_each_triangle_cell_run(chunk.positions[t.x], chunk.positions[t.y], chunk.positions[t.z], frame, box_lower,
+                                   box_upper, 0, grid.cells.z - 1,
+                                   [&](std::uint32_t, std::uint32_t, std::uint32_t x_first, std::uint32_t x_last) {
+                                     overlapped += x_last - x_first + 1;
+                                   });
       }
       cells_spanned.fetch_add(overlapped, std::memory_order_relaxed);
+      box_cells_spanned.fetch_add(box_overlapped, std::memory_order_relaxed);
     });
     if (any_chunks) {
       for (std::size_t i = (centroid_stride - first % centroid_stride) % centroid_stride; i < count; i += centroid_stride) {
@@ -251,6 +265,7 @@ SceneTraits measure_scene_traits(const TriangleSource& source, std::size_t chunk
   traits.triangles_per_vertex = traits.vertices ? 3.0 * double(traits.triangles) / double(traits.vertices) : 0.0;
   traits.mesh_bytes_per_triangle = (12.0 * double(traits.vertices) + 16.0 * double(traits.triangles)) / double(traits.triangles);
   traits.grid_entries_per_triangle = cells.empty() ? 0.0 : double(cells_spanned.load()) / double(cells.size());
+  traits.grid_box_entries_per_triangle = cells.empty() ? 0.0 : double(box_cells_spanned.load()) / double(cells.size());
 
   // Sum of n^2 over sum of n per occupied cell; with a sample of share f, n^2 - (1 - f) n
   // is f^2 times an unbiased estimate of the full cell's N^2, and n is f times N.
@@ -341,9 +356,10 @@ AccelChoice choose_accelerator(const SceneTraits& traits, std::size_t budget_byt
       double mesh = type->holds_own_geometry && streamed_source ? 0.0 : traits.mesh_bytes_per_triangle;
       // bvh's chunks keep copies of their meshes, beside a whole mesh that was not streamed.
       if (candidate.chunked && !type->holds_own_geometry && !streamed_source) mesh *= 2.0;
-      double structure = facts.structure_from_grid_entries
-                             ? kGridBytesPerTriangle + kGridBytesPerEntry * traits.grid_entries_per_triangle
-                             : type->bytes_per_triangle(candidate.options);
+      const double grid_entries = candidate.options.mlgrid.bounding_box_lists ? traits.grid_box_entries_per_triangle
+                                                                              : traits.grid_entries_per_triangle;
+      double structure = facts.structure_from_grid_entries ? kGridBytesPerTriangle + kGridBytesPerEntry * grid_entries
+                                                           : type->bytes_per_triangle(candidate.options);
       double build_temporaries = type->build_bytes_per_triangle;
       if (facts.grows_in_sparse_chunks && candidate.chunked) {
         const double sparse = std::max(1.0, kConnectedTrianglesPerVertex / std::max(traits.triangles_per_vertex, 1.0));
@@ -476,6 +492,7 @@ nlohmann::json to_json(const AccelChoice& choice) {
             {"triangles_per_vertex", t.triangles_per_vertex},
             {"triangles_per_grid_cell", t.triangles_per_grid_cell},
             {"grid_entries_per_triangle", t.grid_entries_per_triangle},
+            {"grid_box_entries_per_triangle", t.grid_box_entries_per_triangle},
             {"mesh_bytes_per_triangle", t.mesh_bytes_per_triangle},
             {"chunks", t.chunks},
             {"chunk_overlap", t.chunk_overlap},

@@ -45,9 +45,11 @@ struct SceneTraits {
   // kTraitSampleLimit). A few on an even surface; the whole small object on a stadium,
   // where a ray entering that cell tests all of them (the grids' failure case).
   double triangles_per_grid_cell = 0.0;
-  // On the same cells: how many an average triangle's box overlaps (the hashed grid's list
-  // entries a triangle, which its bytes follow).
+  // On the same cells: how many an average triangle overlaps (the hashed grid's list entries a
+  // triangle, which its bytes follow), and how many its box does (the paper's lists,
+  // accel.grid.bounding_box_lists).
   double grid_entries_per_triangle = 0.0;
+  double grid_box_entries_per_triangle = 0.0;
   // The mesh read whole: 12 bytes a vertex, 12 of indices and 4 of material a triangle.
   double mesh_bytes_per_triangle = 0.0;
   // The nearest distance from the camera to a triangle that may lie in view (not culled by
