@@ -19,6 +19,73 @@ const StageStats* find_stage(const PipelineRun& run, std::string_view name) {
   return nullptr;
 }
 
+// One render's figures: its stages' seconds and rays (the photon pass's too), and what
+// [memory] counted of trace and approx_hit.
+ReorderBenchResult result_of(ReorderHeuristic heuristic, const RenderOutput& output) {
+  ReorderBenchResult result;
+  result.heuristic = to_string(heuristic);
+  result.render_seconds = output.seconds();
+  result.closest_mrays_per_s = output.closest_mrays_per_s;
+  result.shadow_mrays_per_s = output.any_mrays_per_s;
+  const double thread_seconds = output.seconds() * output.run.threads;
+  if (const StageStats* trace = find_stage(output.run, "trace")) {
+    result.trace_seconds = trace->seconds;
+    result.trace_mrays_per_s = trace->mrays_per_s();
+    result.rays_traced = trace->rays_in;
+    if (trace->pager) {
+      result.page_faults = trace->pager->counters.faults;
+      result.bytes_loaded = trace->pager->counters.bytes_loaded;
+      result.simulated_io_seconds = trace->pager->counters.simulated_io_seconds;
+    }
+    if (trace->cache) result.cache_misses = trace->cache->counters.misses;
+    if (trace->disk) {
+      result.disk_faults = trace->disk->counters.faults;
+      result.disk_bytes_read = trace->disk->counters.bytes_read;
+      result.disk_read_seconds = trace->disk->counters.read_seconds;
+      result.disk_wait_seconds = trace->disk->counters.wait_seconds;
+      result.disk_reads_in_flight_max = trace->disk->reads_in_flight_max;
+      result.disk_prefetched = trace->disk->prefetched;
+      result.disk_prefetch_hits = trace->disk->prefetch_hits;
+      if (trace->disk->ray_windows.windows > 0) result.disk_pages_per_1000_rays = trace->disk->pages_per_window();
+      result.disk_faults_by_part = trace->disk->faults_by_part;
+    }
+  }
+  if (const StageStats* approx = find_stage(output.run, "approx_hit")) {
+    result.approx_hit_seconds = approx->seconds;
+    result.rays_retired_by_approx_hit = approx->rays_in - approx->rays_out;
+    // The proxy's traffic counts too: it is the price of the ordering.
+    if (approx->pager && result.page_faults) {
+      *result.page_faults += approx->pager->counters.faults;
+      *result.bytes_loaded += approx->pager->counters.bytes_loaded;
+      *result.simulated_io_seconds += approx->pager->counters.simulated_io_seconds;
+    }
+    if (approx->cache && result.cache_misses) *result.cache_misses += approx->cache->counters.misses;
+  }
+  if (const StageStats* zsort = find_stage(output.run, "zsort")) {
+    result.sort_seconds = zsort->seconds;
+    result.spill = zsort->spill;
+  }
+  if (output.photons) {
+    // The photon pass is traced and reordered as the camera pass is: its stages count too
+    // (and [memory]'s counters above already hold both passes').
+    result.photon_seconds = output.photons->run.seconds + output.photons->map_seconds;
+    for (const StageStats& stage : output.photons->run.stages) {
+      if (stage.name == "trace") {
+        result.trace_seconds += stage.seconds;
+        result.rays_traced += stage.rays_in;
+      }
+      if (stage.name == "approx_hit") {
+        result.approx_hit_seconds += stage.seconds;
+        result.rays_retired_by_approx_hit += stage.rays_in - stage.rays_out;
+      }
+      if (stage.name == "zsort") result.sort_seconds += stage.seconds;
+    }
+    result.trace_mrays_per_s = result.trace_seconds > 0.0 ? double(result.rays_traced) / result.trace_seconds * 1e-6 : 0.0;
+  }
+  result.overhead_share = (result.approx_hit_seconds + result.sort_seconds) / thread_seconds;
+  return result;
+}
+
 }  // namespace
 
 ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<ReorderHeuristic>& heuristics, int rounds) {
@@ -82,67 +149,7 @@ ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<Reo
       const RenderOutput output = render_image(plan, world, camera);
       report.threads = output.run.threads;
 
-      ReorderBenchResult result;
-      result.heuristic = to_string(heuristic);
-      result.render_seconds = output.seconds();
-      result.closest_mrays_per_s = output.closest_mrays_per_s;
-      result.shadow_mrays_per_s = output.any_mrays_per_s;
-      const double thread_seconds = output.seconds() * output.run.threads;
-      if (const StageStats* trace = find_stage(output.run, "trace")) {
-        result.trace_seconds = trace->seconds;
-        result.trace_mrays_per_s = trace->mrays_per_s();
-        result.rays_traced = trace->rays_in;
-        if (trace->pager) {
-          result.page_faults = trace->pager->counters.faults;
-          result.bytes_loaded = trace->pager->counters.bytes_loaded;
-          result.simulated_io_seconds = trace->pager->counters.simulated_io_seconds;
-        }
-        if (trace->cache) result.cache_misses = trace->cache->counters.misses;
-        if (trace->disk) {
-          result.disk_faults = trace->disk->counters.faults;
-          result.disk_bytes_read = trace->disk->counters.bytes_read;
-          result.disk_read_seconds = trace->disk->counters.read_seconds;
-          result.disk_wait_seconds = trace->disk->counters.wait_seconds;
-          result.disk_reads_in_flight_max = trace->disk->reads_in_flight_max;
-          result.disk_prefetched = trace->disk->prefetched;
-          result.disk_prefetch_hits = trace->disk->prefetch_hits;
-          if (trace->disk->ray_windows.windows > 0) result.disk_pages_per_1000_rays = trace->disk->pages_per_window();
-          result.disk_faults_by_part = trace->disk->faults_by_part;
-        }
-      }
-      if (const StageStats* approx = find_stage(output.run, "approx_hit")) {
-        result.approx_hit_seconds = approx->seconds;
-        result.rays_retired_by_approx_hit = approx->rays_in - approx->rays_out;
-        // The proxy's traffic counts too: it is the price of the ordering.
-        if (approx->pager && result.page_faults) {
-          *result.page_faults += approx->pager->counters.faults;
-          *result.bytes_loaded += approx->pager->counters.bytes_loaded;
-          *result.simulated_io_seconds += approx->pager->counters.simulated_io_seconds;
-        }
-        if (approx->cache && result.cache_misses) *result.cache_misses += approx->cache->counters.misses;
-      }
-      if (const StageStats* zsort = find_stage(output.run, "zsort")) {
-        result.sort_seconds = zsort->seconds;
-        result.spill = zsort->spill;
-      }
-      if (output.photons) {
-        // The photon pass is traced and reordered as the camera pass is: its stages count too
-        // (and [memory]'s counters above already hold both passes').
-        result.photon_seconds = output.photons->run.seconds + output.photons->map_seconds;
-        for (const StageStats& stage : output.photons->run.stages) {
-          if (stage.name == "trace") {
-            result.trace_seconds += stage.seconds;
-            result.rays_traced += stage.rays_in;
-          }
-          if (stage.name == "approx_hit") {
-            result.approx_hit_seconds += stage.seconds;
-            result.rays_retired_by_approx_hit += stage.rays_in - stage.rays_out;
-          }
-          if (stage.name == "zsort") result.sort_seconds += stage.seconds;
-        }
-        result.trace_mrays_per_s = result.trace_seconds > 0.0 ? double(result.rays_traced) / result.trace_seconds * 1e-6 : 0.0;
-      }
-      result.overhead_share = (result.approx_hit_seconds + result.sort_seconds) / thread_seconds;
+      ReorderBenchResult result = result_of(heuristic, output);
       if (first_image.empty()) first_image = output.image;
       result.image_identical = output.image == first_image;
       rounds_of[h].push_back(std::move(result));
