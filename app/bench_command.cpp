@@ -64,7 +64,9 @@ BenchSetup prepare(const BenchArguments& args) {
   for (const std::string& spec : split_commas(args.accel)) setup.accelerators.push_back(parse_accelerator_spec(spec, setup.config));
   if (setup.accelerators.empty()) throw ConfigError("--accel names no accelerator");
   if (is_world_file(args.scene)) {
-    setup.world = load_world(args.scene, std::nullopt, args.threads);
+    // `--set memory.backing=copy` walks the world on huge pages, as the render does.
+    setup.world = load_world(args.scene, std::nullopt, args.threads, CheckedPages::kept,
+                             world_holding(plan_render(setup.config)));
     return setup;
   }
   setup.loaded_scene = load_scene(plan_render(setup.config).scene);

@@ -66,6 +66,7 @@ int finish_render(const RenderArguments& args, const MpiSession& session, const 
   if (show_progress) progress.finish();
   if (session.rank() != 0) return 0;
   measured.after_render_bytes = read_resident_memory().current_bytes;
+  measured.huge_page_bytes = anonymous_huge_page_bytes();
   measured.peak_rss_bytes = read_resident_memory().peak_bytes;
 
   write_exr(args.out, plan.image.width, plan.image.height, output.image);
@@ -104,6 +105,11 @@ int render_in_session(const RenderArguments& args, const MpiSession& session) {
     measured.load_seconds = built.phases().load_seconds;
     measured.after_load_bytes = built.phases().after_load_bytes;
     measured.after_build_bytes = built.phases().after_build_bytes;
+    if (const SectionFile* file = built.world_file(); file != nullptr) {
+      measured.world_holding = file->pager() != nullptr ? "paged" : std::string(to_string(file->holding()));
+      measured.world_holding_note = file->holding_note();
+      if (!measured.world_holding_note.empty() && session.rank() == 0) fmt::print("{}\n", measured.world_holding_note);
+    }
     const RenderPlan& done = built.plan();
     activity = fmt::format("rendering {}x{} at {} spp", done.image.width, done.image.height, done.image.samples_per_pixel);
     const AccelChoice* choice =

@@ -210,7 +210,11 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
                      {"after_load_bytes", measured.after_load_bytes},
                      {"after_build_bytes", measured.after_build_bytes},
                      {"after_render_bytes", measured.after_render_bytes},
-                     {"peak_rss_bytes_per_triangle", double(measured.peak_rss_bytes) / triangles}};
+                     {"peak_rss_bytes_per_triangle", double(measured.peak_rss_bytes) / triangles},
+                     {"huge_page_bytes", measured.huge_page_bytes}};
+  if (!measured.world_holding.empty()) {
+    stats["memory"]["world"] = {{"holding", measured.world_holding}, {"note", measured.world_holding_note}};
+  }
   if (facts.distributed != nullptr) stats["distribute"] = distribute_json(*facts.distributed, facts.plan);
   return stats;
 }
@@ -350,6 +354,11 @@ std::string render_table(const RenderFacts& facts) {
       double(measured.peak_rss_bytes) * 1e-9, double(measured.peak_rss_bytes) / double(facts.scene.triangle_count),
       measured.load_seconds, double(measured.after_load_bytes) * 1e-9, double(measured.after_build_bytes) * 1e-9,
       double(measured.after_render_bytes) * 1e-9);
+  if (!measured.world_holding.empty()) {
+    table += fmt::format("world file {}; {:.2f} GB of the process on 2 MiB pages\n",
+                         measured.world_holding_note.empty() ? measured.world_holding : measured.world_holding_note,
+                         double(measured.huge_page_bytes) * 1e-9);
+  }
   table += memory_lines(run.stages);
   if (facts.output.memory_unobserved) table += "memory: " + *facts.output.memory_unobserved + "\n";
   if (facts.output.rejected_contributions > 0) {

@@ -20,6 +20,10 @@ struct RenderPhases {
   std::size_t after_render_bytes = 0;
   std::size_t peak_rss_bytes = 0;
   double load_seconds = 0.0;  // wall time of the scene load (a streamed scene: its bounds pass)
+  // A world file's holding: "mapped", "copied" or "paged" ("" for a scene built now), and why
+  // a copy asked for was not made.
+  std::string world_holding, world_holding_note;
+  std::size_t huge_page_bytes = 0;  // AnonHugePages after the render
 };
 
 struct RenderFacts {

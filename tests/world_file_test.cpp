@@ -180,7 +180,7 @@ std::vector<float> build_and_save(const std::vector<std::string>& settings, cons
 std::vector<float> render_loaded(const std::vector<std::string>& settings, const std::string& path) {
   const Config config = small_render(settings);
   const RenderPlan plan = plan_render(config);
-  const std::unique_ptr<LoadedWorld> world = load_world(path, world_paging(plan), 2);
+  const std::unique_ptr<LoadedWorld> world = load_world(path, world_paging(plan), 2, CheckedPages::kept, world_holding(plan));
   const LoadedWorld& loaded = *world;
   return render_with(config, World{loaded.scene, *loaded.accelerator, *loaded.lights,
                                    plan.needs_proxy() ? loaded.proxy.get() : nullptr, loaded.file->pager()});
@@ -408,6 +408,52 @@ TEST(WorldFile, SavedProxyOrdersRaysAsTheFreshOneDoes) {
   const std::vector<std::string> settings = {"accel.type=hmq", "reorder.heuristic=hph"};
   const std::vector<float> fresh = build_and_save(settings, path, true);
   EXPECT_TRUE(render_loaded(settings, path) == fresh);
+  fs::remove(path);
+}
+
+// memory.backing = copy: the world read into memory of the process's own (on 2 MiB pages where
+// the kernel gives them) renders the fresh build's image, hands out the copy and not the file's
+// mapping, and checks every section as a mapped load does; a data-parallel rank, which holds
+// only the chunks it answers, maps instead and says why.
+TEST(WorldFile, ACopiedWorldRendersTheFreshImageFromItsOwnMemory) {
+  const std::string path = temp_path("copied.wtw");
+  const std::vector<std::string> build = {"accel.type=hmq", "accel.hmq.width=8", "build.chunk_triangles=4096"};
+  const std::vector<float> fresh = build_and_save(build, path);
+  std::vector<std::string> copied = build;
+  copied.emplace_back("memory.backing=copy");
+  EXPECT_TRUE(render_loaded(copied, path) == fresh);
+
+  const auto mapped = SectionFile::open(path);
+  const auto copy = SectionFile::open(path, std::nullopt, CheckedPages::kept, FileHolding::copied);
+  ASSERT_EQ(copy->holding(), FileHolding::copied) << copy->holding_note();
+  EXPECT_TRUE(copy->holding_note().empty());
+  EXPECT_EQ(mapped->holding(), FileHolding::mapped);
+  ASSERT_EQ(copy->sections().size(), mapped->sections().size());
+  for (const SectionInfo& section : mapped->sections()) {
+    const std::span<const std::byte> a = mapped->bytes(section.name), b = copy->bytes(section.name);
+    ASSERT_EQ(a.size(), b.size()) << section.name;
+    EXPECT_NE(a.data(), b.data()) << section.name;
+    EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size()), 0) << section.name;
+    EXPECT_EQ(reinterpret_cast<std::uintptr_t>(b.data()) % 4096, 0u) << section.name;  // aligned as mapped
+  }
+
+  const auto rank = SectionFile::open(path, std::nullopt, CheckedPages::given_back, FileHolding::copied);
+  EXPECT_EQ(rank->holding(), FileHolding::mapped);
+  EXPECT_NE(rank->holding_note().find("data-parallel rank"), std::string::npos) << rank->holding_note();
+
+  std::string damaged = read_all(path);
+  Resealer probe(path);
+  damaged[probe.entry("accel/chunk.0/hmq8.nodes").offset + 64] ^= 0x20;
+  const std::string bad = temp_path("copied_damaged.wtw");
+  write_all(bad, damaged);
+  try {
+    SectionFile::open(bad, std::nullopt, CheckedPages::kept, FileHolding::copied);
+    ADD_FAILURE() << "a damaged section was copied without complaint";
+  } catch (const SectionFileError& error) {
+    EXPECT_NE(std::string(error.what()).find("'accel/chunk.0/hmq8.nodes' checksum mismatch"), std::string::npos)
+        << error.what();
+  }
+  fs::remove(bad);
   fs::remove(path);
 }
 
@@ -652,6 +698,17 @@ TEST(WorldFileCli, BuildRenderAndInfo) {
   EXPECT_NE(chunked.output.find("saved in place, each chunk as it was built"), std::string::npos) << chunked.output;
   const auto chunked_render = testing::run_wavetrace("render " + world + " --size 32x24 --out " + temp_path("c.exr"));
   EXPECT_EQ(chunked_render.exit_code, 0) << chunked_render.output;
+  const auto copied = testing::run_wavetrace("render " + world + " --size 32x24 --set memory.backing=copy --out " +
+                                             temp_path("c2.exr") + " --stats " + stats);
+  ASSERT_EQ(copied.exit_code, 0) << copied.output;
+  EXPECT_EQ(read_all(temp_path("c.exr")), read_all(temp_path("c2.exr")));
+  EXPECT_NE(copied.output.find("world file copied"), std::string::npos) << copied.output;
+  EXPECT_EQ(nlohmann::json::parse(read_all(stats)).at("memory").at("world").at("holding"), "copied");
+  const auto copy_not_world = testing::run_wavetrace("render builtin:room:20k --size 8x8 --set memory.backing=copy --out " +
+                                                     temp_path("y.exr"));
+  EXPECT_EQ(copy_not_world.exit_code, 1);
+  EXPECT_NE(copy_not_world.output.find("memory.backing = copy copies a world file"), std::string::npos)
+      << copy_not_world.output;
   // A pool smaller than one page could hold nothing: refused, not rounded up.
   const auto built_again = testing::run_wavetrace("build builtin:room:20k --accel hmq --out " + world);
   ASSERT_EQ(built_again.exit_code, 0) << built_again.output;

@@ -16,7 +16,8 @@ Config heuristic_variant(const Config& config, ReorderHeuristic heuristic) {
 
 RenderWorld::RenderWorld(const RenderPlan& base, bool needs_proxy) {
   if (is_world_file(base.scene.source)) {
-    saved_ = load_world(base.scene.source, world_paging(base), base.pipeline.threads);
+    saved_ = load_world(base.scene.source, world_paging(base), base.pipeline.threads, CheckedPages::kept,
+                        world_holding(base));
     saved_->accelerator->use_isa(parse_kernel_isa(base.accelerator.isa));
     if (needs_proxy && !saved_->proxy) {
       throw ConfigError(fmt::format("{} was saved without a proxy, which hit-point heuristics need: build it with --proxy",
@@ -25,6 +26,7 @@ RenderWorld::RenderWorld(const RenderPlan& base, bool needs_proxy) {
     return;
   }
   if (base.memory.file_backing) throw ConfigError("memory.backing = file pages a world file: give one (wavetrace build)");
+  if (base.memory.copy_world) throw ConfigError("memory.backing = copy copies a world file: give one (wavetrace build)");
   built_scene_ = load_scene(base.scene);
   built_accelerator_ = build_world_accelerator(built_scene_, base.accelerator);
   built_lights_ = std::make_unique<LightSampler>(represented_lights(built_scene_, *built_accelerator_));

@@ -1,4 +1,4 @@
-// Reads /proc/self/status and /proc/meminfo; each field is a line "Name:   1234 kB".
+// Reads /proc/self/status, /proc/self/smaps_rollup and /proc/meminfo; each field is a line "Name:   1234 kB".
 #include "wavetrace/memory/process_memory.hpp"
 
 #include <cstdio>
@@ -37,5 +37,7 @@ bool reset_peak_resident_memory() {
 }
 
 std::size_t available_memory_bytes() { return read_kilobyte_field("/proc/meminfo", "MemAvailable:"); }
+
+std::size_t anonymous_huge_page_bytes() { return read_kilobyte_field("/proc/self/smaps_rollup", "AnonHugePages:"); }
 
 }  // namespace wavetrace

@@ -23,4 +23,8 @@ bool reset_peak_resident_memory();
 // it cannot be read.
 std::size_t available_memory_bytes();
 
+// AnonHugePages of /proc/self/smaps_rollup: the process's anonymous memory on transparent huge
+// pages, which shows whether the advice to use them took; 0 where it cannot be read.
+std::size_t anonymous_huge_page_bytes();
+
 }  // namespace wavetrace

@@ -17,6 +17,9 @@
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
 
+#include "wavetrace/memory/cache_aligned_allocator.hpp"
+#include "wavetrace/memory/process_memory.hpp"
+
 namespace wavetrace {
 
 using namespace section_file;
@@ -76,7 +79,29 @@ std::uint64_t checksum_by_reads(int fd, std::uint64_t offset, std::uint64_t size
   return sum;
 }
 
+// The checksum of a section read into its place in a copy of the file, a piece at a time so
+// that each piece is summed while it is still in the cache.
+std::uint64_t checksum_by_copy(int fd, std::uint64_t offset, std::uint64_t size, std::byte* destination) {
+  constexpr std::size_t kPieceBytes = std::size_t{512} << 10;
+  XXH3_state_t* state = XXH3_createState();
+  XXH3_64bits_reset(state);
+  for (std::uint64_t done = 0; done < size;) {
+    const std::size_t piece = static_cast<std::size_t>(std::min<std::uint64_t>(kPieceBytes, size - done));
+    if (!read_exactly(fd, destination + done, piece, offset + done)) {
+      XXH3_freeState(state);
+      return ~XXH3_64bits(nullptr, 0);  // a short read can never match
+    }
+    XXH3_64bits_update(state, destination + done, piece);
+    done += piece;
+  }
+  const std::uint64_t sum = XXH3_64bits_digest(state);
+  XXH3_freeState(state);
+  return sum;
+}
+
 }  // namespace
+
+std::string_view to_string(FileHolding holding) { return holding == FileHolding::copied ? "copied" : "mapped"; }
 
 void SectionFile::fail(std::string_view section, const std::string& problem) const {
   if (section.empty()) throw SectionFileError(fmt::format("{}: {}", path_, problem));
@@ -84,7 +109,7 @@ void SectionFile::fail(std::string_view section, const std::string& problem) con
 }
 
 std::shared_ptr<const SectionFile> SectionFile::open(const std::string& path, const std::optional<PagingRequest>& paging,
-                                                     CheckedPages checked) {
+                                                     CheckedPages checked, FileHolding holding) {
   std::shared_ptr<SectionFile> file(new SectionFile());
   file->path_ = path;
   file->checked_ = checked;
@@ -170,18 +195,44 @@ std::shared_ptr<const SectionFile> SectionFile::open(const std::string& path, co
     file->base_ = file->pager_->base();
     file->name_paged_parts();
   } else {
-    void* mapping = ::mmap(nullptr, actual_size, PROT_READ, MAP_SHARED, fd.get(), 0);
-    if (mapping == MAP_FAILED) file->fail({}, fmt::format("cannot be mapped: {}", std::strerror(errno)));
-    file->mapping_ = mapping;
-    file->base_ = static_cast<const std::byte*>(mapping);
-    // Read, not through the mapping: checking a page must not make it resident in this
-    // process, which then holds only what its render touches (a data-parallel rank its own
-    // chunks; docs/distributed.md). The page cache keeps what was read for the mapping.
-    tbb::parallel_for(std::size_t{0}, table.size(), [&](std::size_t i) {
-      constexpr std::size_t kBufferBytes = std::size_t{1} << 20;
-      const std::unique_ptr<std::byte[]> buffer(new std::byte[kBufferBytes]);
-      sums[i] = checksum_by_reads(fd.get(), table[i].offset, table[i].size, buffer.get(), kBufferBytes);
-    });
+    if (holding == FileHolding::copied) {
+      const std::size_t available = available_memory_bytes();
+      const std::uint64_t needed = actual_size + kCopyReserveBytes;
+      if (checked == CheckedPages::given_back) {
+        file->holding_note_ = "mapped, not copied: a data-parallel rank holds only the chunks it answers";
+      } else if (available < needed) {
+        file->holding_note_ = fmt::format(
+            "mapped, not copied: a copy needs {:.2f} GB (the file and a reserve of {:.0f} GB), the machine has {:.2f} GB "
+            "available",
+            double(needed) * 1e-9, double(kCopyReserveBytes) * 1e-9, double(available) * 1e-9);
+      } else {
+        // On a 2 MiB boundary whatever its size: sections keep the 4 KiB alignment the format
+        // promises, and a large file starts on a huge page.
+        const std::size_t bytes = align_up(static_cast<std::size_t>(actual_size), kHugePageBytes);
+        file->copy_ = std::aligned_alloc(kHugePageBytes, bytes);
+        if (file->copy_ == nullptr) file->fail({}, fmt::format("cannot be copied: {} bytes could not be allocated", bytes));
+        if (huge_pages_advised()) ::madvise(file->copy_, bytes, MADV_HUGEPAGE);  // advice only: failure is harmless
+        auto* copy = static_cast<std::byte*>(file->copy_);
+        tbb::parallel_for(std::size_t{0}, table.size(), [&](std::size_t i) {
+          sums[i] = checksum_by_copy(fd.get(), table[i].offset, table[i].size, copy + table[i].offset);
+        });
+        file->base_ = copy;
+      }
+    }
+    if (file->copy_ == nullptr) {
+      void* mapping = ::mmap(nullptr, actual_size, PROT_READ, MAP_SHARED, fd.get(), 0);
+      if (mapping == MAP_FAILED) file->fail({}, fmt::format("cannot be mapped: {}", std::strerror(errno)));
+      file->mapping_ = mapping;
+      file->base_ = static_cast<const std::byte*>(mapping);
+      // Read, not through the mapping: checking a page must not make it resident in this
+      // process, which then holds only what its render touches (a data-parallel rank its own
+      // chunks; docs/distributed.md). The page cache keeps what was read for the mapping.
+      tbb::parallel_for(std::size_t{0}, table.size(), [&](std::size_t i) {
+        constexpr std::size_t kBufferBytes = std::size_t{1} << 20;
+        const std::unique_ptr<std::byte[]> buffer(new std::byte[kBufferBytes]);
+        sums[i] = checksum_by_reads(fd.get(), table[i].offset, table[i].size, buffer.get(), kBufferBytes);
+      });
+    }
   }
   for (std::size_t i = 0; i < table.size(); ++i) {
     if (sums[i] != table[i].checksum) file->fail(table[i].name, "checksum mismatch: the file is damaged");
@@ -222,6 +273,7 @@ void SectionFile::name_paged_parts() {
 
 SectionFile::~SectionFile() {
   if (mapping_ != nullptr) ::munmap(mapping_, file_bytes_);
+  std::free(copy_);
 }
 
 const SectionInfo* SectionFile::find(std::string_view name) const {

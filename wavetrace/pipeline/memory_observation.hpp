@@ -21,6 +21,7 @@ namespace wavetrace {
 struct MemoryPlan {
   std::optional<MemoryBudget> budget;  // no pager without one
   bool file_backing = false;           // memory.backing = file: a world file really paged under the budget
+  bool copy_world = false;             // memory.backing = copy: a world file copied onto huge pages
   std::size_t page_bytes = std::size_t{4} << 20;
   // Real paging: sorted batches queued for trace whose pages its look-ahead reads first (0: none).
   std::size_t look_ahead_batches = 0;

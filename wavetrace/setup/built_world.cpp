@@ -19,9 +19,10 @@ BuiltWorld::BuiltWorld(const RenderPlan& plan, std::string* activity, CheckedPag
     doing = fmt::format("loading the world {}", plan_.scene.source);
     open_world_file(checked);
   } else {
-    if (plan_.memory.file_backing) {
-      throw ConfigError(fmt::format(
-          "memory.backing = file pages a world file; {} is not one (make one with wavetrace build)", plan_.scene.source));
+    if (plan_.memory.file_backing || plan_.memory.copy_world) {
+      throw ConfigError(fmt::format("memory.backing = {} {} a world file; {} is not one (make one with wavetrace build)",
+                                    plan_.memory.file_backing ? "file" : "copy",
+                                    plan_.memory.file_backing ? "pages" : "copies", plan_.scene.source));
     }
     build_from_scene(doing);
   }
@@ -29,8 +30,10 @@ BuiltWorld::BuiltWorld(const RenderPlan& plan, std::string* activity, CheckedPag
 
 BuiltWorld::~BuiltWorld() = default;
 
+const SectionFile* BuiltWorld::world_file() const { return loaded_ ? loaded_->file.get() : nullptr; }
+
 void BuiltWorld::open_world_file(CheckedPages checked) {
-  loaded_ = load_world(plan_.scene.source, world_paging(plan_), plan_.pipeline.threads, checked);
+  loaded_ = load_world(plan_.scene.source, world_paging(plan_), plan_.pipeline.threads, checked, world_holding(plan_));
   loaded_->accelerator->use_isa(parse_kernel_isa(plan_.accelerator.isa));
   phases_.load_seconds = loaded_->seconds;
   phases_.after_load_bytes = phases_.after_build_bytes = read_resident_memory().current_bytes;

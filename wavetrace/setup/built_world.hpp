@@ -49,6 +49,8 @@ class BuiltWorld {
   // What auto or a pixel bound resolved to; null for a world file.
   const ResolvedAccelerator* resolution() const { return resolved_ ? &*resolved_ : nullptr; }
   const WorldPhases& phases() const { return phases_; }
+  // The world file the world was loaded from; null for a scene built now.
+  const SectionFile* world_file() const;
   // The chunks of a chunked world (for a data-parallel render to own and route); null for
   // any other world.
   ChunkSet* chunk_set();

@@ -131,6 +131,7 @@ void read_kernel_isa(const Config& config, std::string_view key, RenderPlan& pla
 }
 void read_backing(const Config& config, std::string_view key, RenderPlan& plan) {
   plan.memory.file_backing = config.text(key) == "file";
+  plan.memory.copy_world = config.text(key) == "copy";
 }
 void read_io(const Config& config, std::string_view key, RenderPlan& plan) { plan.memory.io = io_preset(config.text(key)); }
 void read_cache(const Config& config, std::string_view key, RenderPlan& plan) {
@@ -386,9 +387,10 @@ const std::vector<ConfigKey>& config_schema() {
        "page size of the pool in bytes, a power of two (the paper: 4 MiB; real paging of room:8M on this project's "
        "machines is fastest at 64 KiB: docs/measurements.md)",
        integer<&P::memory, &MemoryPlan::page_bytes>},
-      {"memory.backing", T::text, std::string("memory"), 0, 0, {"memory", "file"},
-       "where a world file's pages live: memory (mapped, the OS pages it) or file (real paging: read on demand "
-       "with O_DIRECT into a pool of memory.budget, evicted LRU)",
+      {"memory.backing", T::text, std::string("memory"), 0, 0, {"memory", "copy", "file"},
+       "where a world file's pages live: memory (mapped, the OS pages it), copy (read whole into memory on 2 MiB "
+       "pages, for walks over gigabytes; mapped where the machine cannot spare the file and 1 GB) or file (real "
+       "paging: read on demand with O_DIRECT into a pool of memory.budget, evicted LRU)",
        read_backing},
       {"memory.look_ahead", T::integer, std::int64_t{0}, 0, 64, {},
        "real paging (memory.backing = file): how many of the sorted batches queued for trace a thread of its own "

@@ -114,6 +114,10 @@ std::optional<PagingRequest> world_paging(const RenderPlan& plan) {
   return PagingRequest{plan.memory.page_bytes, *plan.memory.budget, kFilePagerClients};
 }
 
+FileHolding world_holding(const RenderPlan& plan) {
+  return plan.memory.copy_world ? FileHolding::copied : FileHolding::mapped;
+}
+
 bool is_world_file(const std::string& path) { return path.size() > 4 && path.compare(path.size() - 4, 4, ".wtw") == 0; }
 
 void save_world(const std::string& path, const Scene& scene, const LightSampler& lights, const Accelerator& accelerator,
@@ -184,11 +188,11 @@ void save_world(SectionWriter& out, const Scene& scene, const LightSampler& ligh
 }
 
 std::unique_ptr<LoadedWorld> load_world(const std::string& path, const std::optional<PagingRequest>& paging, int threads,
-                                        CheckedPages checked) {
+                                        CheckedPages checked, FileHolding holding) {
   const auto start = std::chrono::steady_clock::now();
   auto loaded = std::make_unique<LoadedWorld>();
   LoadedWorld& world = *loaded;
-  world.file = SectionFile::open(path, paging, checked);
+  world.file = SectionFile::open(path, paging, checked, holding);
   const SectionFile& file = *world.file;
   SectionLoader(world.file, "world.").expect_kind("world", kWorldFileVersion);
 

@@ -84,11 +84,14 @@ struct LoadedWorld {
 // The paging a plan asks for: real paging under memory.budget when memory.backing = file.
 struct RenderPlan;
 std::optional<PagingRequest> world_paging(const RenderPlan& plan);
+// How a plan asks a world file not paged to be held: copied when memory.backing = copy.
+FileHolding world_holding(const RenderPlan& plan);
 
-// Maps `path` (or pages it under `paging`) and loads the world in place. `threads` is for
-// a rebuilt Embree; `checked` says what the load's checks leave resident (section_file.hpp).
-// Throws SectionFileError naming the file and its problem.
+// Maps `path` (copies it, as `holding` asks, or pages it under `paging`) and loads the world
+// in place. `threads` is for a rebuilt Embree; `checked` says what the load's checks leave
+// resident (section_file.hpp). Throws SectionFileError naming the file and its problem.
 std::unique_ptr<LoadedWorld> load_world(const std::string& path, const std::optional<PagingRequest>& paging = std::nullopt,
-                                        int threads = 0, CheckedPages checked = CheckedPages::kept);
+                                        int threads = 0, CheckedPages checked = CheckedPages::kept,
+                                        FileHolding holding = FileHolding::mapped);
 
 }  // namespace wavetrace
