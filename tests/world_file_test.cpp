@@ -10,6 +10,7 @@
 #include <functional>
 #include <random>
 
+#include <fmt/format.h>
 #include <xxhash.h>
 #include <nlohmann/json.hpp>
 
@@ -510,6 +511,24 @@ TEST_F(DamagedWorld, EachProblemIsNamedWithTheFile) {
   outside.entry("accel/chunk.0/hmq.blocks").size = std::uint64_t{1} << 40;
   outside.seal(path_);
   EXPECT_NE(open_error(path_).find("lies outside the file"), std::string::npos) << open_error(path_);
+}
+
+// Chunks are checked in parallel; of two damaged ones the lower is named, on every load.
+TEST_F(DamagedWorld, OfTwoDamagedChunksTheLowerIsNamedEveryTime) {
+  Resealer two(good_);
+  for (const auto& [chunk, version] : {std::pair{1, 98u}, std::pair{2, 99u}}) {
+    const std::string name = fmt::format("accel/chunk.{}/kind", chunk);
+    SavedKind kind{};
+    std::memcpy(&kind, two.data(name), sizeof(kind));
+    kind.version = version;
+    std::memcpy(two.data(name), &kind, sizeof(kind));
+  }
+  two.seal(path_);
+  for (int load = 0; load < 4; ++load) {
+    const std::string error = open_error(path_);
+    EXPECT_NE(error.find("chunk.1/"), std::string::npos) << error;
+    EXPECT_NE(error.find("'hmq' format version 98"), std::string::npos) << error;
+  }
 }
 
 TEST_F(DamagedWorld, FlippedBytesAnywhereAreRefusedOrHarmless) {
