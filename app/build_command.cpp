@@ -11,6 +11,7 @@
 #include <tbb/global_control.h>
 
 #include "wavetrace/accel/chunked/chunked_accelerator.hpp"
+#include "wavetrace/accel/proxy/proxy_by_chunks.hpp"
 #include "wavetrace/accel/registry.hpp"
 #include "wavetrace/bench/json_fields.hpp"
 #include "app/command_options.hpp"
@@ -72,16 +73,15 @@ int run_build(const BuildArguments& args) {
   }
   const bool with_proxy = args.proxy || plan.needs_proxy();
   // A world that builds in chunks is written chunk by chunk as it is built and never held
-  // whole, so that it may be larger than memory; not with a proxy, whose quality is measured
-  // by tracing the built world (and which is simplified from the whole mesh in memory).
-  const auto streams_to_file = [&](const std::string& type) {
-    return !with_proxy && saves_structure(type) && builds_in_chunks(type);
-  };
+  // whole, so that it may be larger than memory; its proxy, when one is wanted, is simplified
+  // chunk by chunk too (proxy_by_chunks.hpp).
+  const auto streams_to_file = [&](const std::string& type) { return saves_structure(type) && builds_in_chunks(type); };
 
   // As render does: an accelerator holding its own geometry is built from a streamed scene
-  // (never whole) unless the proxy, simplified from the whole mesh, is wanted.
+  // (never whole) unless a proxy simplified from the whole mesh is wanted.
   const auto load_start = std::chrono::steady_clock::now();
-  SceneForWorld loaded = load_scene_for_world(plan, with_proxy, streams_to_file(plan.accelerator.type));
+  const bool streams = streams_to_file(plan.accelerator.type);
+  SceneForWorld loaded = load_scene_for_world(plan, with_proxy && !streams, streams);
   Scene& scene = loaded.scene;
   plan.accelerator = loaded.accelerator.options;
   const std::string& type = plan.accelerator.type;
@@ -95,12 +95,26 @@ int run_build(const BuildArguments& args) {
   info.scene_seconds = seconds_since(load_start);
   const auto build_start = std::chrono::steady_clock::now();
   SectionWriter out(args.out);
-  const ChunkStream stream{out, kWorldAcceleratorPrefix};
+  std::optional<ProxyByChunks> proxy_pieces;
+  if (with_proxy && streams_to_file(type)) proxy_pieces.emplace(plan.proxy);
+  ChunkStream stream{out, kWorldAcceleratorPrefix};
+  if (proxy_pieces) {
+    stream.observe = [&](std::size_t chunk, std::size_t first, const TriangleMesh& mesh, const Accelerator& built) {
+      proxy_pieces->add(chunk, first, mesh, built);
+    };
+  }
   const std::unique_ptr<Accelerator> accelerator =
       build_world_accelerator(scene, plan.accelerator, streams_to_file(type) ? &stream : nullptr);
   const LightSampler lights = represented_lights(scene, *accelerator);
   std::unique_ptr<Proxy> proxy;
-  if (with_proxy) proxy = std::make_unique<Proxy>(scene.mesh, plan.proxy, *accelerator);
+  if (proxy_pieces && !proxy_pieces->empty()) {
+    proxy = proxy_pieces->finish(scene.bounds);
+  } else if (with_proxy) {
+    // Built whole (a scene of one chunk, or a type that does not build in chunks): from the
+    // whole mesh, which a streamed scene of one chunk gives again.
+    const TriangleMesh whole = scene.streamed() ? scene.stream->extract(0, scene.triangle_count) : TriangleMesh{};
+    proxy = std::make_unique<Proxy>(scene.streamed() ? whole : scene.mesh, plan.proxy, *accelerator);
+  }
   // A type traced in place no longer needs the mesh (bvh's face sets have their own copy
   // or keep the mesh they point into; rebuilt types save it).
   if (holds_own_geometry(type)) scene.release_mesh();

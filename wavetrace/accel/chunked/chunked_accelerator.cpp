@@ -213,6 +213,7 @@ class ChunkedAccelerator final : public Accelerator, public ChunkSet {
       tbb::parallel_for(wave_begin, wave_end, [&](std::size_t c) {
         const TriangleMesh& mesh = *meshes[c - wave_begin];
         chunks_[c] = Chunk{ranges[c].first, ranges[c].count, mesh.bounds(), nullptr, build_chunk(mesh), {}};
+        if (stream != nullptr && stream->observe) stream->observe(c, ranges[c].first, mesh, *chunks_[c].accelerator);
       });
       clock.lap(build_.phases, "chunks");
       // The wave's builds held their meshes, their temporaries and every chunk finished before.

@@ -45,9 +45,18 @@ class SectionWriter;
 // wave is built, and the chunk's structure is freed (all but chunk 0's, which answers
 // represented_point and build_notes). The world built so is for saving, to the same writer
 // under the same prefix, and nothing else: tracing it throws std::logic_error.
+// Told of each chunk of a streamed build as it is built, on the thread that built it
+// (several chunks are built at once): the chunk's index, its first triangle's id in the
+// source, its mesh and its sub-accelerator (triangles numbered from 0), before the chunk is
+// written and freed. For what a build makes beside the world from every chunk (a proxy,
+// proxy_by_chunks.hpp).
+using ChunkObserver =
+    std::function<void(std::size_t chunk, std::size_t first, const TriangleMesh& mesh, const Accelerator& built)>;
+
 struct ChunkStream {
   SectionWriter& out;
   std::string prefix;
+  ChunkObserver observe = {};  // none when empty
 };
 
 // `keeps_mesh`: the sub-accelerators read their chunk's mesh in place (bvh), so the world

@@ -10,10 +10,11 @@
 
 namespace wavetrace {
 
-TriangleMesh simplify_stochastically(const TriangleMesh& mesh, double share) {
+TriangleMesh simplify_stochastically(const TriangleMesh& mesh, double share, std::size_t first_id) {
   share = std::clamp(share, 1e-9, 1.0);
   const auto threshold = static_cast<std::uint64_t>(share * 4294967296.0);
-  const auto kept = [&](std::size_t t) {
+  const auto kept = [&](std::size_t local) {
+    const std::size_t t = first_id + local;
     return (random_bits(std::uint32_t(t), std::uint32_t(t >> 32), 0, RandomPurpose::simplification) >> 32) < threshold;
   };
   std::vector<std::uint32_t> offset(mesh.triangle_count() + 1, 0);

@@ -8,7 +8,8 @@
 
 namespace wavetrace {
 
-// Deterministic (the choice hashes the triangle index). share in (0, 1].
-TriangleMesh simplify_stochastically(const TriangleMesh& mesh, double share);
+// Deterministic (the choice hashes the triangle index, `first_id` + the mesh's own: a chunk
+// of a scene keeps the triangles the whole scene would). share in (0, 1].
+TriangleMesh simplify_stochastically(const TriangleMesh& mesh, double share, std::size_t first_id = 0);
 
 }  // namespace wavetrace
