@@ -83,6 +83,19 @@ ProxyQuality measure_proxy_quality(const Accelerator& candidate, const Accelerat
           hit_either ? double(hit_both) / double(hit_either) : 1.0, hit_both ? error_sum / double(hit_both) : 0.0};
 }
 
+TriangleMesh cleaned_proxy_mesh(TriangleMesh simplified) {
+  try {
+    validate_and_clean(simplified, "proxy");
+  } catch (const SceneError&) {
+    return TriangleMesh{};
+  }
+  return simplified;
+}
+
+bool clustering_wins(const std::optional<ProxyQuality>& cluster, const std::optional<ProxyQuality>& stochastic) {
+  return cluster && (!stochastic || cluster->hit_overlap >= stochastic->hit_overlap);
+}
+
 Proxy::Proxy(const TriangleMesh& mesh, const ProxyOptions& options, const Accelerator& scene_accelerator)
     : scene_bounds_(mesh.bounds()) {
   if (!(options.share > 0.0 && options.share <= 1.0)) {
@@ -90,22 +103,13 @@ Proxy::Proxy(const TriangleMesh& mesh, const ProxyOptions& options, const Accele
   }
   const auto target = static_cast<std::size_t>(std::max(4.0, std::round(options.share * double(mesh.triangle_count()))));
   const auto start = std::chrono::steady_clock::now();
-  // An empty result (everything collapsed or pruned away) marks a method that failed here.
-  const auto cleaned = [](TriangleMesh simplified) {
-    try {
-      validate_and_clean(simplified, "proxy");
-    } catch (const SceneError&) {
-      return TriangleMesh{};
-    }
-    return simplified;
-  };
   double cell_size = 0.0;
   const auto clustered = [&] {
     ClusterSimplification simplified = simplify_by_clustering(mesh, target);
     cell_size = simplified.cell_size;
-    return cleaned(std::move(simplified.mesh));
+    return cleaned_proxy_mesh(std::move(simplified.mesh));
   };
-  const auto pruned = [&] { return cleaned(simplify_stochastically(mesh, options.share)); };
+  const auto pruned = [&] { return cleaned_proxy_mesh(simplify_stochastically(mesh, options.share)); };
 
   if (options.method == ProxyMethod::automatic) {
     TriangleMesh cluster_mesh = clustered(), stochastic_mesh = pruned();
@@ -117,9 +121,7 @@ Proxy::Proxy(const TriangleMesh& mesh, const ProxyOptions& options, const Accele
     };
     report_.cluster_quality = judge(cluster_mesh);
     report_.stochastic_quality = judge(stochastic_mesh);
-    const bool cluster_wins = report_.cluster_quality &&
-                              (!report_.stochastic_quality ||
-                               report_.cluster_quality->hit_overlap >= report_.stochastic_quality->hit_overlap);
+    const bool cluster_wins = clustering_wins(report_.cluster_quality, report_.stochastic_quality);
     report_.method = cluster_wins ? ProxyMethod::cluster : ProxyMethod::stochastic;
     mesh_ = std::move(cluster_wins ? cluster_mesh : stochastic_mesh);
   } else {

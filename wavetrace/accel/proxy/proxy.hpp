@@ -73,6 +73,13 @@ class Proxy {
   float surface_tolerance_ = 0.0f;
 };
 
+// A simplification's mesh cleaned as a scene's is, or empty where the method lost every
+// triangle (an empty result marks a method that failed there).
+TriangleMesh cleaned_proxy_mesh(TriangleMesh simplified);
+// auto's rule: clustering unless stochastic pruning's hits overlap the scene's more (or only
+// it kept triangles). Each quality is empty where its method kept none.
+bool clustering_wins(const std::optional<ProxyQuality>& cluster, const std::optional<ProxyQuality>& stochastic);
+
 // Hit agreement of `candidate` with `scene_accelerator` on `rays` test rays.
 ProxyQuality measure_proxy_quality(const Accelerator& candidate, const Accelerator& scene_accelerator,
                                    const Bounds3& scene_bounds, std::size_t rays = 16384);

@@ -18,16 +18,6 @@ namespace {
 // chunk is judged and its rays stay in its own box.
 constexpr std::size_t kChunkTestRays = 4096;
 
-// An empty mesh marks a method that lost every triangle of the chunk.
-TriangleMesh cleaned(TriangleMesh simplified) {
-  try {
-    validate_and_clean(simplified, "proxy");
-  } catch (const SceneError&) {
-    return TriangleMesh{};
-  }
-  return simplified;
-}
-
 }  // namespace
 
 ProxyByChunks::ProxyByChunks(const ProxyOptions& options) : options_(options) {
@@ -50,10 +40,12 @@ void ProxyByChunks::add(std::size_t chunk, std::size_t first, const TriangleMesh
     return measure_proxy_quality(*accelerator, built, mesh.bounds(), kChunkTestRays);
   };
   TriangleMesh cluster_mesh, stochastic_mesh;
-  if (options_.method != ProxyMethod::stochastic) cluster_mesh = cleaned(std::move(clustered.mesh));
-  if (options_.method != ProxyMethod::cluster) stochastic_mesh = cleaned(simplify_stochastically(mesh, options_.share, first));
+  if (options_.method != ProxyMethod::stochastic) cluster_mesh = cleaned_proxy_mesh(std::move(clustered.mesh));
+  if (options_.method != ProxyMethod::cluster) {
+    stochastic_mesh = cleaned_proxy_mesh(simplify_stochastically(mesh, options_.share, first));
+  }
   const std::optional<ProxyQuality> cluster_quality = judge(cluster_mesh), stochastic_quality = judge(stochastic_mesh);
-  const bool cluster_wins = cluster_quality && (!stochastic_quality || cluster_quality->hit_overlap >= stochastic_quality->hit_overlap);
+  const bool cluster_wins = clustering_wins(cluster_quality, stochastic_quality);
   piece.method = cluster_wins ? ProxyMethod::cluster : ProxyMethod::stochastic;
   piece.mesh = std::move(cluster_wins ? cluster_mesh : stochastic_mesh);
   if (const std::optional<ProxyQuality>& quality = cluster_wins ? cluster_quality : stochastic_quality) piece.quality = *quality;
