@@ -40,11 +40,6 @@ using ChunkBuilder = std::function<std::unique_ptr<Accelerator>(const TriangleMe
 
 class SectionWriter;
 
-// Where a build saves its chunks as they are built, so that a world larger than memory is
-// never held whole: each chunk's sections go to `out` under `prefix` + "chunk.N/" once its
-// wave is built, and the chunk's structure is freed (all but chunk 0's, which answers
-// represented_point and build_notes). The world built so is for saving, to the same writer
-// under the same prefix, and nothing else: tracing it throws std::logic_error.
 // Told of each chunk of a streamed build as it is built, on the thread that built it
 // (several chunks are built at once): the chunk's index, its first triangle's id in the
 // source, its mesh and its sub-accelerator (triangles numbered from 0), before the chunk is
@@ -53,6 +48,11 @@ class SectionWriter;
 using ChunkObserver =
     std::function<void(std::size_t chunk, std::size_t first, const TriangleMesh& mesh, const Accelerator& built)>;
 
+// Where a build saves its chunks as they are built, so that a world larger than memory is
+// never held whole: each chunk's sections go to `out` under `prefix` + "chunk.N/" once its
+// wave is built, and the chunk's structure is freed (all but chunk 0's, which answers
+// represented_point and build_notes). The world built so is for saving, to the same writer
+// under the same prefix, and nothing else: tracing it throws std::logic_error.
 struct ChunkStream {
   SectionWriter& out;
   std::string prefix;
