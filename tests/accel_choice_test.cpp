@@ -209,7 +209,9 @@ TEST(AccelChoice, ABudgetTooSmallForTheBuildTakesSmallerChunks) {
     EXPECT_GT(chunking.chunks, 1u);
     EXPECT_LE(chunking.sizes.front(), chunking.chunk_triangles);
     EXPECT_GE(chunking.overlap, 1.0);
-    if (k > 0) EXPECT_EQ(chunking.chunk_triangles * 4, traits.smaller_chunkings[k - 1].chunk_triangles);
+    if (k > 0) {
+      EXPECT_EQ(chunking.chunk_triangles * 4, traits.smaller_chunkings[k - 1].chunk_triangles);
+    }
   }
   const auto hmq8_with = [&](std::size_t budget) {
     return candidate(choose_accelerator(traits, budget, 0.01, AcceleratorOptions{}, true, kAllowance), "hmq");
