@@ -1,6 +1,7 @@
 // Saved worlds: the section container's checks, images from a world file bit-identical to a
 // fresh build for every accelerator (Embree and the grids rebuilt from saved geometry), real
-// paging that changes no pixel, and damaged files refused with the file and problem named.
+// paging that changes no pixel, copies on huge pages, and the build, render and info commands.
+// Damaged and crafted files: damaged_world_test.cpp.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -25,65 +26,15 @@
 #include "wavetrace/setup/render_setup.hpp"
 #include "wavetrace/setup/world_file.hpp"
 #include "test_support.hpp"
+#include "world_file_support.hpp"
 
 namespace wavetrace {
 namespace {
 
+using namespace world_testing;
 namespace fs = std::filesystem;
 using section_file::Header;
 using section_file::TableEntry;
-
-std::string temp_path(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / "wavetrace_tests";
-  fs::create_directories(dir);
-  return (dir / (std::to_string(::getpid()) + "_" + name)).string();
-}
-
-std::string read_all(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
-void write_all(const std::string& path, const std::string& bytes) { std::ofstream(path, std::ios::binary) << bytes; }
-
-// Replaces a section's bytes in place (same size) and recomputes every checksum, so that a
-// test reaches the check behind them (a wrong version, an offset out of bounds).
-struct Resealer {
-  std::string bytes;
-  Header header{};
-  std::vector<TableEntry> table;
-  explicit Resealer(const std::string& path) : bytes(read_all(path)) {
-    std::memcpy(&header, bytes.data(), sizeof(header));
-    table.resize(header.section_count);
-    std::memcpy(table.data(), bytes.data() + header.table_offset, table.size() * sizeof(TableEntry));
-  }
-  TableEntry& entry(const std::string& name) {
-    for (TableEntry& e : table) {
-      if (name == e.name) return e;
-    }
-    throw std::logic_error("no section " + name);
-  }
-  char* data(const std::string& name) { return bytes.data() + entry(name).offset; }
-  void seal(const std::string& path) {
-    for (TableEntry& e : table) {
-      if (e.offset + e.size <= bytes.size()) e.checksum = XXH3_64bits(bytes.data() + e.offset, e.size);
-    }
-    std::memcpy(bytes.data() + header.table_offset, table.data(), table.size() * sizeof(TableEntry));
-    header.table_checksum = XXH3_64bits(table.data(), table.size() * sizeof(TableEntry));
-    header.header_checksum = XXH3_64bits(&header, section_file::kHeaderChecksummedBytes);
-    std::memcpy(bytes.data(), &header, sizeof(header));
-    write_all(path, bytes);
-  }
-};
-
-std::string open_error(const std::string& path) {
-  try {
-    load_world(path);
-  } catch (const SectionFileError& error) {
-    return error.what();
-  }
-  return "(no error)";
-}
 
 // A writer works in an unnamed file and renames at finish(): a failed save leaves no file and
 // keeps the world that was there, and a process with that world mapped keeps reading it
@@ -145,47 +96,6 @@ TEST(SectionFile, ArraysComeBackInPlaceAndChecked) {
   }
 }
 
-Config small_render(const std::vector<std::string>& settings) {
-  Config config;
-  config.set("render.width=32");
-  config.set("render.height=24");
-  config.set("render.spp=1");
-  config.set("render.threads=2");
-  for (const std::string& s : settings) config.set(s);
-  return config;
-}
-
-std::vector<float> render_with(const Config& config, const World& world) {
-  const RenderPlan plan = plan_render(config);
-  return render_image(plan, world, resolve_camera(plan.camera, world.scene)).image;
-}
-
-const Scene& room() {
-  static const Scene scene = make_builtin_scene("builtin:room:20k");
-  return scene;
-}
-
-// Builds `settings` over the room, saves it, and returns the fresh build's image.
-std::vector<float> build_and_save(const std::vector<std::string>& settings, const std::string& path, bool proxy = false) {
-  const Config config = small_render(settings);
-  const RenderPlan plan = plan_render(config);
-  const Scene& scene = room();
-  const auto accelerator = build_world_accelerator(scene, plan.accelerator);
-  const LightSampler lights(scene);
-  std::unique_ptr<Proxy> simplified;
-  if (proxy) simplified = std::make_unique<Proxy>(scene.mesh, plan.proxy, *accelerator);
-  save_world(path, scene, lights, *accelerator, plan.accelerator.type, simplified.get(), config, {});
-  return render_with(config, World{scene, *accelerator, lights, simplified.get()});
-}
-
-std::vector<float> render_loaded(const std::vector<std::string>& settings, const std::string& path) {
-  const Config config = small_render(settings);
-  const RenderPlan plan = plan_render(config);
-  const std::unique_ptr<LoadedWorld> world = load_world(path, world_paging(plan), 2, CheckedPages::kept, world_holding(plan));
-  const LoadedWorld& loaded = *world;
-  return render_with(config, World{loaded.scene, *loaded.accelerator, *loaded.lights,
-                                   plan.needs_proxy() ? loaded.proxy.get() : nullptr, loaded.file->pager()});
-}
 
 class WorldRoundTrip : public ::testing::TestWithParam<std::vector<std::string>> {};
 
@@ -458,217 +368,6 @@ TEST(WorldFile, ACopiedWorldRendersTheFreshImageFromItsOwnMemory) {
   fs::remove(path);
 }
 
-class DamagedWorld : public ::testing::Test {
- protected:
-  void SetUp() override {
-    path_ = temp_path("damaged.wtw");
-    good_ = temp_path("good.wtw");
-    build_and_save({"accel.type=hmq", "build.chunk_triangles=8192"}, good_);
-    bytes_ = read_all(good_);
-  }
-  void TearDown() override {
-    fs::remove(path_);
-    fs::remove(good_);
-  }
-  std::string path_, good_, bytes_;
-};
-
-TEST_F(DamagedWorld, EachProblemIsNamedWithTheFile) {
-  const auto expect_error = [&](const std::string& contents, const std::string& problem) {
-    write_all(path_, contents);
-    const std::string error = open_error(path_);
-    EXPECT_NE(error.find(path_), std::string::npos) << error;
-    EXPECT_NE(error.find(problem), std::string::npos) << "expected '" << problem << "' in: " << error;
-  };
-  expect_error(bytes_.substr(0, 40), "truncated");
-  expect_error(bytes_.substr(0, bytes_.size() - 4096), "truncated");
-  expect_error(std::string(bytes_.size(), '\0'), "incomplete");
-  std::string magic = bytes_;
-  magic[0] = 'X';
-  expect_error(magic, "not a wavetrace world file");
-  std::string data = bytes_;
-  Resealer probe(good_);
-  data[probe.entry("accel/chunk.0/hmq.blocks").offset + 100] ^= 0x10;
-  expect_error(data, "'accel/chunk.0/hmq.blocks' checksum mismatch");
-  std::string table = bytes_;
-  table[probe.header.table_offset + 70] ^= 0x01;
-  expect_error(table, "table checksum mismatch");
-
-  Resealer version(good_);
-  version.header.version = 7;
-  version.seal(path_);
-  EXPECT_NE(open_error(path_).find("container version 7"), std::string::npos) << open_error(path_);
-
-  Resealer accel_version(good_);
-  SavedKind kind{};
-  std::memcpy(&kind, accel_version.data("accel/chunk.0/kind"), sizeof(kind));
-  kind.version = 99;
-  std::memcpy(accel_version.data("accel/chunk.0/kind"), &kind, sizeof(kind));
-  accel_version.seal(path_);
-  EXPECT_NE(open_error(path_).find("'hmq' format version 99"), std::string::npos) << open_error(path_);
-
-  Resealer outside(good_);
-  outside.entry("accel/chunk.0/hmq.blocks").size = std::uint64_t{1} << 40;
-  outside.seal(path_);
-  EXPECT_NE(open_error(path_).find("lies outside the file"), std::string::npos) << open_error(path_);
-}
-
-// Chunks are checked in parallel; of two damaged ones the lower is named, on every load.
-TEST_F(DamagedWorld, OfTwoDamagedChunksTheLowerIsNamedEveryTime) {
-  Resealer two(good_);
-  for (const auto& [chunk, version] : {std::pair{1, 98u}, std::pair{2, 99u}}) {
-    const std::string name = fmt::format("accel/chunk.{}/kind", chunk);
-    SavedKind kind{};
-    std::memcpy(&kind, two.data(name), sizeof(kind));
-    kind.version = version;
-    std::memcpy(two.data(name), &kind, sizeof(kind));
-  }
-  two.seal(path_);
-  for (int load = 0; load < 4; ++load) {
-    const std::string error = open_error(path_);
-    EXPECT_NE(error.find("chunk.1/"), std::string::npos) << error;
-    EXPECT_NE(error.find("'hmq' format version 98"), std::string::npos) << error;
-  }
-}
-
-TEST_F(DamagedWorld, FlippedBytesAnywhereAreRefusedOrHarmless) {
-  const std::vector<float> expected = render_loaded({"accel.type=hmq"}, good_);
-  std::mt19937_64 random(20261201);
-  std::size_t refused = 0, harmless = 0;
-  for (int trial = 0; trial < 300; ++trial) {
-    std::string damaged = bytes_;
-    const std::size_t at = random() % damaged.size();
-    damaged[at] = static_cast<char>(damaged[at] ^ static_cast<char>(1 + random() % 255));
-    write_all(path_, damaged);
-    try {
-      // A flip in the zero padding between sections touches no checked byte: the world
-      // must then load and render exactly as before.
-      EXPECT_TRUE(render_loaded({"accel.type=hmq"}, path_) == expected) << "flip at byte " << at;
-      ++harmless;
-    } catch (const SectionFileError& error) {
-      EXPECT_NE(std::string(error.what()).find(path_), std::string::npos);
-      ++refused;
-    }
-  }
-  EXPECT_GT(refused, 0u);
-  EXPECT_EQ(refused + harmless, 300u);
-}
-
-// The world-file fuzz target's findings, each a file whose checksums were re-sealed after a
-// change: before its structure was checked on load, each was a crash or a hang at the first
-// ray. Now each is an error naming the file and the section.
-struct CraftedCase {
-  std::string name;  // the test's
-  std::vector<std::string> settings;
-  std::string section;                      // under accel/
-  std::function<void(char* data)> damage;  // what the crafted file changes in it
-  std::string problem;                      // expected in the error
-};
-
-void PrintTo(const CraftedCase& c, std::ostream* out) { *out << c.name; }
-
-class CraftedWorld : public ::testing::TestWithParam<CraftedCase> {};
-
-template <typename T>
-void poke(char* at, T value) {
-  std::memcpy(at, &value, sizeof value);
-}
-
-TEST_P(CraftedWorld, IsRefusedOnLoadNamingTheSection) {
-  const CraftedCase& c = GetParam();
-  const std::string good = temp_path("crafted_good.wtw"), crafted = temp_path("crafted.wtw");
-  build_and_save(c.settings, good);
-  Resealer world(good);
-  c.damage(world.data("accel/" + c.section));
-  world.seal(crafted);
-  const std::string error = open_error(crafted);
-  EXPECT_NE(error.find(crafted), std::string::npos) << error;
-  EXPECT_NE(error.find("'accel/" + c.section + "'"), std::string::npos) << error;
-  EXPECT_NE(error.find(c.problem), std::string::npos) << "expected '" << c.problem << "' in: " << error;
-  fs::remove(good);
-  fs::remove(crafted);
-}
-
-// The quantized 8-wide root's first inner child made itself and its leaves past 2^30: the same
-// damage for HMQ's and Ray-Strips' wide tops, which share the node.
-void point_wide_node_past_its_arrays(char* node) {
-  poke<std::uint32_t>(node + 48, 0);        // child_base
-  poke<std::uint32_t>(node + 52, 1u << 30);  // leaf_base
-}
-
-// Offsets from the formats' comments: BvhNode first at 24 (bvh_node.hpp), WideBvhNode child[0]
-// at 192 and count[0] at 224 (wide_bvh_node.hpp), TriangleBlock slot[0] at 144
-// (triangle_block.hpp), QuantizedWideNode child_base at 48 and
-// leaf_base at 52 (quantized_wide_node.hpp), an HMQ block's node_slots at 0 (hmq_format.hpp),
-// a strip's triangle count at 0 (ray_strip_format.hpp).
-INSTANTIATE_TEST_SUITE_P(
-    FuzzFindings, CraftedWorld,
-    ::testing::Values(
-        CraftedCase{"BvhChildBeforeItsParent", {"accel.type=bvh"}, "bvh.nodes", [](char* d) { poke<std::uint32_t>(d + 24, 0); },
-                    "node 0 names child 0, which does not lie after it"},
-        CraftedCase{"WideBvhChildPastTheNodes", {"accel.type=bvh", "accel.bvh.width=8"}, "bvh8.nodes",
-                    [](char* d) {
-                      poke<std::uint32_t>(d + 192, 1u << 30);
-                      poke<std::uint8_t>(d + 224, 0);
-                    },
-                    "which does not lie after it"},
-        CraftedCase{"WideBvhLeafPastItsBlocks", {"accel.type=bvh", "accel.bvh.width=8"}, "bvh8.nodes",
-                    [](char* d) {
-                      for (char* node = d;; node += 256) {  // the first leaf lane: count != 0
-                        for (int lane = 0; lane < 8; ++lane) {
-                          if (d[224 + (node - d) + lane] != 0) return poke<std::uint32_t>(node + 192 + 4 * lane, 1u << 30);
-                        }
-                      }
-                    },
-                    "triangle blocks"},
-        CraftedCase{"TriangleBlockOfAMissingTriangle", {"accel.type=bvh", "accel.bvh.width=8"}, "bvh8.triangle_blocks",
-                    [](char* d) { poke<std::uint32_t>(d + 144, 1u << 30); }, "names a triangle that does not exist"},
-        CraftedCase{"ChunkedTopChildBeforeItsParent", {"accel.type=bvh", "build.chunk_triangles=4096"}, "chunked.top",
-                    [](char* d) { poke<std::uint32_t>(d + 24, 0); }, "does not lie after it"},
-        CraftedCase{"HmqBlockWithoutNodes", {"accel.type=hmq"}, "hmq.blocks", [](char* d) { poke<std::uint8_t>(d, 0); },
-                    "block at word 0: has 0 node and"},
-        CraftedCase{"WideHmqChildAndLeafPastTheirArrays", {"accel.type=hmq", "accel.hmq.width=8"}, "hmq8.nodes",
-                    point_wide_node_past_its_arrays,
-                    "node 0"},
-        CraftedCase{"WideHmqTogetherChildBeforeItsParent",
-                    {"accel.type=hmq", "accel.hmq.width=8", "accel.hmq.leaves_beside_nodes=true"}, "hmq8.tree",
-                    point_wide_node_past_its_arrays, "node at unit 0 names child 0"},
-        CraftedCase{"LeafOfMoreStripsThanFollowIt", {"accel.type=raystrips"}, "raystrips.nodes",
-                    [](char* d) {
-                      for (char* node = d;; node += 32) {  // the first leaf: count with bit 31
-                        std::uint32_t count;
-                        std::memcpy(&count, node + 28, 4);
-                        if (count & 0x80000000u) return poke<std::uint32_t>(node + 28, 0xffffffffu);
-                      }
-                    },
-                    "has a leaf of more strips than follow it"},
-        CraftedCase{"StripOfNoTriangles", {"accel.type=raystrips"}, "raystrips.strips", [](char* d) { poke<std::uint16_t>(d, 0); },
-                    "the strip at byte 0 has no triangles"},
-        CraftedCase{"WideRayStripsChildAndLeafPastTheirArrays", {"accel.type=raystrips", "accel.raystrips.width=8"}, "raystrips.wide_nodes",
-                    point_wide_node_past_its_arrays,
-                    "node 0"}),
-    [](const ::testing::TestParamInfo<CraftedCase>& info) { return info.param.name; });
-
-TEST(CraftedLeaves, GridLinesAndStripCornersStayInRangeForAnyInput) {
-  // A crafted box decoded to NaN or far outside the grid: the line conversion is defined;
-  // a box inside the grid gets the lines it always got.
-  const GlobalGrid grid = grid_from_bits(Bounds3{glm::vec3(0.0f), glm::vec3(1.0f)}, 8);
-  EXPECT_EQ(grid.floor_line(std::numeric_limits<float>::quiet_NaN(), 0), -(1 << 30));
-  EXPECT_EQ(grid.ceil_line(1e30f, 1), 1 << 30);
-  EXPECT_EQ(grid.floor_line(0.5f, 2), int(std::floor((0.5f - grid.origin.z) * grid.inverse_cell.z)));
-  // A corner code of two equal corners (a strip's repeat, or a crafted record) reads corners
-  // of the triangle, not past them (AddressSanitizer, in the sanitizer build, would report
-  // the read past the array); a code of two different corners gives the triangle's plane.
-  const glm::vec3 corners[3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
-  for (std::uint32_t code = 0; code < 8; ++code) {
-    HitBatch hits(1);
-    hits.set_hit(0, 1.0f, 0, 0.25f, 0.25f);
-    set_surface_from_strip(hits, 0, corners, code);
-    if (code / 3 != code % 3) {
-      EXPECT_FLOAT_EQ(std::fabs(hits.normal_z[0]), 1.0f) << code;
-    }
-  }
-}
 
 TEST(WorldFileCli, BuildRenderAndInfo) {
   const std::string world = temp_path("cli.wtw");
