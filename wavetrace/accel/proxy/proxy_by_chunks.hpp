@@ -28,9 +28,9 @@ namespace wavetrace {
 //   diagonal), since the streamed world cannot be traced whole while it is built.
 class ProxyByChunks {
  public:
+  // Throws SceneError for a share outside (0, 1].
   explicit ProxyByChunks(const ProxyOptions& options);
-  // One chunk's piece; thread-safe for distinct chunks. Throws SceneError for a share outside
-  // (0, 1].
+  // One chunk's piece; thread-safe for distinct chunks.
   void add(std::size_t chunk, std::size_t first, const TriangleMesh& mesh, const Accelerator& built);
   bool empty() const { return pieces_.empty(); }
   // The proxy from every piece added; throws SceneError when every chunk lost its triangles.
