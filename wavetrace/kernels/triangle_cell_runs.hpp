@@ -138,15 +138,19 @@ void for_each_triangle_cell_run(const glm::vec3& a, const glm::vec3& b, const gl
   using namespace triangle_cell_runs_detail;
   z_first = std::max(box_lower.z, z_first);
   z_last = std::min(box_upper.z, z_last);
-  if (box_lower.y == box_upper.y && box_lower.z == box_upper.z) {  // one row: the box's run is the triangle's
-    if (z_first <= z_last) run(box_lower.y, box_lower.z, box_lower.x, box_upper.x);
+  const bool thin_x = box_lower.x == box_upper.x, thin_y = box_lower.y == box_upper.y, thin_z = box_lower.z == box_upper.z;
+  if (int(thin_x) + int(thin_y) + int(thin_z) >= 2) {
+    // A line of cells: the triangle, connected and within the slack of each, meets them all.
+    for (std::uint32_t z = z_first; z <= z_last; ++z) {
+      for (std::uint32_t y = box_lower.y; y <= box_upper.y; ++y) run(y, z, box_lower.x, box_upper.x);
+    }
     return;
   }
   const TriangleLayers layers(a, b, c);
   for (std::uint32_t z = z_first; z <= z_last; ++z) {
     glm::dvec2 layer[5];  // the triangle's part in layer z
     const double bottom = frame.lower.z + double(z) * frame.cell_size.z;
-    const int corners = box_lower.z == box_upper.z  // in a box one layer thick: all of it
+    const int corners = thin_z  // in a box one layer thick: all of it
                             ? layers.section(-std::numeric_limits<double>::infinity(),
                                              std::numeric_limits<double>::infinity(), layer)
                             : layers.section(bottom - frame.slack.z, bottom + frame.cell_size.z + frame.slack.z, layer);
@@ -165,6 +169,10 @@ void for_each_triangle_cell_run(const glm::vec3& a, const glm::vec3& b, const gl
         cells_spanned(frame, 0, least, most, box_lower.x, box_upper.x, x_first, x_last);
       }
       run(y_first, z, x_first, x_last);
+      continue;
+    }
+    if (thin_x) {  // a column of rows one cell long: the part, connected, meets each
+      for (std::uint32_t y = y_first; y <= y_last; ++y) run(y, z, box_lower.x, box_lower.x);
       continue;
     }
     const EdgesAlongY edges(layer, corners);

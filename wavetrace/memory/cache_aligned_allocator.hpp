@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <cstdlib>
 #include <new>
 #include <string_view>
@@ -36,6 +37,16 @@ inline void* allocate_large_array(std::size_t bytes) {
   if (memory == nullptr) throw std::bad_alloc();
   if (huge) madvise(memory, align_up(bytes, alignment), MADV_HUGEPAGE);  // advice only: failure is harmless
   return memory;
+}
+
+// Hands the whole 4 KiB pages within [begin, end) back to the OS: for a large temporary read
+// front to back, whose part already read is no longer needed (it reads as zeros afterwards).
+// Advice only: where the OS refuses, the pages stay.
+inline void release_read_pages(const void* begin, const void* end) {
+  constexpr std::uintptr_t kPage = 4096;
+  const std::uintptr_t first = (reinterpret_cast<std::uintptr_t>(begin) + kPage - 1) & ~(kPage - 1);
+  const std::uintptr_t last = reinterpret_cast<std::uintptr_t>(end) & ~(kPage - 1);
+  if (first < last) madvise(reinterpret_cast<void*>(first), last - first, MADV_DONTNEED);
 }
 
 template <typename T>

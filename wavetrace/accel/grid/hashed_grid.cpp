@@ -1,7 +1,7 @@
-// Counting construction of the hashed grid (triangles bucketed by slabs of z layers, D bits,
-// first-fit row displacement for O, counts and prefix sums for H, insertion in triangle order
-// for L, each slab's cells filled by one task) and 3D-DDA traversal that stops once the
-// nearest hit found lies before the next cell.
+// Construction of the hashed grid in slabs of z layers (a slab task finds its triangles' runs
+// of cells once, and from them its D bits, first-fit row displacement for O, counts and prefix
+// sums for H; the slabs' parts appended in order, each list filled in triangle order) and
+// 3D-DDA traversal that stops once the nearest hit found lies before the next cell.
 #include "wavetrace/accel/grid/hashed_grid.hpp"
 
 #include <algorithm>
@@ -9,9 +9,12 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
 
 #include "wavetrace/accel/grid/grid_walk.hpp"
 #include "wavetrace/accel/hit_surface.hpp"
@@ -44,17 +47,13 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
     clock.lap(build_.phases, "bounds");
     bucket_by_slab();
     clock.lap(build_.phases, "slabs");
-    mark_cells();
-    clock.lap(build_.phases, "mark");
-    displace_rows();
-    clock.lap(build_.phases, "displace");
-    fill_lists(clock);
-    const std::size_t slab_bytes = slab_triangles_.size() * sizeof(std::uint32_t);
+    domain_.assign((std::size_t(cells_.x) * cells_.y * cells_.z + 63) / 64, 0);
+    build_slab_parts(clock);
     slab_triangles_ = {};
     build_macrocells(options.macrocell_factor);
     clock.lap(build_.phases, "macrocells");
     build_.seconds = clock.elapsed();
-    build_.peak_bytes = memory().total() + row_scratch_bytes_ + slab_bytes;  // an upper bound: the slabs go first
+    build_.peak_bytes = memory().total() + scratch_bytes_;  // an upper bound: the parts go as they are placed
   }
 
   std::string name() const override { return macrocell_factor_ > 0 ? "mlgrid" : "grid"; }
@@ -139,6 +138,7 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
     const std::size_t block_size = std::max<std::size_t>(4096, (triangles + kTriangleBlocks - 1) / kTriangleBlocks);
     const std::size_t blocks = (triangles + block_size - 1) / block_size;
     std::vector<std::size_t> counts(blocks * slabs, 0);  // [block][slab], then each one's offset
+    std::vector<std::size_t> box_cells(blocks, 0);
     const auto slabs_of = [&](std::size_t t) {
       const CellRange r = range_of(t);
       return std::pair(r.lower.z / slab_layers_, r.upper.z / slab_layers_);
@@ -146,10 +146,14 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
     tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t block) {
       std::size_t* block_counts = counts.data() + block * slabs;
       for (std::size_t t = block * block_size, end = std::min(triangles, t + block_size); t < end; ++t) {
-        const auto [first, last] = slabs_of(t);
-        for (std::uint32_t slab = first; slab <= last; ++slab) ++block_counts[slab];
+        const CellRange r = range_of(t);
+        const glm::uvec3 extent = r.upper - r.lower + 1u;
+        box_cells[block] += std::size_t(extent.x) * extent.y * extent.z;
+        for (std::uint32_t slab = r.lower.z / slab_layers_; slab <= r.upper.z / slab_layers_; ++slab) ++block_counts[slab];
       }
     });
+    entries_bound_ = 0;
+    for (const std::size_t cells : box_cells) entries_bound_ += cells;
     slab_starts_.assign(slabs + 1, 0);
     std::size_t total = 0;
     for (std::size_t slab = 0; slab < slabs; ++slab) {
@@ -171,126 +175,231 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
     });
   }
 
-  // Calls row_run(t, y, z, x_lower, x_upper) for each row of cells (y, z) that triangle t of a
-  // slab overlaps (its bounding box does, with kBoundingBoxes or bounding-box lists), within
-  // the slab's layers, triangles in ascending order; slabs in parallel.
-  template <bool kBoundingBoxes = false, typename RowRun>
-  void for_each_slab_row_run(RowRun&& row_run) const {
-    const CellGridFrame frame{glm::dvec3(bounds_.lower), glm::dvec3(cell_size_), glm::dvec3(cell_size_ * 1e-3f)};
-    tbb::parallel_for(std::size_t{0}, slab_starts_.size() - 1, [&](std::size_t slab) {
-      const std::uint32_t z_first = std::uint32_t(slab) * slab_layers_;
-      const std::uint32_t z_last = std::min(cells_.z - 1, z_first + slab_layers_ - 1);
-      for (std::size_t k = slab_starts_[slab]; k < slab_starts_[slab + 1]; ++k) {
-        const std::uint32_t t = slab_triangles_[k];
-        const CellRange r = range_of(t);
-        if (kBoundingBoxes || bounding_box_lists_) {
-          for (std::uint32_t z = std::max(r.lower.z, z_first); z <= std::min(r.upper.z, z_last); ++z) {
-            for (std::uint32_t y = r.lower.y; y <= r.upper.y; ++y) row_run(t, y, z, r.lower.x, r.upper.x);
-          }
-        } else {
-          const glm::uvec3& tri = mesh_.triangles[t];
-          for_each_triangle_cell_run(mesh_.positions[tri.x], mesh_.positions[tri.y], mesh_.positions[tri.z], frame,
-                                     r.lower, r.upper, z_first, z_last,
-                                     [&](std::uint32_t y, std::uint32_t z, std::uint32_t x_first, std::uint32_t x_last) {
-                                       row_run(t, y, z, x_first, x_last);
-                                     });
-        }
+  // A run of cells that a triangle of a slab overlaps, in 12 bytes: the slab's row
+  // (z - z_first)·My + y, and the cells first() ..= last() in it, at most kLongestRun of them
+  // (a longer run is several): x in the low 21 bits of `cells` (a grid has at most 2^21 cells
+  // a side), the count less one in the high 11.
+  struct SlabRowRun {
+    static constexpr std::uint32_t kLongestRun = 1u << 11;
+    std::uint32_t triangle, row, cells;
+    std::uint32_t first() const { return cells & ((1u << 21) - 1); }
+    std::uint32_t last() const { return first() + (cells >> 21); }
+  };
+  static_assert(sizeof(SlabRowRun) == 12);
+
+  // One slab's share of the grid: its rows' offsets and slots numbered from the slab's own
+  // first slot, its lists from its own first entry, and the scratch that made them. Rows of
+  // different slabs never share a slot, so each slab's slots and entries are one range of H
+  // and of L, appended in slab order. A part is reused from slab to slab, so the build's
+  // scratch is a few slabs' worth, touched once.
+  struct SlabPart {
+    std::vector<SlabRowRun> runs;
+    std::vector<std::uint64_t> occupied;     // the slab's D bits: bit row·Mx + x of the slab's rows
+    std::vector<std::uint64_t> taken;        // the slots its rows took (the paper's bH)
+    std::vector<std::uint32_t> row;          // one row's occupied cells
+    std::vector<std::uint32_t> row_offsets;  // kEmptyRow where the row has no occupied cell
+    std::vector<std::uint32_t> starts;       // the slab's H, and one past its last slot
+    std::size_t entries = 0;                 // its lists' length
+    double runs_seconds = 0.0, cells_seconds = 0.0;  // summed over the slabs it held
+  };
+  static constexpr std::uint32_t kEmptyRow = ~std::uint32_t{0};
+
+  // Slabs made in parallel and appended in order by a pipeline, a few in flight: L grows in
+  // place into room reserved for the most entries the triangles' boxes allow, so its pages
+  // are touched once, in order, and no list is copied twice.
+  void build_slab_parts(PhaseClock& clock) {
+    const std::size_t slabs = slab_starts_.size() - 1;
+    offsets_.assign(std::size_t(cells_.y) * cells_.z, 0);
+    starts_.clear();
+    items_.clear();
+    // Address space only, untouched pages cost nothing: L's room is the most entries the
+    // boxes allow, H's as much (in practice it needs fewer: about one slot per cell listed).
+    // Where the OS will not map that, the arrays grow by reallocation instead.
+    try {
+      items_.reserve(entries_bound_);
+      starts_.reserve(entries_bound_ + 1);
+    } catch (const std::bad_alloc&) {
+    }
+    const std::size_t in_flight = std::size_t(tbb::this_task_arena::max_concurrency()) + 1;
+    std::vector<SlabPart> parts(in_flight);
+    std::size_t next = 0;
+    tbb::parallel_pipeline(
+        in_flight,
+        tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
+                                            [&](tbb::flow_control& control) -> std::size_t {
+                                              if (next == slabs) control.stop();
+                                              return next++;
+                                            }) &
+            tbb::make_filter<std::size_t, std::size_t>(tbb::filter_mode::parallel,
+                                                       [&](std::size_t slab) {
+                                                         build_slab(slab, parts[slab % in_flight]);
+                                                         return slab;
+                                                       }) &
+            tbb::make_filter<std::size_t, void>(tbb::filter_mode::serial_in_order,
+                                                [&](std::size_t slab) { append_slab_part(slab, parts[slab % in_flight]); }));
+    starts_.push_back(checked_uint32(items_.size(), "grid cell entries; lower accel.grid.density"));
+    slot_count_ = starts_.size() - 1;
+    for (const SlabPart& part : parts) {
+      for (const auto& array : {part.row_offsets, part.starts, part.row}) {
+        scratch_bytes_ += array.capacity() * sizeof(std::uint32_t);
       }
-    });
+      scratch_bytes_ += part.runs.capacity() * sizeof(SlabRowRun) +
+                        (part.occupied.capacity() + part.taken.capacity()) * sizeof(std::uint64_t);
+    }
+    scratch_bytes_ += slab_triangles_.size() * sizeof(std::uint32_t);
+    clock.lap(build_.phases, "lists");
+    // The pipeline's stages overlap: their thread-seconds, summed over slabs.
+    double runs_seconds = 0.0, cells_seconds = 0.0;
+    for (const SlabPart& part : parts) runs_seconds += part.runs_seconds, cells_seconds += part.cells_seconds;
+    build_.phases.add("lists.runs", runs_seconds);
+    build_.phases.add("lists.cells", cells_seconds);
+    build_.phases.add("lists.append", append_seconds_);
   }
 
-  void mark_cells() {
-    const std::size_t cell_count = std::size_t(cells_.x) * cells_.y * cells_.z;
-    domain_.assign((cell_count + 63) / 64, 0);
-    // By bounding boxes whatever the lists (the header says why); a row run's bits a word at
-    // a time, atomic since a word may straddle two slabs' layers.
-    for_each_slab_row_run<true>([&](std::uint32_t, std::uint32_t y, std::uint32_t z, std::uint32_t x_lower, std::uint32_t x_upper) {
-      const std::size_t first = cell_index(x_lower, y, z), last = cell_index(x_upper, y, z);
-      for (std::size_t word = first / 64; word <= last / 64; ++word) {
-        std::uint64_t bits = ~std::uint64_t{0};
-        if (word == first / 64) bits &= ~std::uint64_t{0} << (first % 64);
-        if (word == last / 64) bits &= ~std::uint64_t{0} >> (63 - last % 64);
-        std::atomic_ref<std::uint64_t>(domain_[word]).fetch_or(bits, std::memory_order_relaxed);
+  // A slab's part after the slabs before it: its slots after theirs, and its lists, filled
+  // here from its runs in their (ascending triangle) order, after theirs.
+  void append_slab_part(std::size_t slab, SlabPart& part) {
+    PhaseClock clock;
+    const std::size_t slot_base = starts_.size(), entry_base = items_.size();
+    if (entry_base + part.entries > std::numeric_limits<std::uint32_t>::max()) {
+      throw std::runtime_error("grid: more than 2^32 cell entries; lower accel.grid.density");
+    }
+    std::uint32_t* offsets = offsets_.data() + slab * slab_layers_ * cells_.y;
+    for (std::size_t r = 0; r < part.row_offsets.size(); ++r) {
+      if (part.row_offsets[r] != kEmptyRow) {
+        offsets[r] = checked_uint32(slot_base + part.row_offsets[r], "grid row offset; lower accel.grid.max_cells");
       }
-    });
+    }
+    for (std::size_t slot = 0; slot + 1 < part.starts.size(); ++slot) {
+      starts_.push_back(static_cast<std::uint32_t>(entry_base + part.starts[slot]));
+    }
+    // The slabs up to this one are made, so the lists of their triangles are read.
+    release_read_pages(slab_triangles_.data(), slab_triangles_.data() + slab_starts_[slab + 1]);
+    items_.resize(entry_base + part.entries);
+    std::uint32_t* lists = items_.data() + entry_base;
+    for (const SlabRowRun& run : part.runs) {
+      std::uint32_t* cursors = part.starts.data() + part.row_offsets[run.row];
+      for (std::uint32_t x = run.first(), last = run.last(); x <= last; ++x) lists[cursors[x]++] = run.triangle;
+    }
+    append_seconds_ += clock.elapsed();
+  }
+
+  // One slab's runs, and from them its cells' D bits, its rows' first-fit displacement (from
+  // the slab's own first slot: slabs never share one), its counts, H and L. A slab's cells
+  // are its own, so only D's words at the slab's two ends are shared with another task.
+  void build_slab(std::size_t slab, SlabPart& part) {
+    const std::uint32_t z_first = std::uint32_t(slab) * slab_layers_;
+    const std::uint32_t z_last = std::min(cells_.z - 1, z_first + slab_layers_ - 1);
+    const std::size_t rows = std::size_t(z_last - z_first + 1) * cells_.y, row_cells = cells_.x;
+
+    PhaseClock clock;
+    std::vector<SlabRowRun>& runs = part.runs;
+    runs.clear();
+    const CellGridFrame frame{glm::dvec3(bounds_.lower), glm::dvec3(cell_size_), glm::dvec3(cell_size_ * 1e-3f)};
+    for (std::size_t k = slab_starts_[slab]; k < slab_starts_[slab + 1]; ++k) {
+      const std::uint32_t t = slab_triangles_[k];
+      const CellRange r = range_of(t);
+      const auto add = [&](std::uint32_t y, std::uint32_t z, std::uint32_t x_first, std::uint32_t x_last) {
+        const std::uint32_t row = (z - z_first) * cells_.y + y;
+        for (; x_last - x_first >= SlabRowRun::kLongestRun; x_first += SlabRowRun::kLongestRun) {
+          runs.push_back({t, row, x_first | ((SlabRowRun::kLongestRun - 1) << 21)});
+        }
+        runs.push_back({t, row, x_first | ((x_last - x_first) << 21)});
+      };
+      if (bounding_box_lists_) {
+        for (std::uint32_t z = std::max(r.lower.z, z_first); z <= std::min(r.upper.z, z_last); ++z) {
+          for (std::uint32_t y = r.lower.y; y <= r.upper.y; ++y) add(y, z, r.lower.x, r.upper.x);
+        }
+      } else {
+        const glm::uvec3& tri = mesh_.triangles[t];
+        for_each_triangle_cell_run(mesh_.positions[tri.x], mesh_.positions[tri.y], mesh_.positions[tri.z], frame,
+                                   r.lower, r.upper, z_first, z_last, add);
+      }
+    }
+
+    part.runs_seconds += clock.lap();
+    std::vector<std::uint64_t>& occupied = part.occupied;
+    occupied.assign((rows * row_cells + 63) / 64, 0);
+    for (const SlabRowRun& run : runs) set_bits(occupied, run.row * row_cells + run.first(), run.row * row_cells + run.last());
+    merge_into_domain(occupied, std::size_t(z_first) * cells_.y * row_cells);
+
+    // First fit from the last row's offset, as the paper builds O: each row's occupied cells
+    // land on slots that no earlier row of the slab took.
+    std::vector<std::uint64_t>& taken = part.taken;
+    taken.assign(std::max<std::size_t>(taken.size(), 1024), 0);
+    const auto is_taken = [&](std::size_t slot) { return slot / 64 < taken.size() && ((taken[slot / 64] >> (slot % 64)) & 1u); };
+    std::vector<std::uint32_t>& row = part.row;
+    part.row_offsets.assign(rows, kEmptyRow);
+    std::size_t last_offset = 0, used_slots = 0;
+    for (std::size_t r = 0; r < rows; ++r) {
+      row.clear();
+      for_each_set_bit(occupied.data(), r * row_cells, row_cells, [&](std::uint32_t x) { row.push_back(x); });
+      if (row.empty()) continue;  // never read: its D bits are all clear
+      std::size_t offset = last_offset;
+      while (std::any_of(row.begin(), row.end(), [&](std::uint32_t x) { return is_taken(offset + x); })) ++offset;
+      const std::size_t end = offset + row.back() + 1;
+      if ((end + 63) / 64 > taken.size()) taken.resize(std::max(taken.size() * 2, (end + 63) / 64), 0);
+      for (std::uint32_t x : row) taken[(offset + x) / 64] |= std::uint64_t{1} << ((offset + x) % 64);
+      part.row_offsets[r] = checked_uint32(offset, "grid row offset; lower accel.grid.max_cells");
+      used_slots = std::max(used_slots, end);
+      last_offset = offset;
+    }
+
+    // Counts per slot, then their exclusive prefix sums: where each slot's list starts.
+    auto& starts = part.starts;
+    starts.assign(used_slots + 1, 0);
+    for (const SlabRowRun& run : runs) {
+      std::uint32_t* slots = starts.data() + part.row_offsets[run.row];
+      for (std::uint32_t x = run.first(), last = run.last(); x <= last; ++x) ++slots[x];
+    }
+    std::uint64_t total = 0;
+    for (std::uint32_t& start : starts) {
+      const std::uint32_t count = start;
+      start = static_cast<std::uint32_t>(std::min<std::uint64_t>(total, std::numeric_limits<std::uint32_t>::max()));
+      total += count;
+    }
+    part.entries = total;
+    part.cells_seconds += clock.lap();
+  }
+
+  // Sets bits first ..= last.
+  static void set_bits(std::vector<std::uint64_t>& bits, std::size_t first, std::size_t last) {
+    for (std::size_t word = first / 64; word <= last / 64; ++word) {
+      std::uint64_t mask = ~std::uint64_t{0};
+      if (word == first / 64) mask &= ~std::uint64_t{0} << (first % 64);
+      if (word == last / 64) mask &= ~std::uint64_t{0} >> (63 - last % 64);
+      bits[word] |= mask;
+    }
+  }
+
+  // ORs a slab's bits into D from D's bit `first`: atomic, since a word at either end of the
+  // slab may hold another slab's cells.
+  void merge_into_domain(const std::vector<std::uint64_t>& bits, std::size_t first) {
+    const std::size_t first_word = first / 64, shift = first % 64;
+    const auto merge = [&](std::size_t word, std::uint64_t mask) {
+      if (mask != 0) std::atomic_ref<std::uint64_t>(domain_[word]).fetch_or(mask, std::memory_order_relaxed);
+    };
+    for (std::size_t word = 0; word < bits.size(); ++word) {
+      if (bits[word] == 0) continue;
+      merge(first_word + word, bits[word] << shift);
+      if (shift != 0) merge(first_word + word + 1, bits[word] >> (64 - shift));
+    }
+  }
+
+  // Calls f(i) for each set bit first + i of `bits`, i < count ascending: a word at a time,
+  // since rows are mostly empty.
+  template <typename F>
+  static void for_each_set_bit(const std::uint64_t* bits, std::size_t first, std::size_t count, F&& f) {
+    const std::size_t end = first + count;
+    for (std::size_t word = first / 64; word * 64 < end; ++word) {
+      std::uint64_t mask = bits[word];
+      if (word * 64 < first) mask &= ~std::uint64_t{0} << (first - word * 64);
+      if ((word + 1) * 64 > end) mask &= ~std::uint64_t{0} >> ((word + 1) * 64 - end);
+      for (; mask != 0; mask &= mask - 1) f(std::uint32_t(word * 64 + std::countr_zero(mask) - first));
+    }
   }
 
   bool occupied(std::size_t d) const { return (domain_[d / 64] >> (d % 64)) & 1u; }
-
-  // Calls f(x) for each occupied cell of row (y, z), x ascending: the row's D bits a word at
-  // a time, since rows are mostly empty.
-  template <typename F>
-  void for_each_occupied_cell_of_row(std::uint32_t y, std::uint32_t z, F&& f) const {
-    const std::size_t first = cell_index(0, y, z), row_end = first + cells_.x;
-    for (std::size_t word = first / 64; word * 64 < row_end; ++word) {
-      std::uint64_t bits = domain_[word];
-      if (word * 64 < first) bits &= ~std::uint64_t{0} << (first - word * 64);
-      if ((word + 1) * 64 > row_end) bits &= ~std::uint64_t{0} >> ((word + 1) * 64 - row_end);
-      for (; bits != 0; bits &= bits - 1) f(std::uint32_t(word * 64 + std::countr_zero(bits) - first));
-    }
-  }
-
-  // First fit from the last row's offset, as the paper builds O: each row's set cells land on
-  // slots of the shared bit array bH that no earlier row took.
-  void displace_rows() {
-    offsets_.assign(std::size_t(cells_.y) * cells_.z, 0);
-    std::vector<std::uint64_t> taken(1024, 0);
-    const auto is_taken = [&](std::size_t slot) { return slot / 64 < taken.size() && ((taken[slot / 64] >> (slot % 64)) & 1u); };
-    std::vector<std::uint32_t> row;
-    std::size_t last_offset = 0, used_slots = 0;
-    for (std::uint32_t z = 0; z < cells_.z; ++z) {
-      for (std::uint32_t y = 0; y < cells_.y; ++y) {
-        row.clear();
-        for_each_occupied_cell_of_row(y, z, [&](std::uint32_t x) { row.push_back(x); });
-        if (row.empty()) continue;  // never read: its D bits are all clear
-        std::size_t offset = last_offset;
-        while (std::any_of(row.begin(), row.end(), [&](std::uint32_t x) { return is_taken(offset + x); })) ++offset;
-        const std::size_t end = offset + row.back() + 1;
-        if ((end + 63) / 64 > taken.size()) taken.resize(std::max(taken.size() * 2, (end + 63) / 64), 0);
-        for (std::uint32_t x : row) taken[(offset + x) / 64] |= std::uint64_t{1} << ((offset + x) % 64);
-        offsets_[std::size_t(z) * cells_.y + y] = checked_uint32(offset, "grid row offset; lower accel.grid.max_cells");
-        used_slots = std::max(used_slots, end);
-        last_offset = offset;
-      }
-    }
-    slot_count_ = used_slots;
-    row_scratch_bytes_ = taken.size() * sizeof(std::uint64_t);
-  }
-
-  std::size_t slot_of(std::uint32_t x, std::uint32_t y, std::uint32_t z) const {
-    return offsets_[std::size_t(z) * cells_.y + y] + x;
-  }
-
-  // Counts per slot, exclusive prefix sums, then the lists: each slot belongs to one cell and
-  // each cell to one slab task, so counts and cursors are plain; H itself is the cursor (after
-  // the fill, H[slot] holds where slot + 1 starts, and one shift restores it).
-  void fill_lists(PhaseClock& clock) {
-    starts_.assign(slot_count_ + 1, 0);
-    for_each_slab_row_run([&](std::uint32_t, std::uint32_t y, std::uint32_t z, std::uint32_t x_lower, std::uint32_t x_upper) {
-      std::uint32_t* row = starts_.data() + slot_of(0, y, z);
-      for (std::uint32_t x = x_lower; x <= x_upper; ++x) ++row[x];
-    });
-    clock.lap(build_.phases, "count");
-    std::uint64_t total = 0;
-    for (std::uint32_t& start : starts_) {
-      const std::uint32_t count = start;
-      start = static_cast<std::uint32_t>(total);
-      total += count;
-    }
-    if (total > std::numeric_limits<std::uint32_t>::max()) {
-      throw std::runtime_error("grid: more than 2^32 cell entries; lower accel.grid.density");
-    }
-    clock.lap(build_.phases, "prefix");
-    items_.resize(total);
-    clock.lap(build_.phases, "allocate");
-    for_each_slab_row_run([&](std::uint32_t t, std::uint32_t y, std::uint32_t z, std::uint32_t x_lower, std::uint32_t x_upper) {
-      std::uint32_t* row = starts_.data() + slot_of(0, y, z);
-      for (std::uint32_t x = x_lower; x <= x_upper; ++x) items_[row[x]++] = t;
-    });
-    std::move_backward(starts_.begin(), starts_.end() - 1, starts_.end());
-    starts_[0] = 0;
-    clock.lap(build_.phases, "insert");
-  }
 
   // Macrocells (Wald et al. 2006, as the paper uses them): level k is a bit per block of
   // factor^k fine cells, set when any cell in the block holds items; levels stop at one block.
@@ -314,7 +423,8 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
       if (macrocells_.empty()) {
         tbb::parallel_for(std::size_t{0}, std::size_t(cells_.y) * cells_.z, [&](std::size_t row) {
           const auto y = std::uint32_t(row % cells_.y), z = std::uint32_t(row / cells_.y);
-          for_each_occupied_cell_of_row(y, z, [&](std::uint32_t x) { mark(glm::uvec3(x, y, z) / span); });
+          for_each_set_bit(domain_.data(), cell_index(0, y, z), cells_.x,
+                           [&](std::uint32_t x) { mark(glm::uvec3(x, y, z) / span); });
         });
       } else {
         const MacrocellLevel& below = macrocells_.back();
@@ -417,7 +527,9 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
   double effective_density_ = 0.0;
   std::size_t max_cells_ = 0;
   std::size_t slot_count_ = 0;
-  std::size_t row_scratch_bytes_ = 0;
+  std::size_t scratch_bytes_ = 0;  // the slab lists and the parts in flight (build only)
+  double append_seconds_ = 0.0;
+  std::size_t entries_bound_ = 0;  // L's length at most: the cells the triangles' boxes overlap
   // About this many slabs of z layers: enough for both cores to balance dense and empty ones,
   // few enough that a triangle's box rarely crosses more than two.
   static constexpr std::uint32_t kTargetSlabs = 256;
@@ -454,7 +566,7 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
   LargeArray<std::uint64_t> domain_;   // D
   LargeArray<std::uint32_t> offsets_;  // O
   LargeArray<std::uint32_t> starts_;   // H
-  UnfilledLargeArray<std::uint32_t> items_;  // L: sized unwritten, first touched by the slab tasks that fill it
+  UnfilledLargeArray<std::uint32_t> items_;  // L: grown unwritten, filled slab by slab
   BuildReport build_;
 };
 

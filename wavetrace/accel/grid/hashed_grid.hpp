@@ -6,17 +6,17 @@
 //
 // Layout (all arrays 32-bit words except D), for a grid of Mx × My × Mz cells:
 //   D  Mx·My·Mz bits          bit d = (z·My + y)·Mx + x, in 64-bit words lowest bit first
-//                             (word d / 64, bit d % 64): set where some triangle's bounding
-//                             box overlaps the cell (its list may still be empty, below)
-//   O  My·Mz words            O[z·My + y]: where row (y, z) starts in H (rows overlap, never collide)
+//                             (word d / 64, bit d % 64): set where the cell's list is not empty
+//   O  My·Mz words            O[z·My + y]: where row (y, z) starts in H (rows overlap, never
+//                             collide; 0 for a row with no bit set in D, never read)
 //   H  NH + 1 words           H[O[z·My + y] + x] .. H[... + 1]: the cell's range in L
 //   L  Σ items per cell words  triangle indices, ascending within a cell
 // A cell (x, y, z) holds triangles L[H[h] .. H[h + 1]) with h = O[z·My + y] + x, when its D
 // bit is set; otherwise it is empty and H is not read. Triangles are read in place from the
 // mesh (its indexed face set). A triangle is listed in every cell it overlaps (or, as in the
-// paper, every cell its bounding box overlaps: `bounding_box_lists`). D and O are the paper's
-// either way: marking by boxes is cheaper than by triangles and sets hardly more bits (5.0M
-// against 4.8M on builtin:room:8M), so a few cells with a D bit have an empty range in H.
+// paper, every cell its bounding box overlaps: `bounding_box_lists`). The build makes the grid
+// in slabs of z layers, and a slab's rows take slots after the slabs before it, so O places
+// rows first fit within a slab, as the paper does within the whole grid.
 #pragma once
 
 #include <memory>
