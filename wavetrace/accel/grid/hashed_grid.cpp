@@ -9,6 +9,7 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -200,43 +201,70 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
     std::vector<std::uint32_t> row_offsets;  // kEmptyRow where the row has no occupied cell
     std::vector<std::uint32_t> starts;       // the slab's H, and one past its last slot
     std::size_t entries = 0;                 // its lists' length
-    double runs_seconds = 0.0, cells_seconds = 0.0;  // summed over the slabs it held
+    std::size_t entry_base = 0;              // where its lists start in L, once placed
+    double stage_seconds[3] = {};            // runs, cells, fill: summed over the slabs it held
   };
   static constexpr std::uint32_t kEmptyRow = ~std::uint32_t{0};
 
-  // Slabs made in parallel and appended in order by a pipeline, a few in flight: L grows in
-  // place into room reserved for the most entries the triangles' boxes allow, so its pages
-  // are touched once, in order, and no list is copied twice.
+  // Slabs made in parallel, placed in order and filled in parallel by a pipeline, a few in
+  // flight: L grows in place into room reserved for the most entries the triangles' boxes
+  // allow, so each list is written once, where it stays, and L's fresh pages are first
+  // touched by both cores.
   void build_slab_parts(PhaseClock& clock) {
     const std::size_t slabs = slab_starts_.size() - 1;
     offsets_.assign(std::size_t(cells_.y) * cells_.z, 0);
     starts_.clear();
     items_.clear();
     // Address space only, untouched pages cost nothing: L's room is the most entries the
-    // boxes allow, H's as much (in practice it needs fewer: about one slot per cell listed).
-    // Where the OS will not map that, the arrays grow by reallocation instead.
+    // boxes allow, H's as much (in practice it needs about one slot per cell listed). Where
+    // the OS will not map that, the arrays grow by reallocation, and the lists are filled as
+    // each slab is placed.
+    bool lists_in_place = true;
     try {
       items_.reserve(entries_bound_);
       starts_.reserve(entries_bound_ + 1);
     } catch (const std::bad_alloc&) {
+      lists_in_place = false;
     }
-    const std::size_t in_flight = std::size_t(tbb::this_task_arena::max_concurrency()) + 1;
+    const std::size_t in_flight = std::size_t(tbb::this_task_arena::max_concurrency()) + 2;
     std::vector<SlabPart> parts(in_flight);
+    std::vector<SlabPart*> free_parts;  // a part per live token: one is free whenever a slab starts
+    for (SlabPart& part : parts) free_parts.push_back(&part);
+    std::mutex free_parts_mutex;
+    struct Work {
+      std::size_t slab;
+      SlabPart* part;
+    };
     std::size_t next = 0;
     tbb::parallel_pipeline(
         in_flight,
-        tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
-                                            [&](tbb::flow_control& control) -> std::size_t {
-                                              if (next == slabs) control.stop();
-                                              return next++;
-                                            }) &
-            tbb::make_filter<std::size_t, std::size_t>(tbb::filter_mode::parallel,
-                                                       [&](std::size_t slab) {
-                                                         build_slab(slab, parts[slab % in_flight]);
-                                                         return slab;
-                                                       }) &
-            tbb::make_filter<std::size_t, void>(tbb::filter_mode::serial_in_order,
-                                                [&](std::size_t slab) { append_slab_part(slab, parts[slab % in_flight]); }));
+        tbb::make_filter<void, Work>(tbb::filter_mode::serial_in_order,
+                                     [&](tbb::flow_control& control) -> Work {
+                                       if (next == slabs) {
+                                         control.stop();
+                                         return {};
+                                       }
+                                       const std::scoped_lock lock(free_parts_mutex);
+                                       SlabPart* part = free_parts.back();
+                                       free_parts.pop_back();
+                                       return {next++, part};
+                                     }) &
+            tbb::make_filter<Work, Work>(tbb::filter_mode::parallel,
+                                         [&](Work work) {
+                                           build_slab(work.slab, *work.part);
+                                           return work;
+                                         }) &
+            tbb::make_filter<Work, Work>(tbb::filter_mode::serial_in_order,
+                                         [&](Work work) {
+                                           place_slab_part(work.slab, *work.part);
+                                           if (!lists_in_place) fill_slab_lists(*work.part);
+                                           return work;
+                                         }) &
+            tbb::make_filter<Work, void>(tbb::filter_mode::parallel, [&](Work work) {
+              if (lists_in_place) fill_slab_lists(*work.part);
+              const std::scoped_lock lock(free_parts_mutex);
+              free_parts.push_back(work.part);
+            }));
     starts_.push_back(checked_uint32(items_.size(), "grid cell entries; lower accel.grid.density"));
     slot_count_ = starts_.size() - 1;
     for (const SlabPart& part : parts) {
@@ -249,19 +277,23 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
     scratch_bytes_ += slab_triangles_.size() * sizeof(std::uint32_t);
     clock.lap(build_.phases, "lists");
     // The pipeline's stages overlap: their thread-seconds, summed over slabs.
-    double runs_seconds = 0.0, cells_seconds = 0.0;
-    for (const SlabPart& part : parts) runs_seconds += part.runs_seconds, cells_seconds += part.cells_seconds;
-    build_.phases.add("lists.runs", runs_seconds);
-    build_.phases.add("lists.cells", cells_seconds);
-    build_.phases.add("lists.append", append_seconds_);
+    double seconds[3] = {};
+    for (const SlabPart& part : parts) {
+      for (int stage = 0; stage < 3; ++stage) seconds[stage] += part.stage_seconds[stage];
+    }
+    build_.phases.add("lists.runs", seconds[0]);
+    build_.phases.add("lists.cells", seconds[1]);
+    build_.phases.add("lists.fill", seconds[2]);
+    build_.phases.add("lists.place", place_seconds_);
   }
 
-  // A slab's part after the slabs before it: its slots after theirs, and its lists, filled
-  // here from its runs in their (ascending triangle) order, after theirs.
-  void append_slab_part(std::size_t slab, SlabPart& part) {
+  // A slab's part after the slabs before it: its rows' offsets and its slots after theirs,
+  // and the room for its lists after theirs.
+  void place_slab_part(std::size_t slab, SlabPart& part) {
     PhaseClock clock;
-    const std::size_t slot_base = starts_.size(), entry_base = items_.size();
-    if (entry_base + part.entries > std::numeric_limits<std::uint32_t>::max()) {
+    const std::size_t slot_base = starts_.size();
+    part.entry_base = items_.size();
+    if (part.entry_base + part.entries > std::numeric_limits<std::uint32_t>::max()) {
       throw std::runtime_error("grid: more than 2^32 cell entries; lower accel.grid.density");
     }
     std::uint32_t* offsets = offsets_.data() + slab * slab_layers_ * cells_.y;
@@ -271,17 +303,23 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
       }
     }
     for (std::size_t slot = 0; slot + 1 < part.starts.size(); ++slot) {
-      starts_.push_back(static_cast<std::uint32_t>(entry_base + part.starts[slot]));
+      starts_.push_back(static_cast<std::uint32_t>(part.entry_base + part.starts[slot]));
     }
     // The slabs up to this one are made, so the lists of their triangles are read.
     release_read_pages(slab_triangles_.data(), slab_triangles_.data() + slab_starts_[slab + 1]);
-    items_.resize(entry_base + part.entries);
-    std::uint32_t* lists = items_.data() + entry_base;
+    items_.resize(part.entry_base + part.entries);  // within the room reserved: L does not move
+    place_seconds_ += clock.elapsed();
+  }
+
+  // A placed slab's lists, from its runs in their (ascending triangle) order.
+  void fill_slab_lists(SlabPart& part) {
+    PhaseClock clock;
+    std::uint32_t* lists = items_.data() + part.entry_base;
     for (const SlabRowRun& run : part.runs) {
       std::uint32_t* cursors = part.starts.data() + part.row_offsets[run.row];
       for (std::uint32_t x = run.first(), last = run.last(); x <= last; ++x) lists[cursors[x]++] = run.triangle;
     }
-    append_seconds_ += clock.elapsed();
+    part.stage_seconds[2] += clock.elapsed();
   }
 
   // One slab's runs, and from them its cells' D bits, its rows' first-fit displacement (from
@@ -317,7 +355,7 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
       }
     }
 
-    part.runs_seconds += clock.lap();
+    part.stage_seconds[0] += clock.lap();
     std::vector<std::uint64_t>& occupied = part.occupied;
     occupied.assign((rows * row_cells + 63) / 64, 0);
     for (const SlabRowRun& run : runs) set_bits(occupied, run.row * row_cells + run.first(), run.row * row_cells + run.last());
@@ -359,7 +397,7 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
       total += count;
     }
     part.entries = total;
-    part.cells_seconds += clock.lap();
+    part.stage_seconds[1] += clock.lap();
   }
 
   // Sets bits first ..= last.
@@ -528,7 +566,7 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
   std::size_t max_cells_ = 0;
   std::size_t slot_count_ = 0;
   std::size_t scratch_bytes_ = 0;  // the slab lists and the parts in flight (build only)
-  double append_seconds_ = 0.0;
+  double place_seconds_ = 0.0;
   std::size_t entries_bound_ = 0;  // L's length at most: the cells the triangles' boxes overlap
   // About this many slabs of z layers: enough for both cores to balance dense and empty ones,
   // few enough that a triangle's box rarely crosses more than two.
