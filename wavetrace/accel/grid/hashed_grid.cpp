@@ -568,9 +568,9 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
   std::size_t scratch_bytes_ = 0;  // the slab lists and the parts in flight (build only)
   double place_seconds_ = 0.0;
   std::size_t entries_bound_ = 0;  // L's length at most: the cells the triangles' boxes overlap
-  // About this many slabs of z layers: enough for both cores to balance dense and empty ones,
-  // few enough that a triangle's box rarely crosses more than two.
-  static constexpr std::uint32_t kTargetSlabs = 256;
+  // About this many slabs of z layers: enough that a slab's runs (a part's scratch) stay a
+  // few MiB, few enough that a triangle's box rarely crosses more than two.
+  static constexpr std::uint32_t kTargetSlabs = 512;
   static constexpr std::size_t kTriangleBlocks = 64;
   std::uint32_t slab_layers_ = 1;
   std::vector<std::size_t> slab_starts_;      // slab s lists slab_triangles_[starts[s] .. starts[s + 1])
