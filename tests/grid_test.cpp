@@ -211,10 +211,10 @@ TEST(Grid, BuildIsTheSameOnAnyThreadCountAndEveryListAscends) {
           phase_seconds += grid->build().phases.seconds(phase);
         }
         EXPECT_LE(phase_seconds, grid->build().seconds);
-        for (const char* stage : {"lists.runs", "lists.cells", "lists.append"}) {  // thread-seconds, overlapping
+        for (const char* stage : {"lists.runs", "lists.cells", "lists.place", "lists.fill"}) {  // thread-seconds, overlapping
           EXPECT_GT(grid->build().phases.seconds(stage), 0.0) << stage;
         }
-        EXPECT_EQ(grid->build().phases.entries().size(), 7u);
+        EXPECT_EQ(grid->build().phases.entries().size(), 8u);
         for (const auto span : grid->memory_spans()) arrays_by_threads[threads - 1].emplace_back(span.begin(), span.end());
       });
     }
