@@ -334,7 +334,14 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
     std::vector<SlabRowRun>& runs = part.runs;
     runs.clear();
     const CellGridFrame frame{glm::dvec3(bounds_.lower), glm::dvec3(cell_size_), glm::dvec3(cell_size_ * 1e-3f)};
-    for (std::size_t k = slab_starts_[slab]; k < slab_starts_[slab + 1]; ++k) {
+    const std::size_t slab_end = slab_starts_[slab + 1];
+    for (std::size_t k = slab_starts_[slab]; k < slab_end; ++k) {
+      // A slab's triangles are scattered over the mesh: their corners fetched ahead.
+      if (k + kPrefetchAhead < slab_end) {
+        const glm::uvec3& ahead = mesh_.triangles[slab_triangles_[k + kPrefetchAhead]];
+        for (int corner = 0; corner < 3; ++corner) __builtin_prefetch(&mesh_.positions[ahead[corner]]);
+      }
+      if (k + 2 * kPrefetchAhead < slab_end) __builtin_prefetch(&mesh_.triangles[slab_triangles_[k + 2 * kPrefetchAhead]]);
       const std::uint32_t t = slab_triangles_[k];
       const CellRange r = range_of(t);
       const auto add = [&](std::uint32_t y, std::uint32_t z, std::uint32_t x_first, std::uint32_t x_last) {
@@ -572,6 +579,7 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
   // few MiB, few enough that a triangle's box rarely crosses more than two.
   static constexpr std::uint32_t kTargetSlabs = 512;
   static constexpr std::size_t kTriangleBlocks = 64;
+  static constexpr std::size_t kPrefetchAhead = 8;  // triangles
   std::uint32_t slab_layers_ = 1;
   std::vector<std::size_t> slab_starts_;      // slab s lists slab_triangles_[starts[s] .. starts[s + 1])
   UnfilledLargeArray<std::uint32_t> slab_triangles_;  // build temporary: sized unwritten, filled, freed after the lists
