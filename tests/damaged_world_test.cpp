@@ -17,10 +17,7 @@
 namespace wavetrace {
 namespace {
 
-using namespace world_testing;
-namespace fs = std::filesystem;
-using section_file::Header;
-using section_file::TableEntry;
+using namespace world_testing;  // and its fs, Header and TableEntry
 
 class DamagedWorld : public ::testing::Test {
  protected:

@@ -31,10 +31,7 @@
 namespace wavetrace {
 namespace {
 
-using namespace world_testing;
-namespace fs = std::filesystem;
-using section_file::Header;
-using section_file::TableEntry;
+using namespace world_testing;  // and its fs, Header and TableEntry
 
 // A writer works in an unnamed file and renames at finish(): a failed save leaves no file and
 // keeps the world that was there, and a process with that world mapped keeps reading it

@@ -92,6 +92,10 @@ TriangleMesh cleaned_proxy_mesh(TriangleMesh simplified) {
   return simplified;
 }
 
+std::size_t proxy_target_triangles(double share, std::size_t mesh_triangles) {
+  return static_cast<std::size_t>(std::max(4.0, std::round(share * double(mesh_triangles))));
+}
+
 bool clustering_wins(const std::optional<ProxyQuality>& cluster, const std::optional<ProxyQuality>& stochastic) {
   return cluster && (!stochastic || cluster->hit_overlap >= stochastic->hit_overlap);
 }
@@ -101,7 +105,7 @@ Proxy::Proxy(const TriangleMesh& mesh, const ProxyOptions& options, const Accele
   if (!(options.share > 0.0 && options.share <= 1.0)) {
     throw SceneError(fmt::format("proxy share {} must be in (0, 1]", options.share));
   }
-  const auto target = static_cast<std::size_t>(std::max(4.0, std::round(options.share * double(mesh.triangle_count()))));
+  const std::size_t target = proxy_target_triangles(options.share, mesh.triangle_count());
   const auto start = std::chrono::steady_clock::now();
   double cell_size = 0.0;
   const auto clustered = [&] {

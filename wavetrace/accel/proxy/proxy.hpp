@@ -73,6 +73,8 @@ class Proxy {
   float surface_tolerance_ = 0.0f;
 };
 
+// The triangles a simplification aims for: the share of the mesh's, at least a tetrahedron's.
+std::size_t proxy_target_triangles(double share, std::size_t mesh_triangles);
 // A simplification's mesh cleaned as a scene's is, or empty where the method lost every
 // triangle (an empty result marks a method that failed there).
 TriangleMesh cleaned_proxy_mesh(TriangleMesh simplified);

@@ -31,7 +31,7 @@ void ProxyByChunks::add(std::size_t chunk, std::size_t first, const TriangleMesh
   Piece piece;
   piece.scene_triangles = mesh.triangle_count();
   piece.diagonal = mesh.bounds().diagonal();
-  const auto target = static_cast<std::size_t>(std::max(4.0, std::round(options_.share * double(mesh.triangle_count()))));
+  const std::size_t target = proxy_target_triangles(options_.share, mesh.triangle_count());
   ClusterSimplification clustered = simplify_by_clustering(mesh, target);
   piece.cell_size = clustered.cell_size;  // the scale of either method, as for a whole mesh
   const auto judge = [&](const TriangleMesh& candidate) -> std::optional<ProxyQuality> {
