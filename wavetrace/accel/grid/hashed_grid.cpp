@@ -219,12 +219,13 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
     // boxes allow, H's as much (in practice it needs about one slot per cell listed). Where
     // the OS will not map that, the arrays grow by reallocation, and the lists are filled as
     // each slab is placed.
-    bool lists_in_place = true;
+    const std::size_t most_entries = std::min<std::size_t>(entries_bound_, std::numeric_limits<std::uint32_t>::max());
     try {
-      items_.reserve(entries_bound_);
-      starts_.reserve(entries_bound_ + 1);
+      items_.reserve(most_entries);
+      starts_.reserve(most_entries + 1);
+      lists_in_place_ = true;
     } catch (const std::bad_alloc&) {
-      lists_in_place = false;
+      lists_in_place_ = false;
     }
     const std::size_t in_flight = std::size_t(tbb::this_task_arena::max_concurrency()) + 2;
     std::vector<SlabPart> parts(in_flight);
@@ -257,11 +258,11 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
             tbb::make_filter<Work, Work>(tbb::filter_mode::serial_in_order,
                                          [&](Work work) {
                                            place_slab_part(work.slab, *work.part);
-                                           if (!lists_in_place) fill_slab_lists(*work.part);
+                                           if (!lists_in_place_) fill_slab_lists(*work.part);
                                            return work;
                                          }) &
             tbb::make_filter<Work, void>(tbb::filter_mode::parallel, [&](Work work) {
-              if (lists_in_place) fill_slab_lists(*work.part);
+              if (lists_in_place_) fill_slab_lists(*work.part);
               const std::scoped_lock lock(free_parts_mutex);
               free_parts.push_back(work.part);
             }));
@@ -307,7 +308,11 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
     }
     // The slabs up to this one are made, so the lists of their triangles are read.
     release_read_pages(slab_triangles_.data(), slab_triangles_.data() + slab_starts_[slab + 1]);
-    items_.resize(part.entry_base + part.entries);  // within the room reserved: L does not move
+    // Within the room reserved L must not move: earlier slabs' lists are being written.
+    if (lists_in_place_ && part.entry_base + part.entries > items_.capacity()) {
+      throw std::logic_error("grid: the lists outgrew the room their triangles' boxes allow");
+    }
+    items_.resize(part.entry_base + part.entries);
     place_seconds_ += clock.elapsed();
   }
 
@@ -574,6 +579,7 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
   std::size_t slot_count_ = 0;
   std::size_t scratch_bytes_ = 0;  // the slab lists and the parts in flight (build only)
   double place_seconds_ = 0.0;
+  bool lists_in_place_ = true;  // L's room reserved: slabs' lists filled in parallel (build only)
   std::size_t entries_bound_ = 0;  // L's length at most: the cells the triangles' boxes overlap
   // About this many slabs of z layers: enough that a slab's runs (a part's scratch) stay a
   // few MiB, few enough that a triangle's box rarely crosses more than two.
