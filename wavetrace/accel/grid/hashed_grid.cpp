@@ -189,10 +189,10 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
   static_assert(sizeof(SlabRowRun) == 12);
 
   // One slab's share of the grid: its rows' offsets and slots numbered from the slab's own
-  // first slot, its lists from its own first entry, and the scratch that made them. Rows of
-  // different slabs never share a slot, so each slab's slots and entries are one range of H
-  // and of L, appended in slab order. A part is reused from slab to slab, so the build's
-  // scratch is a few slabs' worth, touched once.
+  // first slot, where each slot's list starts from the slab's own first entry, and the runs
+  // its lists are filled from. Rows of different slabs never share a slot, so each slab's
+  // slots and entries are one range of H and of L, in slab order. A part is reused from slab
+  // to slab, so the build's scratch is a few slabs' worth, touched once.
   struct SlabPart {
     std::vector<SlabRowRun> runs;
     std::vector<std::uint64_t> occupied;     // the slab's D bits: bit row·Mx + x of the slab's rows
@@ -328,8 +328,9 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
   }
 
   // One slab's runs, and from them its cells' D bits, its rows' first-fit displacement (from
-  // the slab's own first slot: slabs never share one), its counts, H and L. A slab's cells
-  // are its own, so only D's words at the slab's two ends are shared with another task.
+  // the slab's own first slot: slabs never share one), its counts and their prefix sums. A
+  // slab's cells are its own, so only D's words at the slab's two ends are shared with
+  // another task.
   void build_slab(std::size_t slab, SlabPart& part) {
     const std::uint32_t z_first = std::uint32_t(slab) * slab_layers_;
     const std::uint32_t z_last = std::min(cells_.z - 1, z_first + slab_layers_ - 1);
@@ -582,13 +583,14 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
   bool lists_in_place_ = true;  // L's room reserved: slabs' lists filled in parallel (build only)
   std::size_t entries_bound_ = 0;  // L's length at most: the cells the triangles' boxes overlap
   // About this many slabs of z layers: enough that a slab's runs (a part's scratch) stay a
-  // few MiB, few enough that a triangle's box rarely crosses more than two.
+  // few MiB, few enough that a triangle is visited again in only a few neighbouring slabs
+  // (room:8M: 2 layers a slab; 4 build as fast and hold more runs at once).
   static constexpr std::uint32_t kTargetSlabs = 512;
   static constexpr std::size_t kTriangleBlocks = 64;
   static constexpr std::size_t kPrefetchAhead = 8;  // triangles
   std::uint32_t slab_layers_ = 1;
   std::vector<std::size_t> slab_starts_;      // slab s lists slab_triangles_[starts[s] .. starts[s + 1])
-  UnfilledLargeArray<std::uint32_t> slab_triangles_;  // build temporary: sized unwritten, filled, freed after the lists
+  UnfilledLargeArray<std::uint32_t> slab_triangles_;  // build temporary: sized unwritten, filled, handed back as read
   struct MacrocellLevel {
     std::uint32_t span = 1;  // fine cells per block side
     glm::uvec3 cells{1};
