@@ -92,6 +92,10 @@ TriangleMesh cleaned_proxy_mesh(TriangleMesh simplified) {
   return simplified;
 }
 
+void check_proxy_share(double share) {
+  if (!(share > 0.0 && share <= 1.0)) throw SceneError(fmt::format("proxy share {} must be in (0, 1]", share));
+}
+
 std::size_t proxy_target_triangles(double share, std::size_t mesh_triangles) {
   return static_cast<std::size_t>(std::max(4.0, std::round(share * double(mesh_triangles))));
 }
@@ -102,9 +106,7 @@ bool clustering_wins(const std::optional<ProxyQuality>& cluster, const std::opti
 
 Proxy::Proxy(const TriangleMesh& mesh, const ProxyOptions& options, const Accelerator& scene_accelerator)
     : scene_bounds_(mesh.bounds()) {
-  if (!(options.share > 0.0 && options.share <= 1.0)) {
-    throw SceneError(fmt::format("proxy share {} must be in (0, 1]", options.share));
-  }
+  check_proxy_share(options.share);
   const std::size_t target = proxy_target_triangles(options.share, mesh.triangle_count());
   const auto start = std::chrono::steady_clock::now();
   double cell_size = 0.0;

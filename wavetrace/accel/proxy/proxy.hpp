@@ -73,6 +73,8 @@ class Proxy {
   float surface_tolerance_ = 0.0f;
 };
 
+// Throws SceneError for a share outside (0, 1].
+void check_proxy_share(double share);
 // The triangles a simplification aims for: the share of the mesh's, at least a tetrahedron's.
 std::size_t proxy_target_triangles(double share, std::size_t mesh_triangles);
 // A simplification's mesh cleaned as a scene's is, or empty where the method lost every

@@ -21,9 +21,7 @@ constexpr std::size_t kChunkTestRays = 4096;
 }  // namespace
 
 ProxyByChunks::ProxyByChunks(const ProxyOptions& options) : options_(options) {
-  if (!(options.share > 0.0 && options.share <= 1.0)) {
-    throw SceneError(fmt::format("proxy share {} must be in (0, 1]", options.share));
-  }
+  check_proxy_share(options.share);
 }
 
 void ProxyByChunks::add(std::size_t chunk, std::size_t first, const TriangleMesh& mesh, const Accelerator& built) {
