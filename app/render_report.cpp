@@ -84,6 +84,10 @@ std::string memory_lines(const std::vector<StageStats>& stages) {
   return lines;
 }
 
+nlohmann::json spill_json(const SpillCounters& spill) {
+  return {{"bytes_written", spill.bytes_written}, {"bytes_read", spill.bytes_read}, {"seconds", spill.seconds}, {"runs", spill.runs}};
+}
+
 nlohmann::json disk_parts_json(const DiskStats& disk) {
   nlohmann::json parts = nlohmann::json::object();
   for (const auto& [part, faults] : disk.faults_by_part) parts[part] = faults;
@@ -135,12 +139,7 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
                                                                 : std::nullopt)}};
     }
     if (stage.cache) entry["cache"] = cache_json(*stage.cache);
-    if (stage.spill) {
-      entry["spill"] = {{"bytes_written", stage.spill->bytes_written},
-                        {"bytes_read", stage.spill->bytes_read},
-                        {"seconds", stage.spill->seconds},
-                        {"runs", stage.spill->runs}};
-    }
+    if (stage.spill) entry["spill"] = spill_json(*stage.spill);
     stages.push_back(entry);
   }
   nlohmann::json hit_rates = nlohmann::json::array();
@@ -187,11 +186,13 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
   if (const std::optional<PhotonPassReport>& photons = facts.output.photons) {
     nlohmann::json photon_stages = nlohmann::json::array();
     for (const StageStats& stage : photons->run.stages) {
-      photon_stages.push_back({{"name", stage.name},
-                               {"rays_in", stage.rays_in},
-                               {"rays_out", stage.rays_out},
-                               {"seconds", stage.seconds},
-                               {"mrays_per_s", stage.mrays_per_s()}});
+      nlohmann::json entry = {{"name", stage.name},
+                              {"rays_in", stage.rays_in},
+                              {"rays_out", stage.rays_out},
+                              {"seconds", stage.seconds},
+                              {"mrays_per_s", stage.mrays_per_s()}};
+      if (stage.spill) entry["spill"] = spill_json(*stage.spill);
+      photon_stages.push_back(entry);
     }
     stats["photons"] = {{"emitted", photons->emitted},
                         {"global_photons", photons->global_photons},
@@ -203,6 +204,12 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
                         {"map_seconds", photons->map_seconds},
                         {"precomputed", photons->precomputed},
                         {"stages", photon_stages}};
+    if (photons->disk) {
+      stats["photons"]["disk"] = {{"faults", photons->disk->faults},
+                                  {"bytes_read", photons->disk->bytes_read},
+                                  {"read_seconds", photons->disk->read_seconds},
+                                  {"wait_seconds", photons->disk->wait_seconds}};
+    }
   }
   stats["render"] = render;
   const RenderPhases& measured = facts.phases;
@@ -284,6 +291,12 @@ std::string render_table(const RenderFacts& facts) {
                          photons->emitted, photons->run.seconds, photons->global_photons, photons->caustic_photons,
                          photons->map_seconds, photons->precomputed, facts.plan.photon.k, photons->radius);
     table += stage_rows(photons->run);
+    if (photons->disk) {
+      table += fmt::format("photon pass disk: {} real faults, {:.1f} MB read in {:.3f} s, {:.3f} s waited for pages "
+                           "(within the camera pass's trace disk line, which counts the whole render)\n",
+                           photons->disk->faults, double(photons->disk->bytes_read) * 1e-6, photons->disk->read_seconds,
+                           photons->disk->wait_seconds);
+    }
     table += "camera pass:\n";
   }
   table += stage_rows(run);

@@ -169,6 +169,33 @@ TEST(WorldFile, RealPagingChangesNoPixelAndCountsItsReadsOnTwoAndEightThreads) {
   fs::remove(path);
 }
 
+// Photon mapping paged from a world file: the same image as in core, and the photon pass's
+// reads reported apart, a part of the whole render's that the camera pass's trace reports.
+TEST(WorldFile, PagedPhotonMappingReportsThePhotonPassReadsApart) {
+  const std::string path = temp_path("photons_paged.wtw");
+  std::vector<std::string> settings = {"accel.type=hmq", "build.chunk_triangles=4096", "render.integrator=photon",
+                                       "photon.count=20000", "photon.gather_rays=2", "render.max_depth=3"};
+  const std::vector<float> in_core = build_and_save(settings, path);
+  for (const char* s : {"memory.backing=file", "memory.budget=5%", "memory.page_bytes=4096"}) settings.emplace_back(s);
+  const RenderPlan plan = plan_render(small_render(settings));
+  const std::unique_ptr<LoadedWorld> world = load_world(path, world_paging(plan), 2);
+  const RenderOutput output = render_image(
+      plan, World{world->scene, *world->accelerator, *world->lights, nullptr, world->file->pager()},
+      resolve_camera(plan.camera, world->scene));
+  EXPECT_TRUE(output.image == in_core);
+  ASSERT_TRUE(output.photons.has_value());
+  ASSERT_TRUE(output.photons->disk.has_value());
+  const DiskCounters& photon_pass = *output.photons->disk;
+  EXPECT_GT(photon_pass.faults, 0u);
+  EXPECT_EQ(photon_pass.bytes_read, photon_pass.faults * 4096);
+  std::uint64_t whole_render = 0;
+  for (const StageStats& stage : output.run.stages) {
+    if (stage.name == "trace") whole_render = stage.disk->counters.faults;
+  }
+  EXPECT_GT(whole_render, photon_pass.faults);  // the camera pass read pages too
+  fs::remove(path);
+}
+
 // memory.page_trace: a paged render writes the pages its probes touched, each a page of the
 // file, at least one per read from disk that a probe announced.
 TEST(WorldFile, APagedRenderWritesItsPageTrace) {

@@ -69,6 +69,7 @@ ReorderBenchResult result_of(ReorderHeuristic heuristic, const RenderOutput& out
     // The photon pass is traced and reordered as the camera pass is: its stages count too
     // (and [memory]'s counters above already hold both passes').
     result.photon_seconds = output.photons->run.seconds + output.photons->map_seconds;
+    if (output.photons->disk) result.photon_disk_faults = output.photons->disk->faults;
     for (const StageStats& stage : output.photons->run.stages) {
       if (stage.name == "trace") {
         result.trace_seconds += stage.seconds;
@@ -195,6 +196,7 @@ nlohmann::json to_json(const ReorderBenchReport& report) {
                        {"simulated_io_seconds", json_or_null(r.simulated_io_seconds)},
                        {"cache_misses", json_or_null(r.cache_misses)},
                        {"disk_faults", json_or_null(r.disk_faults)},
+                       {"photon_disk_faults", json_or_null(r.photon_disk_faults)},
                        {"disk_bytes_read", json_or_null(r.disk_bytes_read)},
                        {"disk_read_seconds", json_or_null(r.disk_read_seconds)},
                        {"disk_wait_seconds", json_or_null(r.disk_wait_seconds)},
@@ -225,13 +227,15 @@ std::string to_table(const ReorderBenchReport& report) {
                                   report.rounds > 1 ? fmt::format("; the median of {} rounds", report.rounds) : "");
   if (report.proxy) table += "proxy: " + *report.proxy + "\n";
   const bool disk = !report.results.empty() && report.results.front().disk_faults.has_value();
+  const bool photons = !report.results.empty() && report.results.front().photon_seconds > 0.0;
   table += fmt::format("{:<11} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>8} {:>9} {:>10} {:>9} {:>11} {:>11} {:>9} {:>10}",
                        "heuristic", "render s", "trace s", "Mr/s/thr", "closest", "shadow", "approx s", "sort s",
                        "overhead", "faults", "sim I/O s", "misses", "vs first", "speedup", "identical");
-  table += disk ? fmt::format(" {:>11} {:>9} {:>9} {:>9} {:>11} {:>10} {:>10} {:>10} {:>10} {:>9}\n", "disk faults",
+  table += disk ? fmt::format(" {:>11} {:>9} {:>9} {:>9} {:>11} {:>10} {:>10} {:>10} {:>10} {:>9}", "disk faults",
                               "disk MB", "read s", "wait s", "disk vs 1st", "rays/page", "pages/1k", "read ahead",
                               "ahead hits", "in flight")
-                : "\n";
+                : "";
+  table += photons ? fmt::format(" {:>9}{}\n", "photon s", disk ? fmt::format(" {:>13}", "photon faults") : "") : "\n";
   const ReorderBenchResult* first = report.results.empty() ? nullptr : &report.results.front();
   const auto optional = [](const auto& value, const char* format) {
     return value ? fmt::format(fmt::runtime(format), *value) : std::string("-");
@@ -257,6 +261,10 @@ std::string to_table(const ReorderBenchReport& report) {
                            optional(r.disk_pages_per_1000_rays, "{:.1f}"), optional(r.disk_prefetched, "{}"),
                            optional(r.disk_prefetch_hits, "{}"), optional(r.disk_reads_in_flight_max, "{}"));
     }
+    if (photons) {
+      table += fmt::format(" {:>9.3f}", r.photon_seconds);
+      if (disk) table += fmt::format(" {:>13}", optional(r.photon_disk_faults, "{}"));
+    }
     table += "\n";
   }
   table += "Mr/s/thr: trace's rays per busy thread-second (closest: camera and bounce rays; shadow: any-hit rays)\n"
@@ -267,6 +275,10 @@ std::string to_table(const ReorderBenchReport& report) {
              "rays/page: rays traced per page of the world file; pages/1k: distinct pages 1,000 consecutive traced rays touch;\n"
              "read ahead: of the faults, pages trace's look-ahead read before trace reached them (memory.look_ahead);\n"
              "ahead hits: of those, pages trace read before they were evicted; in flight: the most reads under way at once\n";
+  }
+  if (photons) {
+    table += "photon s: photon mapping's photon pass and maps (within render s)";
+    table += disk ? "; photon faults: the disk faults of the photon pass (within disk faults)\n" : "\n";
   }
   return table;
 }

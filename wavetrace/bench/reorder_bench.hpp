@@ -45,6 +45,7 @@ struct ReorderBenchResult {
   std::optional<double> disk_pages_per_1000_rays;   // distinct pages of 1,000 consecutive traced rays
   std::vector<std::pair<std::string, std::uint64_t>> disk_faults_by_part;
   std::optional<SpillCounters> spill;               // a disk ray buffer's runs
+  std::optional<std::uint64_t> photon_disk_faults;  // of disk_faults, those of photon mapping's photon pass
   bool image_identical = false;  // to the first heuristic's image (none, when listed first)
 };
 

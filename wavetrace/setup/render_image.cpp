@@ -68,6 +68,8 @@ std::unique_ptr<PhotonMaps> run_photon_pass(const RenderPlan& plan, const World&
   Pipeline pipeline(emit, chain.stages(), chain.loops(), plan.pipeline);
   report.run = pipeline.run(on_progress);
   report.emitted = emit.generated();
+  // The observation emptied the pager before this pass: all it has read is the photons'.
+  if (observers != nullptr && plan.memory.file_backing && world.pager != nullptr) report.disk = world.pager->total();
   const auto start = std::chrono::steady_clock::now();
   PhotonDeposits::Maps landed = deposits.take();
   report.global_photons = landed.global.size();

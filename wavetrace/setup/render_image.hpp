@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "wavetrace/memory/file_pager.hpp"
 #include "wavetrace/scene/camera.hpp"
 #include "wavetrace/stages/hit_rates.hpp"
 #include "wavetrace/pipeline/pipeline.hpp"
@@ -25,6 +26,9 @@ struct PhotonPassReport {
   std::size_t precomputed = 0;  // irradiance estimates precomputed in the global map (photon.precompute)
   double map_seconds = 0.0;     // sorting the deposits, building both kd-trees, precomputing
   float radius = 0.0f;          // photon.radius as resolved
+  // A world file paged from disk: the pages read while photons were traced, apart from the
+  // camera pass's (its trace stage reports the whole render's, both passes together).
+  std::optional<DiskCounters> disk;
 };
 
 struct RenderOutput {
