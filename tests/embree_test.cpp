@@ -94,7 +94,8 @@ INSTANTIATE_TEST_SUITE_P(AllModes, EmbreeModes,
                          });
 
 // The stream entries answer exactly what rtcIntersect1/rtcOccluded1 answer, ray for ray, for
-// closest, coherent and any-hit queries over a range with dead rays and short segments.
+// closest, coherent and any-hit queries over a range with dead rays and short segments; and
+// the distance queries (no surfaces) the closest hits' t, primitive, u and v, both ways.
 TEST(Embree, StreamQueriesAnswerWhatSingleQueriesAnswer) {
   const Scene room = make_builtin_scene("builtin:room:20k");
   AcceleratorOptions single_options, stream_options;
@@ -114,9 +115,12 @@ TEST(Embree, StreamQueriesAnswerWhatSingleQueriesAnswer) {
   }
   rays.count = kRays;
   const RayRange range{3, kRays - 2};
-  for (int query = 0; query < 3; ++query) {
+  for (int query = 0; query < 5; ++query) {
     HitBatch expected(kRays), found(kRays);
-    if (query == 0) {
+    if (query >= 3) {
+      single->intersect_closest(rays, expected, range);
+      (query == 3 ? stream : single)->intersect_distance(rays, found, range);
+    } else if (query == 0) {
       single->intersect_closest(rays, expected, range);
       stream->intersect_closest(rays, found, range);
     } else if (query == 1) {
@@ -134,6 +138,7 @@ TEST(Embree, StreamQueriesAnswerWhatSingleQueriesAnswer) {
       EXPECT_EQ(found.t[i], expected.t[i]) << i;
       EXPECT_EQ(found.u[i], expected.u[i]) << i;
       EXPECT_EQ(found.v[i], expected.v[i]) << i;
+      if (query >= 3) continue;  // a distance query leaves the surface unset
       EXPECT_EQ(found.point(i), expected.point(i)) << i;
       EXPECT_EQ(found.normal(i), expected.normal(i)) << i;
     }

@@ -58,8 +58,8 @@ void ApproxHitStage::process(Batch* batch, StageOutput& out) const {
     return;
   }
 
-  // The proxy's closest hits, into the hit columns trace will overwrite, from one surface
-  // tolerance past each origin (restored after).
+  // The proxy's closest hits' distances, into the hit columns trace will overwrite, from one
+  // surface tolerance past each origin (restored after).
   HitBatch& hits = batch->hits;
   std::vector<float> tmin(rays.tmin, rays.tmin + kept);
   for (std::size_t i = 0; i < kept; ++i) rays.tmin[i] += proxy_.surface_tolerance();
@@ -68,7 +68,7 @@ void ApproxHitStage::process(Batch* batch, StageOutput& out) const {
                          std::size_t(tbb::this_task_arena::current_thread_index()));
     proxy_.accelerator().intersect_closest_probed(rays, hits, rays.all(), probe);
   } else {
-    proxy_.accelerator().intersect_closest(rays, hits, rays.all());
+    proxy_.accelerator().intersect_distance(rays, hits, rays.all());  // only t is read below
   }
   std::copy(tmin.begin(), tmin.end(), rays.tmin);
   for (std::size_t i = 0; i < kept; ++i) {

@@ -101,12 +101,16 @@ class EmbreeAccelerator final : public Accelerator {
   // A stream of one ray (the megakernel's) goes to rtcIntersect1: the same hits, without
   // the stream's set-up.
   void intersect_closest(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
+    intersect_distance(rays, hits, range);
+    set_surfaces_from_mesh(hits, range, mesh_);
+  }
+
+  void intersect_distance(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
     if (options_.queries == EmbreeQueries::stream && range.size() > 1) {
       intersect_stream(rays, hits, range, RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
     } else {
       intersect_single(rays, hits, range);
     }
-    set_surfaces_from_mesh(hits, range, mesh_);
   }
 
   void intersect_coherent(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
