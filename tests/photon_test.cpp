@@ -38,8 +38,8 @@ double mean(const std::vector<float>& image) {
 }
 
 // Photons of power 1 on a jittered grid of the unit square in z = 0, `per_side` a side, facing +z.
-std::vector<Photon> square_of_photons(int per_side) {
-  std::vector<Photon> photons;
+PhotonArray square_of_photons(int per_side) {
+  PhotonArray photons;
   for (int y = 0; y < per_side; ++y) {
     for (int x = 0; x < per_side; ++x) {
       const UnitPair u = unit_pair(random_bits(x, y, 0, RandomPurpose::benchmark));

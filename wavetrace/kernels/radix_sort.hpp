@@ -17,10 +17,11 @@
 
 namespace wavetrace {
 
-// Sorts `records` by key, keeping the input order among equal keys; `scratch` is resized
-// and reused across calls.
-template <typename Record>
-void radix_sort_by_key(std::vector<Record>& records, std::vector<Record>& scratch) {
+// Sorts `records` (a std::vector of records, any allocator) by key, keeping the input order
+// among equal keys; `scratch` is resized and reused across calls.
+template <typename Records>
+void radix_sort_by_key(Records& records, Records& scratch) {
+  using Record = typename Records::value_type;
   constexpr int kDigitBits = 11;  // 6 passes for 64-bit keys (8 of 8 bits): fewer passes over the records
   constexpr std::size_t kBuckets = std::size_t{1} << kDigitBits;
   constexpr std::size_t kParallelRecords = std::size_t{1} << 16;  // below this one block: a pass is microseconds

@@ -12,13 +12,13 @@ void PhotonDeposits::add(std::uint64_t key, const Photon& photon, bool caustic) 
 }
 
 PhotonDeposits::Maps PhotonDeposits::take() {
-  std::vector<Deposit> all;
+  LargeArray<Deposit> all;
   std::size_t total = 0;
   for (const auto& list : per_thread_) total += list.size();
   all.reserve(total);
   for (auto& list : per_thread_) {
     all.insert(all.end(), list.begin(), list.end());
-    std::vector<Deposit>().swap(list);
+    LargeArray<Deposit>().swap(list);
   }
   // Keys are unique, so any sort gives the one order.
   tbb::parallel_sort(all.begin(), all.end(), [](const Deposit& a, const Deposit& b) { return a.key < b.key; });

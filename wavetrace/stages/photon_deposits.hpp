@@ -22,8 +22,8 @@ class PhotonDeposits {
   void add(std::uint64_t key, const Photon& photon, bool caustic);
 
   struct Maps {
-    std::vector<Photon> global;   // every photon that landed on a diffuse surface
-    std::vector<Photon> caustic;  // those that came by specular paths only
+    PhotonArray global;   // every photon that landed on a diffuse surface
+    PhotonArray caustic;  // those that came by specular paths only
   };
   // Every deposit so far in key order; leaves this empty.
   Maps take();
@@ -34,7 +34,7 @@ class PhotonDeposits {
     Photon photon;
     bool caustic;
   };
-  tbb::enumerable_thread_specific<std::vector<Deposit>> per_thread_;
+  tbb::enumerable_thread_specific<LargeArray<Deposit>> per_thread_;
 };
 
 }  // namespace wavetrace

@@ -88,7 +88,7 @@ struct PhotonMap::Tree {
   KdTree index;
 };
 
-PhotonMap::PhotonMap(std::vector<Photon> photons) : photons_(std::move(photons)) {
+PhotonMap::PhotonMap(PhotonArray photons) : photons_(std::move(photons)) {
   if (photons_.empty()) return;
   // Photons near in space near in memory: a search reads each candidate's position and
   // normal, and in key order (the order they landed) those are scattered over the array.
@@ -98,7 +98,7 @@ PhotonMap::PhotonMap(std::vector<Photon> photons) : photons_(std::move(photons))
     upper = glm::max(upper, photon.position);
   }
   const glm::vec3 scale = float((1u << 21) - 1) / glm::max(upper - lower, glm::vec3(1e-30f));
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> order(photons_.size());
+  LargeArray<std::pair<std::uint64_t, std::uint32_t>> order(photons_.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, photons_.size(), 4096), [&](const auto& range) {
     for (std::size_t i = range.begin(); i != range.end(); ++i) {
       const glm::vec3 cell = (photons_[i].position - lower) * scale;
@@ -107,7 +107,7 @@ PhotonMap::PhotonMap(std::vector<Photon> photons) : photons_(std::move(photons))
     }
   });
   tbb::parallel_sort(order.begin(), order.end());  // (code, index) pairs are unique: one order
-  std::vector<Photon> sorted(photons_.size());
+  PhotonArray sorted(photons_.size());
   for (std::size_t i = 0; i < order.size(); ++i) sorted[i] = photons_[order[i].second];
   photons_ = std::move(sorted);
   tree_ = std::make_unique<Tree>(photons_);
@@ -141,7 +141,7 @@ const Photon* PhotonMap::nearest(const glm::vec3& point, const glm::vec3& normal
 }
 
 void PhotonMap::precompute_irradiance(std::uint32_t stride, std::uint32_t k, float max_radius) {
-  std::vector<Photon> points((photons_.size() + stride - 1) / stride);
+  PhotonArray points((photons_.size() + stride - 1) / stride);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 1024), [&](const auto& range) {
     for (std::size_t i = range.begin(); i != range.end(); ++i) {
       const Photon& at = photons_[i * stride];

@@ -8,6 +8,8 @@
 #include <span>
 #include <vector>
 
+#include "wavetrace/memory/cache_aligned_allocator.hpp"
+
 #include <glm/vec3.hpp>
 
 namespace wavetrace {
@@ -21,12 +23,16 @@ struct Photon {
   glm::vec3 normal;
 };
 
+// A map's photons: tens of MB, on huge pages (their first touch in 4 KiB faults took half of
+// the maps' build on builtin:room:1M; docs/measurements.md).
+using PhotonArray = LargeArray<Photon>;
+
 class PhotonMap {
  public:
   // The most photons one estimate gathers (photon.k's bound): a query keeps them on its stack.
   static constexpr std::uint32_t kMaxNearest = 1024;
 
-  explicit PhotonMap(std::vector<Photon> photons);
+  explicit PhotonMap(PhotonArray photons);
   ~PhotonMap();
   PhotonMap(const PhotonMap&) = delete;
   PhotonMap& operator=(const PhotonMap&) = delete;
@@ -57,7 +63,7 @@ class PhotonMap {
 
  private:
   struct Tree;
-  std::vector<Photon> photons_;
+  PhotonArray photons_;
   std::unique_ptr<Tree> tree_;
   std::unique_ptr<PhotonMap> precomputed_;  // power holds the irradiance there
 };
@@ -65,7 +71,7 @@ class PhotonMap {
 // The camera pass's maps and how it reads them (photon.k, photon.radius resolved; with
 // photon.precompute > 0 the global map's irradiance precomputed at every that many photons).
 struct PhotonMaps {
-  PhotonMaps(std::vector<Photon> global_photons, std::vector<Photon> caustic_photons, std::uint32_t nearest,
+  PhotonMaps(PhotonArray global_photons, PhotonArray caustic_photons, std::uint32_t nearest,
              float max_radius, std::uint32_t precompute_stride)
       : global(std::move(global_photons)), caustic(std::move(caustic_photons)), k(nearest), radius(max_radius) {
     if (precompute_stride > 0) global.precompute_irradiance(precompute_stride, k, radius);

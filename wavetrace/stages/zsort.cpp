@@ -70,7 +70,7 @@ std::vector<Batch*> ZSortStage::sort_held(StageOutput& out) const {
   std::vector<std::size_t> first(held_.size() + 1, 0);
   for (std::size_t b = 0; b < held_.size(); ++b) first[b + 1] = first[b] + held_[b]->rays.count;
   const std::size_t total = first.back();
-  std::vector<SortEntry>& entries = entries_;
+  LargeArray<SortEntry>& entries = entries_;
   entries.resize(total);
   const bool sorts = options_.heuristic != ReorderHeuristic::none;
   tbb::parallel_for(std::size_t{0}, held_.size(), [&](std::size_t b) {

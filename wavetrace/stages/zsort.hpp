@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "wavetrace/memory/cache_aligned_allocator.hpp"
 #include "wavetrace/memory/ray_spill.hpp"
 #include "wavetrace/stages/buffering_stage.hpp"
 #include "wavetrace/stages/reorder_keys.hpp"
@@ -98,7 +99,7 @@ class ZSortStage final : public BufferingStage {
   std::string spill_dir_;
   mutable std::vector<Batch*> held_;
   mutable std::size_t held_rays_ = 0;
-  mutable std::vector<SortEntry> entries_, scratch_;  // kept across flushes: no page faults per flush
+  mutable LargeArray<SortEntry> entries_, scratch_;  // kept across flushes, on huge pages: few page faults
   mutable std::atomic<std::size_t> buffered_rays_{0}, spilled_rays_{0};
   mutable std::atomic<bool> draining_{false};
   mutable std::vector<std::unique_ptr<SpillRun>> runs_;  // the next generation's
