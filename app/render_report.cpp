@@ -84,6 +84,15 @@ std::string memory_lines(const std::vector<StageStats>& stages) {
   return lines;
 }
 
+// A stage's rays and seconds, the start of its entry in either pass.
+nlohmann::json stage_json(const StageStats& stage) {
+  return {{"name", stage.name},
+          {"rays_in", stage.rays_in},
+          {"rays_out", stage.rays_out},
+          {"seconds", stage.seconds},
+          {"mrays_per_s", stage.mrays_per_s()}};
+}
+
 nlohmann::json spill_json(const SpillCounters& spill) {
   return {{"bytes_written", spill.bytes_written}, {"bytes_read", spill.bytes_read}, {"seconds", spill.seconds}, {"runs", spill.runs}};
 }
@@ -117,11 +126,7 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
   const double triangles = double(facts.scene.triangle_count);
   nlohmann::json stages = nlohmann::json::array();
   for (const StageStats& stage : facts.output.run.stages) {
-    nlohmann::json entry = {{"name", stage.name},
-                            {"rays_in", stage.rays_in},
-                            {"rays_out", stage.rays_out},
-                            {"seconds", stage.seconds},
-                            {"mrays_per_s", stage.mrays_per_s()}};
+    nlohmann::json entry = stage_json(stage);
     if (stage.pager) entry["pager"] = pager_json(*stage.pager);
     if (stage.disk) {
       entry["disk"] = {{"page_bytes", stage.disk->page_bytes},
@@ -186,11 +191,7 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
   if (const std::optional<PhotonPassReport>& photons = facts.output.photons) {
     nlohmann::json photon_stages = nlohmann::json::array();
     for (const StageStats& stage : photons->run.stages) {
-      nlohmann::json entry = {{"name", stage.name},
-                              {"rays_in", stage.rays_in},
-                              {"rays_out", stage.rays_out},
-                              {"seconds", stage.seconds},
-                              {"mrays_per_s", stage.mrays_per_s()}};
+      nlohmann::json entry = stage_json(stage);  // no [memory] counts: the camera pass reports both passes'
       if (stage.spill) entry["spill"] = spill_json(*stage.spill);
       photon_stages.push_back(entry);
     }
