@@ -51,7 +51,7 @@ class Accelerator {
 
   // The nearest hits as intersect_closest finds them (t, primitive, u, v), without their
   // points and normals, which may be left as they were: for a query that wants only where a
-  // ray stops (approx_hit's walk of the proxy, where Embree's surfaces cost 15-25% of the
+  // ray stops (approx_hit's walk of the proxy, where Embree's surfaces cost 8-18% of the
   // stage). The default is intersect_closest.
   virtual void intersect_distance(const RayBatch& rays, HitBatch& hits, RayRange range) const {
     intersect_closest(rays, hits, range);
