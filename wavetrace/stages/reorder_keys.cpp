@@ -45,48 +45,63 @@ std::array<float, 2> octahedral(float x, float y, float z) {
   return {(u + 1.0f) * 0.5f, (v + 1.0f) * 0.5f};
 }
 
-template <int D, int kBits, CurveKind kCurve>
-std::uint64_t curve_key(const std::array<std::uint32_t, D>& cell) {
-  if constexpr (kCurve == CurveKind::morton) {
-    return morton_key<D, kBits>(cell);
-  } else {
-    return hilbert_key<D, kBits>(cell);
-  }
-}
+template <ReorderHeuristic kHeuristic>
+constexpr int kDimensions = kHeuristic == ReorderHeuristic::hph_origin                                        ? 6
+                            : kHeuristic == ReorderHeuristic::origin_dir || kHeuristic == ReorderHeuristic::hph_dir ? 5
+                                                                                                                  : 3;
 
 template <ReorderHeuristic kHeuristic, CurveKind kCurve>
 void keys_for(RayBatch& rays, const Bounds3& bounds) {
   constexpr int kBits = kHeuristic == ReorderHeuristic::origin || kHeuristic == ReorderHeuristic::hph ? 20
                         : kHeuristic == ReorderHeuristic::hph_origin                                 ? 10
                                                                                                      : 12;
+  constexpr int D = kDimensions<kHeuristic>;
   const Quantizer quantize(bounds, kBits);
-  for (std::size_t i = 0; i < rays.count; ++i) {
-    std::uint64_t key = 0;
-    const auto origin = [&](int axis) {
-      return quantize.cell(axis == 0 ? rays.origin_x[i] : axis == 1 ? rays.origin_y[i] : rays.origin_z[i], axis);
-    };
-    const auto hit = [&](int axis) {
-      return quantize.cell(axis == 0 ? rays.approx_hit_x[i] : axis == 1 ? rays.approx_hit_y[i] : rays.approx_hit_z[i],
-                           axis);
+  const auto cell_of = [&](std::size_t i) {
+    const std::array<std::uint32_t, 3> origin{quantize.cell(rays.origin_x[i], 0), quantize.cell(rays.origin_y[i], 1),
+                                              quantize.cell(rays.origin_z[i], 2)};
+    const auto hit = [&] {
+      return std::array<std::uint32_t, 3>{quantize.cell(rays.approx_hit_x[i], 0), quantize.cell(rays.approx_hit_y[i], 1),
+                                          quantize.cell(rays.approx_hit_z[i], 2)};
     };
     const auto direction = [&] {
       const auto uv = octahedral(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]);
       return std::array<std::uint32_t, 2>{quantize.unit_cell(uv[0]), quantize.unit_cell(uv[1])};
     };
     if constexpr (kHeuristic == ReorderHeuristic::origin) {
-      key = curve_key<3, kBits, kCurve>({origin(0), origin(1), origin(2)});
+      return origin;
     } else if constexpr (kHeuristic == ReorderHeuristic::hph) {
-      key = curve_key<3, kBits, kCurve>({hit(0), hit(1), hit(2)});
+      return hit();
     } else if constexpr (kHeuristic == ReorderHeuristic::origin_dir) {
       const auto d = direction();
-      key = curve_key<5, kBits, kCurve>({origin(0), origin(1), origin(2), d[0], d[1]});
+      return std::array<std::uint32_t, 5>{origin[0], origin[1], origin[2], d[0], d[1]};
     } else if constexpr (kHeuristic == ReorderHeuristic::hph_dir) {
+      const auto h = hit();
       const auto d = direction();
-      key = curve_key<5, kBits, kCurve>({hit(0), hit(1), hit(2), d[0], d[1]});
-    } else if constexpr (kHeuristic == ReorderHeuristic::hph_origin) {
-      key = curve_key<6, kBits, kCurve>({hit(0), hit(1), hit(2), origin(0), origin(1), origin(2)});
+      return std::array<std::uint32_t, 5>{h[0], h[1], h[2], d[0], d[1]};
+    } else {
+      const auto h = hit();
+      return std::array<std::uint32_t, 6>{h[0], h[1], h[2], origin[0], origin[1], origin[2]};
     }
+  };
+  const auto set_key = [&](std::size_t i, std::uint64_t key) {
     rays.sort_key[i] = key | (rays.kind[i] == RayKind::shadow ? std::uint64_t{1} << 63 : 0);
+  };
+  if constexpr (kCurve == CurveKind::morton) {
+    for (std::size_t i = 0; i < rays.count; ++i) set_key(i, morton_key<D, kBits>(cell_of(i)));
+  } else {
+    // Skilling's transform in lanes, kHilbertLanes rays at a time.
+    for (std::size_t first = 0; first < rays.count; first += kHilbertLanes) {
+      const std::size_t lanes = std::min(kHilbertLanes, rays.count - first);
+      std::uint32_t cells[D][kHilbertLanes] = {};
+      for (std::size_t lane = 0; lane < lanes; ++lane) {
+        const std::array<std::uint32_t, D> cell = cell_of(first + lane);
+        for (int d = 0; d < D; ++d) cells[d][lane] = cell[d];
+      }
+      std::uint64_t keys[kHilbertLanes];
+      hilbert_keys<D, kBits>(cells, keys);
+      for (std::size_t lane = 0; lane < lanes; ++lane) set_key(first + lane, keys[lane]);
+    }
   }
 }
 
