@@ -435,7 +435,9 @@ const std::vector<ConfigKey>& config_schema() {
       {"reorder.heuristic", T::text, std::string("none"), 0, 0,
        {"none", "origin", "origin_dir", "hph", "hph_origin", "hph_dir"}, "ray ordering keys (none: no reordering)",
        choice<parse_reorder_heuristic, &P::reorder, &ZSortOptions::heuristic>},
-      {"reorder.curve", T::text, std::string("morton"), 0, 0, {"morton", "hilbert"}, "space-filling curve of the keys",
+      {"reorder.curve", T::text, std::string("morton"), 0, 0, {"morton", "hilbert"},
+       "space-filling curve of the keys: morton is a little faster in core, hilbert reads fewer pages of a world "
+       "paged from its file (docs/reordering.md)",
        choice<parse_curve_kind, &P::reorder, &ZSortOptions::curve>},
       {"reorder.buffer_rays", T::integer, std::int64_t{1} << 18, 1, std::int64_t{1} << 32, {},
        "rays zsort holds before it sorts (it also flushes when it holds every live ray)",
