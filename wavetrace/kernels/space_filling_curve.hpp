@@ -63,7 +63,7 @@ inline void hilbert_transpose(Coordinate (&cell)[D]) {
     }
   }
   for (int d = 1; d < D; ++d) cell[d] ^= cell[d - 1];  // Gray encode
-  Coordinate flip = cell[D - 1] & 0u;
+  Coordinate flip = cell[D - 1] & 0u;  // zero, of the coordinates' type
   for (int level = kBits - 1; level > 0; --level) {
     flip ^= ((std::uint32_t{1} << level) - 1) & (0u - ((cell[D - 1] >> level) & 1u));
   }
