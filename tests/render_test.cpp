@@ -91,6 +91,38 @@ TEST(Generate, ClaimsEveryRayOnceFromManyThreads) {
   for (std::size_t i = 0; i < claimed.size(); ++i) ASSERT_EQ(claimed[i].load(), 1) << i;
 }
 
+// Passes of one render share a batch pool (photon mapping's two): a pipeline given a pool
+// takes its batches from it, so a second run of the same work allocates none, and a pool
+// of another batch size is refused.
+TEST(Render, PipelinesSharingABatchPoolReuseItsBatches) {
+  class ReleasingStage final : public Stage {
+   public:
+    std::string name() const override { return "release"; }
+    void process(Batch* batch, StageOutput& out) const override { out.release(batch); }
+  };
+  const ImageSpec image{.width = 64, .height = 64, .samples_per_pixel = 4};
+  const ReleasingStage release;
+  PipelineOptions options;
+  options.batch_size = 256;
+  options.threads = 1;
+  BatchPool pool(options.batch_size);
+  GenerateStage first_generate(resolve_camera({}, default_scene()), image, PixelOrder::scanline);
+  Pipeline first(first_generate, {&release}, false, options, &pool);
+  first.run();
+  const std::size_t allocated = pool.allocated();
+  EXPECT_GT(allocated, 0u);
+  GenerateStage second_generate(resolve_camera({}, default_scene()), image, PixelOrder::scanline);
+  Pipeline second(second_generate, {&release}, false, options, &pool);
+  const PipelineRun run = second.run();
+  EXPECT_EQ(pool.allocated(), allocated);
+  EXPECT_EQ(run.stages.at(1).rays_in, std::size_t(image.width) * image.height * image.samples_per_pixel);
+
+  BatchPool other_size(options.batch_size * 2);
+  GenerateStage third_generate(resolve_camera({}, default_scene()), image, PixelOrder::scanline);
+  Pipeline third(third_generate, {&release}, false, options, &other_size);
+  EXPECT_THROW(third.run(), std::logic_error);
+}
+
 // An error inside a stage while progress is being reported reaches the caller as that
 // error (the reporting thread is stopped and joined on the way out, not left to terminate).
 TEST(Render, AStageErrorDuringProgressReportsReachesTheCaller) {

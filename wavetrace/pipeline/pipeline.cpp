@@ -48,8 +48,14 @@ PipelineMode parse_pipeline_mode(const std::string& text) {
 
 std::string to_string(PipelineMode mode) { return mode == PipelineMode::megakernel ? "megakernel" : "wavefront"; }
 
-PipelineContext::PipelineContext(std::size_t batch_capacity, std::size_t rays_in_flight)
-    : pool_(batch_capacity), budget_(std::max(rays_in_flight, 2 * batch_capacity)) {}
+PipelineContext::PipelineContext(std::size_t batch_capacity, std::size_t rays_in_flight, BatchPool* shared_pool)
+    : pool_(shared_pool), budget_(std::max(rays_in_flight, 2 * batch_capacity)) {
+  if (pool_ == nullptr) {
+    pool_ = &own_pool_.emplace(batch_capacity);
+  } else if (pool_->batch_capacity() != batch_capacity) {
+    throw std::logic_error("a shared batch pool's capacity differs from the pipeline's batch size");
+  }
+}
 
 void PipelineContext::retire_rays(std::size_t count) {
   const std::int64_t now = live_rays_.fetch_sub(std::int64_t(count), std::memory_order_seq_cst) - std::int64_t(count);
@@ -64,7 +70,7 @@ void PipelineContext::retire_rays(std::size_t count) {
 
 void PipelineContext::wake_generator() {
   if (generator_node_ != nullptr && !generator_stage_->exhausted() &&
-      in_core_rays() + std::int64_t(pool_.batch_capacity()) <= std::int64_t(budget_)) {
+      in_core_rays() + std::int64_t(pool_->batch_capacity()) <= std::int64_t(budget_)) {
     generator_node_->try_put(tbb::flow::continue_msg());
   }
 }
@@ -204,8 +210,9 @@ std::unique_ptr<tbb::flow::function_node<Batch*>> make_retire_node(tbb::flow::gr
   });
 }
 
-Pipeline::Pipeline(RaySource& generate, std::vector<const Stage*> chain, bool loops, const PipelineOptions& options)
-    : generate_(generate), chain_(std::move(chain)), loops_(loops), options_(options) {}
+Pipeline::Pipeline(RaySource& generate, std::vector<const Stage*> chain, bool loops, const PipelineOptions& options,
+                   BatchPool* shared_pool)
+    : generate_(generate), chain_(std::move(chain)), loops_(loops), options_(options), shared_pool_(shared_pool) {}
 
 PipelineRun Pipeline::run(const std::function<void(const Progress&)>& on_progress, std::chrono::milliseconds interval) {
   TracingArena arena(options_.threads);
@@ -219,7 +226,7 @@ PipelineRun Pipeline::run(const std::function<void(const Progress&)>& on_progres
     if (c->snapshot().name == "trace") trace_counters = c.get();
   }
 
-  PipelineContext context(options_.batch_size, options_.rays_in_flight);
+  PipelineContext context(options_.batch_size, options_.rays_in_flight, shared_pool_);
   const Clock::time_point start = Clock::now();
 
   std::optional<ProgressReporter> reporter;

@@ -60,12 +60,12 @@ constexpr float kAutoRadiusShare = 0.0025f;
 // stages, are the whole render's.
 std::unique_ptr<PhotonMaps> run_photon_pass(const RenderPlan& plan, const World& world, const MemoryObservers* observers,
                                             const std::function<void(const Progress&)>& on_progress,
-                                            PhotonPassReport& report) {
+                                            BatchPool& batches, PhotonPassReport& report) {
   check_photon_memory(plan);
   PhotonDeposits deposits;
   EmitPhotonsStage emit(world.lights, plan.photon.count, plan.image.seed);
   const StageChain chain(plan, world, nullptr, observers, ChainShading{.deposits = &deposits});
-  Pipeline pipeline(emit, chain.stages(), chain.loops(), plan.pipeline);
+  Pipeline pipeline(emit, chain.stages(), chain.loops(), plan.pipeline, &batches);
   report.run = pipeline.run(on_progress);
   report.emitted = emit.generated();
   // The observation emptied the pager before this pass: all it has read is the photons'.
@@ -121,14 +121,15 @@ RenderOutput render_image(const RenderPlan& plan, const World& world, const Came
                                 on_progress);
   } else {
     std::unique_ptr<PhotonMaps> maps;
+    BatchPool batches(plan.pipeline.batch_size);  // both passes' batches: the camera pass reuses the photons'
     if (plan.integrator == Integrator::photon) {
       output.photons.emplace();
-      maps = run_photon_pass(plan, world, observation ? &observation->observers() : nullptr, on_progress,
+      maps = run_photon_pass(plan, world, observation ? &observation->observers() : nullptr, on_progress, batches,
                              *output.photons);
     }
     const StageChain chain(plan, world, &film, observation ? &observation->observers() : nullptr,
                            ChainShading{.maps = maps.get()});
-    Pipeline pipeline(generate, chain.stages(), chain.loops(), plan.pipeline);
+    Pipeline pipeline(generate, chain.stages(), chain.loops(), plan.pipeline, &batches);
     output.run = pipeline.run(on_progress);
     if (observation) observation->report(output.run.stages);
     if (chain.zsort() != nullptr) {
