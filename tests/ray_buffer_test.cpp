@@ -11,7 +11,12 @@
 
 #include "render_support.hpp"
 #include "test_support.hpp"
+#include "wavetrace/accel/registry.hpp"
 #include "wavetrace/scene/builtin_scenes.hpp"
+#include "wavetrace/scene/lights.hpp"
+#include "wavetrace/setup/plan_render.hpp"
+#include "wavetrace/stages/gather_spawn.hpp"
+#include "wavetrace/stages/spawn.hpp"
 
 namespace wavetrace {
 namespace {
@@ -39,6 +44,43 @@ TEST(DiskRayBuffer, ImageIsBitIdenticalToTheMemoryBufferAndToNoReordering) {
   const RenderOutput one_thread = with({"reorder.heuristic=hph_origin", "reorder.buffer=disk",
                                         "reorder.buffer_rays=1024", "render.threads=1"});
   EXPECT_TRUE(one_thread.image == none.image);
+}
+
+// The disk buffer's in-core part fills with camera rays, so the flight budget must leave room
+// for it and for the rays each of its camera rays may become (the spawn stages' own count).
+TEST(DiskRayBuffer, TheFlightBudgetHoldsTheInCorePartAndWhatItsRaysBecome) {
+  const auto plan_with = [](std::vector<std::string> settings) {
+    Config config;
+    for (const std::string& setting : {"reorder.heuristic=hph", "reorder.buffer=disk", "reorder.buffer_rays=3000"}) {
+      settings.push_back(setting);
+    }
+    for (const std::string& setting : settings) config.set(setting);
+    return plan_render(config);
+  };
+  const RenderPlan path = plan_with({});
+  const RenderPlan photon = plan_with({"render.integrator=photon", "photon.gather_rays=6"});
+  EXPECT_EQ(rays_per_camera_ray(path), 2u);
+  EXPECT_EQ(path.pipeline.rays_in_flight, 2u * 3000);
+  EXPECT_EQ(rays_per_camera_ray(photon), 7u);
+  EXPECT_EQ(photon.pipeline.rays_in_flight, 7u * 3000);
+
+  const Scene scene = make_builtin_scene("builtin:room:20k");
+  const auto accelerator = make_accelerator(scene.mesh, path.accelerator);
+  const LightSampler lights(scene);
+  const World world{scene, *accelerator, lights, nullptr};
+  EXPECT_EQ(SpawnStage(world, path.rules).rays_out_per_ray(), rays_per_camera_ray(path));
+  EXPECT_EQ(GatherSpawnStage(world, photon.rules, photon.photon.gather_rays).rays_out_per_ray(),
+            rays_per_camera_ray(photon));
+
+  try {
+    plan_with({"render.rays_in_flight=5000"});
+    ADD_FAILURE() << "a flight budget under the in-core part times 2 was accepted";
+  } catch (const ConfigError& error) {
+    EXPECT_NE(std::string(error.what()).find("render.rays_in_flight = 5000 is under the disk buffer's in-core part "
+                                             "(3000 rays) times the 2 rays each camera ray may become"),
+              std::string::npos)
+        << error.what();
+  }
 }
 
 // What the command says of a spill directory it cannot use, of a disk buffer without zsort,

@@ -123,6 +123,63 @@ TEST(Render, PipelinesSharingABatchPoolReuseItsBatches) {
   EXPECT_THROW(third.run(), std::logic_error);
 }
 
+// The flight budget bounds the rays alive, not only the camera rays: a stage that makes eight
+// rays of each (as a gather makes its rays) has the generator leave room for them. A stage
+// after it holds every ray until it holds all that are alive, so what was made piles up.
+TEST(Render, TheFlightBudgetBoundsWhatCameraRaysBecome) {
+  constexpr std::size_t kRaysPerRay = 8;
+  class FanOutStage final : public Stage {
+   public:
+    std::string name() const override { return "fan_out"; }
+    std::size_t rays_out_per_ray() const override { return kRaysPerRay; }
+    void process(Batch* batch, StageOutput& out) const override {
+      for (std::size_t copy = 0; copy < kRaysPerRay; ++copy) {
+        Batch* made = out.acquire();
+        for (std::size_t i = 0; i < batch->rays.count; ++i) made->rays.copy_ray(i, batch->rays, i);
+        made->rays.count = batch->rays.count;
+        out.emit(made);
+      }
+      out.release(batch);
+    }
+  };
+  class HoldAllStage final : public BufferingStage {
+   public:
+    std::string name() const override { return "hold"; }
+    void process(Batch* batch, StageOutput& out) const override { take(batch, out); }
+    std::size_t take(Batch* batch, StageOutput&) const override {
+      held_.push_back(batch);
+      rays_ += batch->rays.count;
+      return 0;
+    }
+    std::size_t flush(StageOutput& out) const override {
+      for (Batch* batch : held_) out.emit(batch);  // to the retiring node after the chain
+      held_.clear();
+      const std::size_t rays = rays_;
+      rays_ = 0;
+      return rays;
+    }
+    std::size_t buffered_rays() const override { return rays_; }
+
+   private:
+    mutable std::vector<Batch*> held_;
+    mutable std::size_t rays_ = 0;
+  };
+  const ImageSpec image{.width = 64, .height = 64, .samples_per_pixel = 4};
+  const FanOutStage fan_out;
+  const HoldAllStage hold;
+  PipelineOptions options;
+  options.batch_size = 256;
+  options.threads = 2;
+  options.rays_in_flight = 16384;
+  GenerateStage generate(resolve_camera({}, default_scene()), image, PixelOrder::scanline);
+  const PipelineRun run = Pipeline(generate, {&fan_out, &hold}, false, options).run();
+  EXPECT_EQ(run.stages.at(2).rays_in, kRaysPerRay * image.width * image.height * image.samples_per_pixel);
+  // Each thread generating at once may take one batch past the room left, and each becomes
+  // kRaysPerRay batches; the generator's room is the budget over kRaysPerRay, and it fills.
+  EXPECT_LE(run.peak_rays_in_core, options.rays_in_flight + std::size_t(options.threads) * options.batch_size * kRaysPerRay);
+  EXPECT_GE(run.peak_rays_in_core, options.rays_in_flight - options.batch_size * kRaysPerRay);
+}
+
 // An error inside a stage while progress is being reported reaches the caller as that
 // error (the reporting thread is stopped and joined on the way out, not left to terminate).
 TEST(Render, AStageErrorDuringProgressReportsReachesTheCaller) {

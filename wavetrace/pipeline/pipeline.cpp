@@ -1,6 +1,7 @@
 // Flow-graph nodes around stages, ray accounting, and the threaded run.
 #include "wavetrace/pipeline/pipeline.hpp"
 
+#include <algorithm>
 #include <exception>
 #include <mutex>
 #include <optional>
@@ -48,12 +49,23 @@ PipelineMode parse_pipeline_mode(const std::string& text) {
 
 std::string to_string(PipelineMode mode) { return mode == PipelineMode::megakernel ? "megakernel" : "wavefront"; }
 
-PipelineContext::PipelineContext(std::size_t batch_capacity, std::size_t rays_in_flight, BatchPool* shared_pool)
-    : pool_(shared_pool), budget_(std::max(rays_in_flight, 2 * batch_capacity)) {
+PipelineContext::PipelineContext(std::size_t batch_capacity, std::size_t rays_in_flight, BatchPool* shared_pool,
+                                 std::size_t rays_per_source_ray)
+    : pool_(shared_pool),
+      budget_(std::max(rays_in_flight, 2 * batch_capacity)),
+      source_budget_(std::max(budget_ / std::max<std::size_t>(rays_per_source_ray, 1), 2 * batch_capacity)) {
   if (pool_ == nullptr) {
     pool_ = &own_pool_.emplace(batch_capacity);
   } else if (pool_->batch_capacity() != batch_capacity) {
     throw std::logic_error("a shared batch pool's capacity differs from the pipeline's batch size");
+  }
+}
+
+void PipelineContext::add_rays(std::size_t count) {
+  live_rays_.fetch_add(std::int64_t(count), std::memory_order_acq_rel);
+  const std::int64_t now = in_core_rays();
+  std::int64_t peak = peak_in_core_rays_.load(std::memory_order_relaxed);
+  while (now > peak && !peak_in_core_rays_.compare_exchange_weak(peak, now, std::memory_order_relaxed)) {
   }
 }
 
@@ -63,14 +75,14 @@ void PipelineContext::retire_rays(std::size_t count) {
     const auto waiting = std::int64_t(buffer_stage_->buffered_rays());
     if (waiting > 0 && now <= waiting) buffer_node_->try_put(nullptr);
     // A draining disk buffer emits more as the rays in memory make room.
-    if (buffer_stage_->draining() && in_core_rays() < std::int64_t(budget_)) buffer_node_->try_put(nullptr);
+    if (buffer_stage_->draining() && in_core_rays() < std::int64_t(source_budget_)) buffer_node_->try_put(nullptr);
   }
   wake_generator();
 }
 
 void PipelineContext::wake_generator() {
   if (generator_node_ != nullptr && !generator_stage_->exhausted() &&
-      in_core_rays() + std::int64_t(pool_->batch_capacity()) <= std::int64_t(budget_)) {
+      in_core_rays() + std::int64_t(pool_->batch_capacity()) <= std::int64_t(source_budget_)) {
     generator_node_->try_put(tbb::flow::continue_msg());
   }
 }
@@ -82,7 +94,8 @@ std::unique_ptr<GenerateNode> make_generate_node(tbb::flow::graph& graph, RaySou
   auto node = std::make_unique<GenerateNode>(
       graph, tbb::flow::unlimited, [&stage, &context, &counters](tbb::flow::continue_msg, GenerateNode::output_ports_type& ports) {
         const std::size_t capacity = context.pool().batch_capacity();
-        while (!stage.exhausted() && context.in_core_rays() + std::int64_t(capacity) <= std::int64_t(context.budget())) {
+        while (!stage.exhausted() &&
+               context.in_core_rays() + std::int64_t(capacity) <= std::int64_t(context.source_budget())) {
           const Clock::time_point start = Clock::now();
           const RaySource::Claim claimed = stage.claim(capacity);
           if (claimed.count == 0) return;
@@ -191,7 +204,7 @@ std::unique_ptr<BatchNode> make_buffering_node(tbb::flow::graph& graph, const Bu
         if (!stage.draining() && waiting > 0 && std::int64_t(waiting) >= context.live_rays()) rays_out += stage.flush(out);
         if (stage.draining()) {
           // Emit the merged stream as far as the budget allows; a retiring ray pokes for more.
-          const std::int64_t room = std::int64_t(context.budget()) - context.in_core_rays();
+          const std::int64_t room = std::int64_t(context.source_budget()) - context.in_core_rays();
           if (room > 0) rays_out += stage.drain(out, std::size_t(room));
         }
         if (stage.spilled_rays() > spilled) context.wake_generator();  // the spilled rays left memory
@@ -226,7 +239,9 @@ PipelineRun Pipeline::run(const std::function<void(const Progress&)>& on_progres
     if (c->snapshot().name == "trace") trace_counters = c.get();
   }
 
-  PipelineContext context(options_.batch_size, options_.rays_in_flight, shared_pool_);
+  std::size_t rays_per_source_ray = 1;
+  for (const Stage* stage : chain_) rays_per_source_ray = std::max(rays_per_source_ray, stage->rays_out_per_ray());
+  PipelineContext context(options_.batch_size, options_.rays_in_flight, shared_pool_, rays_per_source_ray);
   const Clock::time_point start = Clock::now();
 
   std::optional<ProgressReporter> reporter;
@@ -321,6 +336,7 @@ PipelineRun Pipeline::run(const std::function<void(const Progress&)>& on_progres
   result.stages.push_back(generate_counters.snapshot());
   for (const auto& c : counters) result.stages.push_back(c->snapshot());
   result.batches_allocated = context.pool().allocated();
+  result.peak_rays_in_core = std::size_t(context.peak_in_core_rays());
   return result;
 }
 

@@ -3,9 +3,11 @@
 // Pipeline assembles the chain a config names.
 //
 // Flow control: the context counts the rays alive in the graph. The generate node emits
-// camera batches only while that count stays under the in-flight budget (give or take a
-// batch per thread generating at once), and every node that retires rays wakes it, so
-// memory stays bounded and the graph drains by itself. A buffering stage (zsort, repack)
+// camera batches only while that count stays under the in-flight budget over the chain's
+// fan-out (the most rays one ray can become at a stage: a bounce and a light sample, or a
+// gather's rays), give or take a batch per thread generating at once, so that the rays its
+// batches become stay within the budget; every node that retires rays wakes it, so memory
+// stays bounded and the graph drains by itself. A buffering stage (zsort, repack)
 // holds rays until it is ready or holds every live ray; whoever sees the latter last (its
 // node after taking a batch, or a node after retiring) makes it flush.
 #pragma once
@@ -40,7 +42,9 @@ class PipelineContext {
  public:
   // Batches come from `shared_pool` where given (its capacity must be batch_capacity), else
   // from a pool of the context's own.
-  PipelineContext(std::size_t batch_capacity, std::size_t rays_in_flight, BatchPool* shared_pool = nullptr);
+  // Each ray a source emits may become `rays_per_source_ray` rays at once.
+  PipelineContext(std::size_t batch_capacity, std::size_t rays_in_flight, BatchPool* shared_pool = nullptr,
+                  std::size_t rays_per_source_ray = 1);
 
   BatchPool& pool() { return *pool_; }
   std::int64_t live_rays() const { return live_rays_.load(std::memory_order_acquire); }
@@ -49,11 +53,16 @@ class PipelineContext {
     return live_rays() - (buffer_stage_ != nullptr ? std::int64_t(buffer_stage_->spilled_rays()) : 0);
   }
   std::size_t budget() const { return budget_; }
+  // The in-core rays under which a source (generate, a draining disk buffer) may emit more:
+  // the budget over what each of its rays may become.
+  std::size_t source_budget() const { return source_budget_; }
+  // The most rays alive in memory at once so far.
+  std::int64_t peak_in_core_rays() const { return peak_in_core_rays_.load(std::memory_order_relaxed); }
   // Lets the generator run on if the budget has room (after a buffer moved rays to disk).
   void wake_generator();
 
   // Rays entering the graph (made by generate or spawn).
-  void add_rays(std::size_t count) { live_rays_.fetch_add(std::int64_t(count), std::memory_order_acq_rel); }
+  void add_rays(std::size_t count);
   // Rays leaving it; wakes the generator when there is room for another batch.
   void retire_rays(std::size_t count);
 
@@ -72,7 +81,9 @@ class PipelineContext {
   std::optional<BatchPool> own_pool_;
   BatchPool* pool_;
   std::size_t budget_;
+  std::size_t source_budget_;
   std::atomic<std::int64_t> live_rays_{0};
+  std::atomic<std::int64_t> peak_in_core_rays_{0};
   GenerateNode* generator_node_ = nullptr;
   const RaySource* generator_stage_ = nullptr;
   BatchNode* buffer_node_ = nullptr;
@@ -151,6 +162,7 @@ struct PipelineRun {
   double seconds = 0.0;            // wall time of the whole run
   int threads = 0;
   std::size_t batches_allocated = 0;
+  std::size_t peak_rays_in_core = 0;  // the most rays alive in memory at once
 };
 
 class Pipeline {

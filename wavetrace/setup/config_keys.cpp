@@ -214,8 +214,10 @@ const std::vector<ConfigKey>& config_schema() {
        "rays per batch (1024: a batch and its hits, ~100 KB, stay in L2 between stages)",
        integer<&P::pipeline, &PipelineOptions::batch_size>},
       {"render.rays_in_flight", T::integer, std::nullopt, 1024, std::int64_t{1} << 30, {},
-       "most rays alive at once (bounds memory); default: reorder.buffer_rays with zsort in the chain, else 4 "
-       "batches per worker",
+       "most rays alive in memory at once (bounds memory; camera rays are emitted while there is room for what "
+       "each may become: 2 rays with spawn, photon.gather_rays + 1 with photon mapping); default: "
+       "reorder.buffer_rays with zsort in the chain (with reorder.buffer = disk, times what a camera ray may "
+       "become, so that the in-core part fills), else 4 batches of camera rays per worker and what they become",
        optional_size<&P::pipeline, &PipelineOptions::rays_in_flight>},
       {"render.film", T::text, std::string("shared"), 0, 0, {"shared", "per_thread"},
        "shared: one film, atomic adds; per_thread: a film per worker, summed at the end (same image)",

@@ -80,6 +80,11 @@ void check_megakernel_plan(const RenderPlan& plan) {
 
 }  // namespace
 
+std::size_t rays_per_camera_ray(const RenderPlan& plan) {
+  if (plan.integrator == Integrator::photon) return std::size_t{plan.photon.gather_rays} + 1;
+  return std::find(plan.stages.begin(), plan.stages.end(), "spawn") != plan.stages.end() ? 2 : 1;
+}
+
 void check_accelerator_options(const Config& config, const AcceleratorOptions& options) {
   // epsilon chooses the bits: both given (even bits = 16, the default) is a conflict.
   if ((config.given("accel.hmq.bits") && config.given("accel.hmq.epsilon")) ||
@@ -206,22 +211,28 @@ RenderPlan plan_render(const Config& config) {
     throw ConfigError("pipeline.stages: 'auto' stands alone");
   }
   check_stage_order(plan.stages, plan.reorder.heuristic);
+  // A disk buffer's in-core part fills with camera rays, each of which may become several.
+  const std::size_t disk_buffer_budget = plan.reorder.buffer_rays * rays_per_camera_ray(plan);
   if (!config.has("render.rays_in_flight")) {
     plan.pipeline.rays_in_flight =
-        std::find(plan.stages.begin(), plan.stages.end(), "zsort") != plan.stages.end()
-            ? plan.reorder.buffer_rays  // so that the buffer can fill
-            // Without a buffer to fill, rays in flight only keep the workers busy; more would
-            // cost memory (and first-touch page faults) for nothing.
-            : 4 * std::size_t(worker_count(plan.pipeline)) * plan.pipeline.batch_size;
+        plan.reorder.buffer == RayBufferKind::disk ? disk_buffer_budget
+        : std::find(plan.stages.begin(), plan.stages.end(), "zsort") != plan.stages.end()
+            ? plan.reorder.buffer_rays  // a full buffer alive at once: a flush sorts up to that many
+            // Without a buffer to fill, rays in flight only keep the workers busy (4 batches of
+            // camera rays each, and what they become); more would cost memory (and first-touch
+            // page faults) for nothing.
+            : 4 * std::size_t(worker_count(plan.pipeline)) * plan.pipeline.batch_size * rays_per_camera_ray(plan);
   }
   if (plan.reorder.buffer == RayBufferKind::disk) {
     if (std::find(plan.stages.begin(), plan.stages.end(), "zsort") == plan.stages.end()) {
       throw ConfigError("reorder.buffer = disk is zsort's buffer, and the chain has no zsort: set a reorder.heuristic");
     }
-    if (plan.pipeline.rays_in_flight < plan.reorder.buffer_rays) {
-      throw ConfigError(fmt::format("render.rays_in_flight = {} is under the disk buffer's in-core part ({} rays): "
-                                    "the in-core part must be able to fill",
-                                    plan.pipeline.rays_in_flight, plan.reorder.buffer_rays));
+    if (plan.pipeline.rays_in_flight < disk_buffer_budget) {
+      throw ConfigError(fmt::format("render.rays_in_flight = {} is under the disk buffer's in-core part ({} rays) "
+                                    "times the {} rays each camera ray may become: the in-core part must be able "
+                                    "to fill",
+                                    plan.pipeline.rays_in_flight, plan.reorder.buffer_rays,
+                                    rays_per_camera_ray(plan)));
     }
   }
   if (plan.integrator == Integrator::photon) {

@@ -12,6 +12,10 @@ namespace wavetrace {
 // settings that conflict and a stage list that cannot run.
 RenderPlan plan_render(const Config& config);
 
+// The most rays one camera ray becomes at once in the plan's chain (the largest of its
+// stages' rays_out_per_ray): sizes the flight budget a disk buffer needs to fill.
+std::size_t rays_per_camera_ray(const RenderPlan& plan);
+
 // What a world file keeps of the accelerator the plan built: accel.type and the keys of its
 // section whose rows record a value (widths, modes, error bounds auto or a pixel bound chose).
 void record_built_accelerator(Config& config, const RenderPlan& plan);

@@ -19,6 +19,8 @@ class GatherSpawnStage final : public Stage {
   GatherSpawnStage(const World& world, const PathRules& rules, std::uint32_t gather_rays);
   std::string name() const override { return "spawn"; }
   void process(Batch* batch, StageOutput& out) const override;
+  // A diffuse hit's gathering rays and light sample; a specular hit's one bounce.
+  std::size_t rays_out_per_ray() const override { return std::size_t{gather_rays_} + 1; }
 
  private:
   const World& world_;

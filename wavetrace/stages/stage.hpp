@@ -34,6 +34,11 @@ class Stage {
   // Owns `batch` on entry; must emit or release it (and any batch it acquires).
   virtual void process(Batch* batch, StageOutput& out) const = 0;
 
+  // The most rays alive after this stage for each ray that enters it (the ray itself, or the
+  // rays it spawns in its place). The pipeline's sources leave room in the flight budget for
+  // what each ray they emit may become, so that the budget bounds the rays alive at once.
+  virtual std::size_t rays_out_per_ray() const { return 1; }
+
   // Reading ahead: a stage that takes a buffering stage's batches in their order (the
   // pipeline's ordered hand-off) may look at the first `batches` batches queued for it, on
   // `threads` threads of their own (each on the next batch none has seen), while the batches
