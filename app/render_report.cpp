@@ -154,6 +154,8 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
   nlohmann::json render = {{"seconds", facts.output.run.seconds}, {"threads", facts.output.run.threads}};
   render["stages"] = facts.plan.stages;
   render["mode"] = to_string(facts.plan.pipeline.mode);
+  render["rays_in_memory"] = {{"budget", facts.plan.pipeline.rays_in_flight},
+                              {"peak", facts.output.run.peak_rays_in_core}};  // the camera pass's, with photons
   render["reorder"] = {{"heuristic", to_string(facts.plan.reorder.heuristic)},
                        {"curve", to_string(facts.plan.reorder.curve)},
                        {"buffer_rays", facts.plan.reorder.buffer_rays},

@@ -43,6 +43,10 @@ TEST(Cli, RenderWritesExrPngAndStats) {
     for (const char* key : {"name", "rays_in", "rays_out", "seconds", "mrays_per_s"}) EXPECT_TRUE(stage.contains(key));
   }
   EXPECT_EQ(stats["stages"][0]["rays_out"].get<std::size_t>(), 32u * 24);
+  // 768 camera rays and their bounces and light samples, within the default budget.
+  const std::size_t peak = stats["render"]["rays_in_memory"]["peak"].get<std::size_t>();
+  EXPECT_GT(peak, 0u);
+  EXPECT_LE(peak, stats["render"]["rays_in_memory"]["budget"].get<std::size_t>());
   EXPECT_EQ(stats["image"]["width"], 32);
   EXPECT_EQ(stats["image"]["spp"], 1);
   EXPECT_EQ(stats["image"]["path"], dir + "/image.exr");
