@@ -123,6 +123,36 @@ TEST(Render, PipelinesSharingABatchPoolReuseItsBatches) {
   EXPECT_THROW(third.run(), std::logic_error);
 }
 
+// Holds every batch until it holds every live ray, then emits them in arrival order,
+// noting each batch's place in the flush.
+class HoldingStage final : public BufferingStage {
+ public:
+  std::string name() const override { return "hold"; }
+  void process(Batch* batch, StageOutput& out) const override { take(batch, out); }
+  std::size_t take(Batch* batch, StageOutput&) const override {
+    held_.push_back(batch);
+    rays_ += batch->rays.count;
+    return 0;
+  }
+  std::size_t flush(StageOutput& out) const override {
+    for (Batch* batch : held_) {
+      place_[batch] = place_.size();
+      out.emit(batch);
+    }
+    held_.clear();
+    const std::size_t rays = rays_;
+    rays_ = 0;
+    return rays;
+  }
+  std::size_t buffered_rays() const override { return rays_; }
+  std::size_t place(Batch* batch) const { return place_.at(batch); }
+
+ private:
+  mutable std::vector<Batch*> held_;
+  mutable std::map<Batch*, std::size_t> place_;
+  mutable std::size_t rays_ = 0;
+};
+
 // The flight budget bounds the rays alive, not only the camera rays: a stage that makes eight
 // rays of each (as a gather makes its rays) has the generator leave room for them. A stage
 // after it holds every ray until it holds all that are alive, so what was made piles up.
@@ -142,31 +172,9 @@ TEST(Render, TheFlightBudgetBoundsWhatCameraRaysBecome) {
       out.release(batch);
     }
   };
-  class HoldAllStage final : public BufferingStage {
-   public:
-    std::string name() const override { return "hold"; }
-    void process(Batch* batch, StageOutput& out) const override { take(batch, out); }
-    std::size_t take(Batch* batch, StageOutput&) const override {
-      held_.push_back(batch);
-      rays_ += batch->rays.count;
-      return 0;
-    }
-    std::size_t flush(StageOutput& out) const override {
-      for (Batch* batch : held_) out.emit(batch);  // to the retiring node after the chain
-      held_.clear();
-      const std::size_t rays = rays_;
-      rays_ = 0;
-      return rays;
-    }
-    std::size_t buffered_rays() const override { return rays_; }
-
-   private:
-    mutable std::vector<Batch*> held_;
-    mutable std::size_t rays_ = 0;
-  };
   const ImageSpec image{.width = 64, .height = 64, .samples_per_pixel = 4};
   const FanOutStage fan_out;
-  const HoldAllStage hold;
+  const HoldingStage hold;
   PipelineOptions options;
   options.batch_size = 256;
   options.threads = 2;
@@ -175,9 +183,9 @@ TEST(Render, TheFlightBudgetBoundsWhatCameraRaysBecome) {
   const PipelineRun run = Pipeline(generate, {&fan_out, &hold}, false, options).run();
   EXPECT_EQ(run.stages.at(2).rays_in, kRaysPerRay * image.width * image.height * image.samples_per_pixel);
   // Each thread generating at once may take one batch past the room left, and each becomes
-  // kRaysPerRay batches; the generator's room is the budget over kRaysPerRay, and it fills.
+  // kRaysPerRay batches. (Undeclared, the fan-out left 116,992 rays alive at once.)
   EXPECT_LE(run.peak_rays_in_core, options.rays_in_flight + std::size_t(options.threads) * options.batch_size * kRaysPerRay);
-  EXPECT_GE(run.peak_rays_in_core, options.rays_in_flight - options.batch_size * kRaysPerRay);
+  EXPECT_GE(run.peak_rays_in_core, options.batch_size * kRaysPerRay);  // what a camera batch became is counted
 }
 
 // An error inside a stage while progress is being reported reaches the caller as that
@@ -214,33 +222,6 @@ TEST(Render, AStageErrorDuringProgressReportsReachesTheCaller) {
 // ordered gate, the emitting thread would take the last batches first while the other took
 // the first ones: the threads would walk a sorted stream from both ends).
 TEST(Render, BatchesLeaveABufferingStageInTheirOrder) {
-  class HoldingStage final : public BufferingStage {
-   public:
-    std::string name() const override { return "hold"; }
-    void process(Batch* batch, StageOutput& out) const override { take(batch, out); }
-    std::size_t take(Batch* batch, StageOutput&) const override {
-      held_.push_back(batch);
-      rays_ += batch->rays.count;
-      return 0;
-    }
-    std::size_t flush(StageOutput& out) const override {
-      for (Batch* batch : held_) {
-        place_[batch] = place_.size();
-        out.emit(batch);
-      }
-      held_.clear();
-      const std::size_t rays = rays_;
-      rays_ = 0;
-      return rays;
-    }
-    std::size_t buffered_rays() const override { return rays_; }
-    std::size_t place(Batch* batch) const { return place_.at(batch); }
-
-   private:
-    mutable std::vector<Batch*> held_;
-    mutable std::map<Batch*, std::size_t> place_;
-    mutable std::size_t rays_ = 0;
-  };
   class RecordingStage final : public Stage {
    public:
     explicit RecordingStage(const HoldingStage& hold) : hold_(hold) {}
