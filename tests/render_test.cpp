@@ -124,33 +124,40 @@ TEST(Render, PipelinesSharingABatchPoolReuseItsBatches) {
 }
 
 // Holds every batch until it holds every live ray, then emits them in arrival order,
-// noting each batch's place in the flush.
+// noting each batch's place in the flush. Its count is sequentially consistent, as zsort's:
+// the pipeline's node reads the live rays after writing it while a retiring thread reads it
+// after changing them, and one of the two must see the other's write to make it flush.
 class HoldingStage final : public BufferingStage {
  public:
   std::string name() const override { return "hold"; }
   void process(Batch* batch, StageOutput& out) const override { take(batch, out); }
   std::size_t take(Batch* batch, StageOutput&) const override {
     held_.push_back(batch);
-    rays_ += batch->rays.count;
+    rays_.store(rays_.load() + batch->rays.count);  // only the serial node writes it
     return 0;
   }
   std::size_t flush(StageOutput& out) const override {
     for (Batch* batch : held_) {
-      place_[batch] = place_.size();
+      {
+        std::lock_guard lock(place_mutex_);  // the next stage reads places while this one writes
+        place_[batch] = place_.size();
+      }
       out.emit(batch);
     }
     held_.clear();
-    const std::size_t rays = rays_;
-    rays_ = 0;
-    return rays;
+    return rays_.exchange(0);
   }
-  std::size_t buffered_rays() const override { return rays_; }
-  std::size_t place(Batch* batch) const { return place_.at(batch); }
+  std::size_t buffered_rays() const override { return rays_.load(); }
+  std::size_t place(Batch* batch) const {
+    std::lock_guard lock(place_mutex_);
+    return place_.at(batch);
+  }
 
  private:
   mutable std::vector<Batch*> held_;
+  mutable std::mutex place_mutex_;
   mutable std::map<Batch*, std::size_t> place_;
-  mutable std::size_t rays_ = 0;
+  mutable std::atomic<std::size_t> rays_{0};
 };
 
 // The flight budget bounds the rays alive, not only the camera rays: a stage that makes eight
