@@ -1,4 +1,5 @@
-// Pure kernels: counter-based randomness, sample warps, Morton codes, ray origin offsets.
+// Pure kernels: counter-based randomness, sample warps, Morton codes, ray origin offsets,
+// the packet walks' transposes.
 #include <algorithm>
 #include <cmath>
 #include <set>
@@ -8,6 +9,7 @@
 #include <glm/geometric.hpp>
 
 #include "wavetrace/kernels/checked_narrowing.hpp"
+#include "wavetrace/kernels/lane_transpose.hpp"
 #include "wavetrace/kernels/morton.hpp"
 #include "wavetrace/kernels/random.hpp"
 #include "wavetrace/kernels/ray_offset.hpp"
@@ -136,6 +138,34 @@ TEST(RayOffset, MovesOffTheSurfaceAtEveryScale) {
 
 namespace wavetrace {
 namespace {
+
+TEST(LaneTranspose, BitsAndLanesOfEightByEight) {
+  std::uint64_t state = 0x9E3779B97F4A7C15ull;
+  for (int trial = 0; trial < 200; ++trial) {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    const std::uint64_t bits = state ^ (state >> 29);
+    const std::uint64_t transposed = transpose_bits_8x8(bits);
+    for (int row = 0; row < 8; ++row) {
+      for (int column = 0; column < 8; ++column) {
+        ASSERT_EQ(bits >> (8 * row + column) & 1u, transposed >> (8 * column + row) & 1u) << trial;
+      }
+    }
+  }
+#if WAVETRACE_AVX2
+  alignas(32) float matrix[8][8];
+  __m256 rows[8];
+  for (int row = 0; row < 8; ++row) {
+    for (int lane = 0; lane < 8; ++lane) matrix[row][lane] = float(10 * row + lane);
+    rows[row] = _mm256_load_ps(matrix[row]);
+  }
+  transpose_lanes_8x8(rows);
+  for (int row = 0; row < 8; ++row) {
+    alignas(32) float out[8];
+    _mm256_store_ps(out, rows[row]);
+    for (int lane = 0; lane < 8; ++lane) ASSERT_EQ(out[lane], matrix[lane][row]) << row << " " << lane;
+  }
+#endif
+}
 
 TEST(CheckedNarrowing, PassesWhatFitsAndNamesTheFieldOfWhatDoesNot) {
   EXPECT_EQ(checked_uint32(0xffffffffu, "x"), 0xffffffffu);

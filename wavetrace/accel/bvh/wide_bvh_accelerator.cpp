@@ -25,6 +25,7 @@
 #include "wavetrace/accel/bvh/triangle_block.hpp"
 #include "wavetrace/accel/bvh/wide_bvh_node.hpp"
 #include "wavetrace/kernels/lane_sort.hpp"
+#include "wavetrace/kernels/lane_transpose.hpp"
 #include "wavetrace/kernels/ray_box.hpp"
 #include "wavetrace/accel/bvh/leaf_query.hpp"
 #include "wavetrace/memory/cache_aligned_allocator.hpp"
@@ -187,6 +188,22 @@ class WideBvhAccelerator final : public ProbedAccelerator<WideBvhAccelerator> {
   }
   BuildReport build() const override { return build_; }
 
+#if WAVETRACE_AVX2
+  // Camera rays eight at a time (two 2x2 pixel quads, as hmq:width=8 walks them): a node is
+  // fetched once a packet and its eight boxes slab-tested per ray, each child entered visited
+  // once with the mask of the rays that entered it, nearest first by the least entry distance
+  // among them; each ray tests a leaf's blocks alone. The hits are the single rays' (ties
+  // resolve by id, not by the order a walk meets them: kernels/nearest_hit.hpp).
+  void intersect_coherent(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
+    walk_with(kernel_isa(), [&]<KernelIsa kIsa>() {
+      PacketStack stack;
+      for (std::uint32_t begin = range.begin; begin < range.end; begin += kPacketRays) {
+        trace_packet<kIsa>(rays, hits, begin, std::min<std::uint32_t>(begin + kPacketRays, range.end), stack);
+      }
+    });
+  }
+#endif
+
   std::vector<std::span<const std::byte>> memory_spans() const override {
     std::vector<std::span<const std::byte>> spans = {std::as_bytes(std::span(nodes_)), std::as_bytes(std::span(blocks_))};
     for (const auto& span : geometry_.spans()) spans.push_back(span);
@@ -316,6 +333,114 @@ class WideBvhAccelerator final : public ProbedAccelerator<WideBvhAccelerator> {
       query.write<!kAnyHit>(hits, i, probe);
     });
   }
+
+#if WAVETRACE_AVX2
+  static constexpr int kPacketRays = 8;
+  // A subtree some of the packet's rays entered: their mask and each one's entry distance
+  // (lane r: ray r's, valid where its bit is set).
+  struct PacketEntry {
+    alignas(32) float distance[kPacketRays];
+    std::uint32_t child, count, rays;
+  };
+  // A level pushes at most eight entries and pops one, as the single ray's stack.
+  struct PacketStack {
+    PacketEntry entries[kMaxTreeDepth * kWidth + kWidth];
+  };
+
+  template <KernelIsa kIsa>
+  [[gnu::always_inline]] void trace_packet(const RayBatch& rays, HitBatch& hits, std::uint32_t begin, std::uint32_t end,
+                                           PacketStack& stack) const {
+    NullProbe probe;
+    const WideBvhNode* nodes = nodes_.data();
+    // Slots past `end` repeat the last ray, never live: LeafQuery has no empty state.
+    auto query_for = [&](std::uint32_t r) {
+      return LeafQuery(geometry_, {}, load_ray(rays, std::min(begin + r, end - 1)));
+    };
+    LeafQuery query[kPacketRays] = {query_for(0), query_for(1), query_for(2), query_for(3),
+                                    query_for(4), query_for(5), query_for(6), query_for(7)};
+    WideRay box_ray[kPacketRays];
+    alignas(32) float limit[kPacketRays];  // pruning_distance of each ray's nearest hit so far
+    unsigned live = 0;
+    for (std::uint32_t r = 0; r < kPacketRays; ++r) {
+      const std::uint32_t i = begin + r;
+      limit[r] = i < end ? pruning_distance(query[r].tmax) : -kInfinity;
+      if (i >= end || !(rays.flags[i] & ray_flags::alive)) continue;
+      const glm::vec3 origin(rays.origin_x[i], rays.origin_y[i], rays.origin_z[i]);
+      const glm::vec3 direction(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]);
+      box_ray[r] = {origin, make_box_ray(origin, direction).inverse_direction,
+                    (direction.x == 0.0f) | (direction.y == 0.0f) << 1 | (direction.z == 0.0f) << 2};
+      live |= 1u << r;
+    }
+    PacketEntry current{{}, 0, 0, live};  // the root
+    std::uint32_t top = 0;
+    while (live != 0) {
+      if (current.count == 0) {
+        const WideBvhNode& node = nodes[current.child];
+        // Row r: ray r's entry distances into the eight children (+inf for rays not here).
+        __m256 near[kPacketRays];
+        for (__m256& row : near) row = _mm256_set1_ps(kInfinity);
+        std::uint64_t entered_by_ray = 0;  // byte r: the children ray r entered
+        __m256 least = _mm256_set1_ps(kInfinity);
+        for (unsigned bits = current.rays; bits != 0; bits &= bits - 1) {
+          const int r = std::countr_zero(bits);
+          alignas(32) float distance[kWidth];
+          const unsigned entered = intersect_children(node, box_ray[r], query[r].tmin, limit[r], distance);
+          near[r] = _mm256_load_ps(distance);
+          least = _mm256_blendv_ps(least, _mm256_min_ps(least, near[r]), _mm256_castsi256_ps(lane_sort::lanes_of(entered)));
+          entered_by_ray |= std::uint64_t(entered) << (8 * r);
+        }
+        const std::uint64_t rays_by_child = transpose_bits_8x8(entered_by_ray);  // byte k: the rays that entered child k
+        std::uint64_t folded = entered_by_ray | entered_by_ray >> 32;
+        folded |= folded >> 16;
+        const unsigned any = unsigned(folded | folded >> 8) & 0xFFu;  // the children some ray entered
+        if (std::has_single_bit(any)) {  // one child entered: nothing to order or stack
+          const int k = std::countr_zero(any);
+          current.child = node.child[k], current.count = node.count[k];
+          current.rays = unsigned(rays_by_child >> (8 * k)) & 0xFFu;
+          continue;
+        }
+        if (any != 0) {
+          prefetch_children(node, any, nodes, blocks_.data());
+          transpose_lanes_8x8(near);  // row k: the rays' entry distances into child k
+          // Distances as integers order only from +0 up (push_nearest_last).
+          alignas(32) std::int32_t order[kWidth];
+          _mm256_store_si256(reinterpret_cast<__m256i*>(order),
+                             lane_sort::nearest_last_for<kIsa>(_mm256_max_ps(least, _mm256_setzero_ps()), any));
+          for (int n = 0, count = std::popcount(any); n < count; ++n) {  // farthest first: the nearest ends on top
+            const int k = order[n];
+            PacketEntry& pushed = stack.entries[top++];
+            _mm256_store_ps(pushed.distance, near[k]);
+            pushed.child = node.child[k], pushed.count = node.count[k];
+            pushed.rays = unsigned(rays_by_child >> (8 * k)) & 0xFFu;
+          }
+        }
+      } else {
+        for (unsigned bits = current.rays; bits != 0; bits &= bits - 1) {
+          const int r = std::countr_zero(bits);
+          query[r].template test_blocks<false>(blocks_.data() + current.child, current.count, probe);
+          limit[r] = pruning_distance(query[r].tmax);
+        }
+      }
+      // Pop the nearest subtree some ray can still improve on (not past its nearest hit).
+      unsigned still = 0;
+      const __m256 limits = _mm256_load_ps(limit);
+      while (still == 0 && top > 0) {
+        current = stack.entries[--top];
+        const __m256 within = _mm256_cmp_ps(_mm256_load_ps(current.distance), limits, _CMP_NGT_UQ);
+        still = unsigned(_mm256_movemask_ps(within)) & current.rays;
+      }
+      if (still == 0) break;
+      current.rays = still;
+    }
+    for (std::uint32_t i = begin; i < end; ++i) {
+      if (live >> (i - begin) & 1u) {
+        query[i - begin].template write<true>(hits, i, probe);
+      } else {
+        hits.set_miss(i);
+      }
+    }
+  }
+#endif
 
   IndexedFaceSet geometry_;
   StoredArray<WideBvhNode> nodes_;
