@@ -1,7 +1,7 @@
 // The 8-wide BVH: the binary SAH tree cut into nodes of up to eight children by the
-// surface-area plan (collapse_plan.hpp), traversed one ray at a time with all eight child
-// boxes tested in one AVX2 pass, nearest child first; leaves are blocks of four triangles
-// tested in one 4-lane pass.
+// surface-area plan (collapse_plan.hpp), traversed one ray at a time (camera rays eight at
+// a time) with all eight child boxes tested in one AVX2 pass, nearest child first; leaves
+// are blocks of four triangles tested in one 4-lane pass.
 #include "wavetrace/accel/bvh/wide_bvh_accelerator.hpp"
 #include "wavetrace/build_config.hpp"  // WAVETRACE_AVX2, WAVETRACE_FMA, WAVETRACE_BMI2
 
