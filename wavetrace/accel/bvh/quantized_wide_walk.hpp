@@ -20,6 +20,7 @@
 #include "wavetrace/accel/ray_loop.hpp"
 #include "wavetrace/kernels/kernel_isa.hpp"
 #include "wavetrace/kernels/lane_sort.hpp"
+#include "wavetrace/kernels/lane_transpose.hpp"
 #include "wavetrace/kernels/ray_box.hpp"
 #include "wavetrace/kernels/nearest_hit.hpp"
 
@@ -185,9 +186,9 @@ inline constexpr int kWidePacketRays = 8;
 struct QuantizedWidePacketStack {
   static constexpr std::size_t kEntries = kMaxTreeDepth * QuantizedWideNode::kWidth + QuantizedWideNode::kWidth;
   struct Entry {
+    alignas(32) float distance[kWidePacketRays];  // ray r's entry distance (valid where its bit is set)
     std::uint32_t reference;
     std::uint32_t rays;                   // bit r: ray r entered this child
-    float distance[kWidePacketRays];      // ray r's entry distance (valid where its bit is set)
     Bounds3 frame;
   };
   Entry entries[kEntries];
@@ -211,7 +212,7 @@ template <KernelIsa kIsa, typename Probe, typename VisitLeaf>
       inverse[r][axis] = _mm256_set1_ps(rays_in[r].box.inverse_direction[axis]);
     }
   }
-  Entry current{0, live, {}, root_frame};
+  Entry current{{}, 0, live, root_frame};
   std::uint32_t top = 0;
   while (true) {
     if (!(current.reference & kWideLeafReference)) {
@@ -220,19 +221,23 @@ template <KernelIsa kIsa, typename Probe, typename VisitLeaf>
       __m256 bound[6];
       decode_children(node, current.frame, bound);
       const unsigned occupied = occupied_slots(node);
-      alignas(32) float near[kWidePacketRays][8];
-      unsigned entered[kWidePacketRays] = {};
+      // Row r: ray r's entry distances into the eight children (+inf for rays not here).
+      __m256 near[kWidePacketRays];
+      for (__m256& row : near) row = _mm256_set1_ps(kInfinity);
+      std::uint64_t entered_by_ray = 0;  // byte r: the children ray r entered
       __m256 least = _mm256_set1_ps(kInfinity);
       for (unsigned bits = current.rays; bits != 0; bits &= bits - 1) {
         const int r = std::countr_zero(bits);
-        __m256 entry;
-        entered[r] = enter_children(bound, origin[r], inverse[r], rays_in[r].tmin, tmax[r], entry) & occupied;
-        _mm256_store_ps(near[r], entry);
-        least = _mm256_blendv_ps(least, _mm256_min_ps(least, entry), _mm256_castsi256_ps(lane_sort::lanes_of(entered[r])));
+        const unsigned entered = enter_children(bound, origin[r], inverse[r], rays_in[r].tmin, tmax[r], near[r]) & occupied;
+        least = _mm256_blendv_ps(least, _mm256_min_ps(least, near[r]), _mm256_castsi256_ps(lane_sort::lanes_of(entered)));
+        entered_by_ray |= std::uint64_t(entered) << (8 * r);
       }
-      unsigned any = 0;
-      for (int r = 0; r < kWidePacketRays; ++r) any |= entered[r];
+      std::uint64_t folded = entered_by_ray | entered_by_ray >> 32;
+      folded |= folded >> 16;
+      const unsigned any = unsigned(folded | folded >> 8) & 0xFFu;  // the children some ray entered
       if (any != 0) {
+        const std::uint64_t rays_by_child = transpose_bits_8x8(entered_by_ray);  // byte k: the rays in child k
+        transpose_lanes_8x8(near);                                              // row k: their distances to it
         alignas(32) std::int32_t order[8];
         alignas(32) std::uint32_t reference[8];
         alignas(32) float lanes[6][8];
@@ -242,12 +247,9 @@ template <KernelIsa kIsa, typename Probe, typename VisitLeaf>
         for (int n = 0, count = std::popcount(any); n < count; ++n) {  // farthest first: the nearest ends on top
           const int k = order[n];
           Entry& pushed = stack.entries[top++];
+          _mm256_store_ps(pushed.distance, near[k]);
           pushed.reference = reference[k];
-          pushed.rays = 0;
-          for (int r = 0; r < kWidePacketRays; ++r) {
-            pushed.rays |= ((entered[r] >> k) & 1u) << r;
-            pushed.distance[r] = near[r][k];
-          }
+          pushed.rays = unsigned(rays_by_child >> (8 * k)) & 0xFFu;
           pushed.frame.lower = {lanes[0][k], lanes[1][k], lanes[2][k]};
           pushed.frame.upper = {lanes[3][k], lanes[4][k], lanes[5][k]};
         }
@@ -255,17 +257,14 @@ template <KernelIsa kIsa, typename Probe, typename VisitLeaf>
     } else {
       visit_leaf(current.reference & ~kWideLeafReference, current.frame, current.rays);
     }
-    // Pop the nearest subtree some ray can still improve on.
+    // Pop the nearest subtree some ray can still improve on (not past its nearest hit).
+    const __m256 limits = _mm256_mul_ps(_mm256_loadu_ps(tmax), _mm256_set1_ps(kPruningSlack));  // pruning_distance
     while (true) {
       if (top == 0) return;
       current = stack.entries[--top];
-      unsigned still = 0;
-      for (unsigned bits = current.rays; bits != 0; bits &= bits - 1) {
-        const int r = std::countr_zero(bits);
-        if (!(current.distance[r] > pruning_distance(tmax[r]))) still |= 1u << r;
-      }
-      current.rays = still;
-      if (still != 0) break;
+      const __m256 within = _mm256_cmp_ps(_mm256_load_ps(current.distance), limits, _CMP_NGT_UQ);
+      current.rays &= unsigned(_mm256_movemask_ps(within));
+      if (current.rays != 0) break;
     }
   }
 }
