@@ -390,7 +390,10 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
   std::string name() const override { return "raystrips"; }
 
   void intersect_coherent(const RayBatch& rays, HitBatch& hits, RayRange range) const override {
-    if (!options_.packets || options_.width == 8) return intersect_closest(rays, hits, range);
+    if (!options_.packets) return intersect_closest(rays, hits, range);
+#if WAVETRACE_AVX2 && WAVETRACE_FMA
+    if (options_.width == 8) return intersect_coherent_wide(rays, hits, range);
+#endif
     walk_with(kernel_isa(), [&]<KernelIsa>() {
       PacketTraversal packets{nodes_.data(), strip_bytes_.data(), positions_.data(), options_.run_triangles,
                               options_.packet_min_active};
@@ -523,6 +526,60 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
         return trace_strips<kAnyHit>(ray, box, strip_data, end, near, far, positions, probe);
       }, [&](std::uint32_t leaf) { return strip_bytes_.data() + std::size_t(leaf_words[leaf]) * 4; });
       write_hit<!kAnyHit>(ray, hits, i, &probe);
+    });
+  }
+#endif
+
+#if WAVETRACE_AVX2 && WAVETRACE_FMA
+  // Camera rays eight at a time through the wide top (walk_quantized_wide_packet, as
+  // hmq:width=8 walks them): each node decoded once a packet, each top leaf's strips traced by
+  // every ray that reached it alone, so that each ray's hit is the single ray's.
+  void intersect_coherent_wide(const RayBatch& rays, HitBatch& hits, RayRange range) const {
+    walk_with(kernel_isa(), [&]<KernelIsa kIsa>() {
+      NullProbe probe;
+      QuantizedWidePacketStack stack;
+      const glm::vec3* positions = positions_.data();
+      const std::uint32_t* leaf_words = leaf_words_.data();
+      for (std::uint32_t begin = range.begin; begin < range.end; begin += kWidePacketRays) {
+        const std::uint32_t end = std::min<std::uint32_t>(begin + kWidePacketRays, range.end);
+        SingleRay packet[kWidePacketRays];
+        for (std::uint32_t r = 0; r < kWidePacketRays; ++r) packet[r] = load_ray(rays, std::min(begin + r, end - 1));
+        // Slots past `end` repeat the last ray and are never live.
+        StripRay strip_ray[kWidePacketRays] = {StripRay(packet[0]), StripRay(packet[1]), StripRay(packet[2]),
+                                               StripRay(packet[3]), StripRay(packet[4]), StripRay(packet[5]),
+                                               StripRay(packet[6]), StripRay(packet[7])};
+        float tmax[kWidePacketRays];
+        unsigned live = 0;
+        for (std::uint32_t r = 0; r < kWidePacketRays; ++r) {
+          tmax[r] = strip_ray[r].tmax;
+          if (begin + r < end && (rays.flags[begin + r] & ray_flags::alive)) live |= 1u << r;
+        }
+        if (live != 0) {
+          walk_quantized_wide_packet<kIsa>(
+              wide_nodes_.data(), root_, packet, live, tmax, probe, stack,
+              [&](std::uint32_t leaf, const Bounds3& box, unsigned members) {
+                const std::byte* strip_data = strip_bytes_.data() + std::size_t(leaf_words[leaf]) * 4;
+                const std::byte* strips_end = strip_bytes_.data() + std::size_t(leaf_words[leaf + 1]) * 4;
+                for (; members != 0; members &= members - 1) {
+                  const int r = std::countr_zero(members);
+                  StripRay& ray = strip_ray[r];
+                  float near, far;
+                  if (!clip_to_box(ray.box, box.lower, box.upper, ray.tmin, pruning_distance(ray.tmax), near, far)) {
+                    continue;
+                  }
+                  trace_strips<false>(ray, box, strip_data, strips_end, near, far, positions, probe);
+                  tmax[r] = ray.tmax;
+                }
+              });
+        }
+        for (std::uint32_t i = begin; i < end; ++i) {
+          if (live >> (i - begin) & 1u) {
+            write_hit<true>(strip_ray[i - begin], hits, i);
+          } else {
+            hits.set_miss(i);
+          }
+        }
+      }
     });
   }
 #endif

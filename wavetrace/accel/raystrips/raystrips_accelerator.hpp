@@ -32,10 +32,12 @@ struct RayStripsOptions {
   std::uint32_t bins = 16;  // SAH bins, for the sub-mesh cut and the top BVH
   // The top over the strips: 2, the baseline's 32-byte binary nodes; 8, the quantized 8-wide
   // nodes HMQ's wide layout has (accel/bvh/quantized_wide_node.hpp) and a 4-byte offset per
-  // top leaf. Packets (below) need the binary top.
+  // top leaf.
   std::uint32_t width = 2;
-  // Camera rays (intersect_coherent) as 2x2 packets (§5.3); below `packet_min_active`
-  // active rays in a strip, the packet falls back to single-ray strip traversal.
+  // Camera rays (intersect_coherent) in packets: under the binary top as 2x2 packets (§5.3),
+  // which below `packet_min_active` active rays in a strip fall back to single-ray strip
+  // traversal; under the 8-wide top eight at a time through its nodes, each ray alone
+  // through the strips.
   bool packets = true;
   std::uint32_t packet_min_active = 2;  // 1 .. 4
   bool operator==(const RayStripsOptions&) const = default;
