@@ -1,13 +1,16 @@
 // 8x8 transposes for packet walks: eight rays' answers for eight children (one row a ray)
-// become one row a child, the form a stack entry stores.
+// become one row a child, the form a stack entry stores; PacketChildren collects the answers.
 #pragma once
 
 #include <cstdint>
+#include <limits>
 
 #include "wavetrace/build_config.hpp"  // WAVETRACE_AVX2
 
 #if WAVETRACE_AVX2
 #include <immintrin.h>
+
+#include "wavetrace/kernels/lane_sort.hpp"
 #endif
 
 namespace wavetrace {
@@ -37,6 +40,32 @@ namespace wavetrace {
   row[4] = _mm256_permute2f128_ps(s0, s4, 0x31), row[5] = _mm256_permute2f128_ps(s1, s5, 0x31);
   row[6] = _mm256_permute2f128_ps(s2, s6, 0x31), row[7] = _mm256_permute2f128_ps(s3, s7, 0x31);
 }
+
+// A packet's answers for one node, collected ray by ray (`add`) and read child by child: the
+// children some ray entered, the rays that entered each, their entry distances into it, and
+// the least of those (by which the packet orders its visits).
+struct PacketChildren {
+  __m256 near[8];  // row r: ray r's entry distances (+inf for rays not added); after turn_to_children(), row k: child k's
+  __m256 least = _mm256_set1_ps(std::numeric_limits<float>::infinity());
+  std::uint64_t entered_by_ray = 0;  // byte r: the children ray r entered
+
+  [[gnu::always_inline]] PacketChildren() {
+    for (__m256& row : near) row = _mm256_set1_ps(std::numeric_limits<float>::infinity());
+  }
+  [[gnu::always_inline]] void add(int ray, unsigned entered, __m256 distances) {
+    near[ray] = distances;
+    least = _mm256_blendv_ps(least, _mm256_min_ps(least, distances), _mm256_castsi256_ps(lane_sort::lanes_of(entered)));
+    entered_by_ray |= std::uint64_t(entered) << (8 * ray);
+  }
+  [[gnu::always_inline]] unsigned any() const {
+    std::uint64_t folded = entered_by_ray | entered_by_ray >> 32;
+    folded |= folded >> 16;
+    return unsigned(folded | folded >> 8) & 0xFFu;
+  }
+  // Byte k: the rays that entered child k.
+  [[gnu::always_inline]] std::uint64_t rays_by_child() const { return transpose_bits_8x8(entered_by_ray); }
+  [[gnu::always_inline]] void turn_to_children() { transpose_lanes_8x8(near); }
+};
 #endif
 
 }  // namespace wavetrace

@@ -203,7 +203,6 @@ template <KernelIsa kIsa, typename Probe, typename VisitLeaf>
                                                               QuantizedWidePacketStack& stack, VisitLeaf&& visit_leaf) {
   using namespace quantized_wide;
   using Entry = QuantizedWidePacketStack::Entry;
-  constexpr float kInfinity = std::numeric_limits<float>::infinity();
   __m256 origin[kWidePacketRays][3], inverse[kWidePacketRays][3];
   for (unsigned bits = live; bits != 0; bits &= bits - 1) {
     const int r = std::countr_zero(bits);
@@ -221,33 +220,27 @@ template <KernelIsa kIsa, typename Probe, typename VisitLeaf>
       __m256 bound[6];
       decode_children(node, current.frame, bound);
       const unsigned occupied = occupied_slots(node);
-      // Row r: ray r's entry distances into the eight children (+inf for rays not here).
-      __m256 near[kWidePacketRays];
-      for (__m256& row : near) row = _mm256_set1_ps(kInfinity);
-      std::uint64_t entered_by_ray = 0;  // byte r: the children ray r entered
-      __m256 least = _mm256_set1_ps(kInfinity);
+      PacketChildren children;
       for (unsigned bits = current.rays; bits != 0; bits &= bits - 1) {
         const int r = std::countr_zero(bits);
-        const unsigned entered = enter_children(bound, origin[r], inverse[r], rays_in[r].tmin, tmax[r], near[r]) & occupied;
-        least = _mm256_blendv_ps(least, _mm256_min_ps(least, near[r]), _mm256_castsi256_ps(lane_sort::lanes_of(entered)));
-        entered_by_ray |= std::uint64_t(entered) << (8 * r);
+        __m256 entry;
+        const unsigned entered = enter_children(bound, origin[r], inverse[r], rays_in[r].tmin, tmax[r], entry) & occupied;
+        children.add(r, entered, entry);
       }
-      std::uint64_t folded = entered_by_ray | entered_by_ray >> 32;
-      folded |= folded >> 16;
-      const unsigned any = unsigned(folded | folded >> 8) & 0xFFu;  // the children some ray entered
+      const unsigned any = children.any();
       if (any != 0) {
-        const std::uint64_t rays_by_child = transpose_bits_8x8(entered_by_ray);  // byte k: the rays in child k
-        transpose_lanes_8x8(near);                                              // row k: their distances to it
+        const std::uint64_t rays_by_child = children.rays_by_child();  // byte k: the rays in child k
+        children.turn_to_children();                                   // row k: their distances to it
         alignas(32) std::int32_t order[8];
         alignas(32) std::uint32_t reference[8];
         alignas(32) float lanes[6][8];
-        _mm256_store_si256(reinterpret_cast<__m256i*>(order), lane_sort::nearest_last_for<kIsa>(least, any));
+        _mm256_store_si256(reinterpret_cast<__m256i*>(order), lane_sort::nearest_last_for<kIsa>(children.least, any));
         _mm256_store_si256(reinterpret_cast<__m256i*>(reference), child_references(node));
         for (int b = 0; b < 6; ++b) _mm256_store_ps(lanes[b], bound[b]);
         for (int n = 0, count = std::popcount(any); n < count; ++n) {  // farthest first: the nearest ends on top
           const int k = order[n];
           Entry& pushed = stack.entries[top++];
-          _mm256_store_ps(pushed.distance, near[k]);
+          _mm256_store_ps(pushed.distance, children.near[k]);
           pushed.reference = reference[k];
           pushed.rays = unsigned(rays_by_child >> (8 * k)) & 0xFFu;
           pushed.frame.lower = {lanes[0][k], lanes[1][k], lanes[2][k]};

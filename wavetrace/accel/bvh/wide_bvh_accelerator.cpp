@@ -376,23 +376,15 @@ class WideBvhAccelerator final : public ProbedAccelerator<WideBvhAccelerator> {
     while (live != 0) {
       if (current.count == 0) {
         const WideBvhNode& node = nodes[current.child];
-        // Row r: ray r's entry distances into the eight children (+inf for rays not here).
-        __m256 near[kPacketRays];
-        for (__m256& row : near) row = _mm256_set1_ps(kInfinity);
-        std::uint64_t entered_by_ray = 0;  // byte r: the children ray r entered
-        __m256 least = _mm256_set1_ps(kInfinity);
+        PacketChildren children;
         for (unsigned bits = current.rays; bits != 0; bits &= bits - 1) {
           const int r = std::countr_zero(bits);
           alignas(32) float distance[kWidth];
           const unsigned entered = intersect_children(node, box_ray[r], query[r].tmin, limit[r], distance);
-          near[r] = _mm256_load_ps(distance);
-          least = _mm256_blendv_ps(least, _mm256_min_ps(least, near[r]), _mm256_castsi256_ps(lane_sort::lanes_of(entered)));
-          entered_by_ray |= std::uint64_t(entered) << (8 * r);
+          children.add(r, entered, _mm256_load_ps(distance));
         }
-        const std::uint64_t rays_by_child = transpose_bits_8x8(entered_by_ray);  // byte k: the rays that entered child k
-        std::uint64_t folded = entered_by_ray | entered_by_ray >> 32;
-        folded |= folded >> 16;
-        const unsigned any = unsigned(folded | folded >> 8) & 0xFFu;  // the children some ray entered
+        const unsigned any = children.any();
+        const std::uint64_t rays_by_child = children.rays_by_child();  // byte k: the rays that entered child k
         if (std::has_single_bit(any)) {  // one child entered: nothing to order or stack
           const int k = std::countr_zero(any);
           current.child = node.child[k], current.count = node.count[k];
@@ -401,15 +393,15 @@ class WideBvhAccelerator final : public ProbedAccelerator<WideBvhAccelerator> {
         }
         if (any != 0) {
           prefetch_children(node, any, nodes, blocks_.data());
-          transpose_lanes_8x8(near);  // row k: the rays' entry distances into child k
+          children.turn_to_children();  // row k: the rays' entry distances into child k
           // Distances as integers order only from +0 up (push_nearest_last).
           alignas(32) std::int32_t order[kWidth];
           _mm256_store_si256(reinterpret_cast<__m256i*>(order),
-                             lane_sort::nearest_last_for<kIsa>(_mm256_max_ps(least, _mm256_setzero_ps()), any));
+                             lane_sort::nearest_last_for<kIsa>(_mm256_max_ps(children.least, _mm256_setzero_ps()), any));
           for (int n = 0, count = std::popcount(any); n < count; ++n) {  // farthest first: the nearest ends on top
             const int k = order[n];
             PacketEntry& pushed = stack.entries[top++];
-            _mm256_store_ps(pushed.distance, near[k]);
+            _mm256_store_ps(pushed.distance, children.near[k]);
             pushed.child = node.child[k], pushed.count = node.count[k];
             pushed.rays = unsigned(rays_by_child >> (8 * k)) & 0xFFu;
           }
