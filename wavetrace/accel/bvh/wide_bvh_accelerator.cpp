@@ -352,12 +352,13 @@ class WideBvhAccelerator final : public ProbedAccelerator<WideBvhAccelerator> {
                                            PacketStack& stack) const {
     NullProbe probe;
     const WideBvhNode* nodes = nodes_.data();
-    // Slots past `end` repeat the last ray, never live: LeafQuery has no empty state.
-    auto query_for = [&](std::uint32_t r) {
-      return LeafQuery(geometry_, {}, load_ray(rays, std::min(begin + r, end - 1)));
-    };
-    LeafQuery query[kPacketRays] = {query_for(0), query_for(1), query_for(2), query_for(3),
-                                    query_for(4), query_for(5), query_for(6), query_for(7)};
+    // Slots past `end` repeat the last ray and are never live: LeafQuery has no empty state.
+    SingleRay packet[kPacketRays];
+    for (std::uint32_t r = 0; r < kPacketRays; ++r) packet[r] = load_ray(rays, std::min(begin + r, end - 1));
+    LeafQuery query[kPacketRays] = {
+        LeafQuery(geometry_, {}, packet[0]), LeafQuery(geometry_, {}, packet[1]), LeafQuery(geometry_, {}, packet[2]),
+        LeafQuery(geometry_, {}, packet[3]), LeafQuery(geometry_, {}, packet[4]), LeafQuery(geometry_, {}, packet[5]),
+        LeafQuery(geometry_, {}, packet[6]), LeafQuery(geometry_, {}, packet[7])};
     WideRay box_ray[kPacketRays];
     alignas(32) float limit[kPacketRays];  // pruning_distance of each ray's nearest hit so far
     unsigned live = 0;
@@ -365,15 +366,14 @@ class WideBvhAccelerator final : public ProbedAccelerator<WideBvhAccelerator> {
       const std::uint32_t i = begin + r;
       limit[r] = i < end ? pruning_distance(query[r].tmax) : -kInfinity;
       if (i >= end || !(rays.flags[i] & ray_flags::alive)) continue;
-      const glm::vec3 origin(rays.origin_x[i], rays.origin_y[i], rays.origin_z[i]);
-      const glm::vec3 direction(rays.direction_x[i], rays.direction_y[i], rays.direction_z[i]);
-      box_ray[r] = {origin, make_box_ray(origin, direction).inverse_direction,
+      const glm::vec3& direction = packet[r].direction;
+      box_ray[r] = {packet[r].origin, packet[r].box.inverse_direction,
                     (direction.x == 0.0f) | (direction.y == 0.0f) << 1 | (direction.z == 0.0f) << 2};
       live |= 1u << r;
     }
     PacketEntry current{{}, 0, 0, live};  // the root
     std::uint32_t top = 0;
-    while (live != 0) {
+    while (live != 0) {  // until no entry is left for any ray (the pop below breaks out)
       if (current.count == 0) {
         const WideBvhNode& node = nodes[current.child];
         PacketChildren children;
