@@ -10,6 +10,9 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "wavetrace/stages/gather_spawn.hpp"
+#include "wavetrace/stages/spawn.hpp"
+
 namespace wavetrace {
 namespace {
 
@@ -81,8 +84,8 @@ void check_megakernel_plan(const RenderPlan& plan) {
 }  // namespace
 
 std::size_t rays_per_camera_ray(const RenderPlan& plan) {
-  if (plan.integrator == Integrator::photon) return std::size_t{plan.photon.gather_rays} + 1;
-  return std::find(plan.stages.begin(), plan.stages.end(), "spawn") != plan.stages.end() ? 2 : 1;
+  if (plan.integrator == Integrator::photon) return GatherSpawnStage::rays_out_per_ray(plan.photon.gather_rays);
+  return std::find(plan.stages.begin(), plan.stages.end(), "spawn") != plan.stages.end() ? SpawnStage::kRaysOutPerRay : 1;
 }
 
 void check_accelerator_options(const Config& config, const AcceleratorOptions& options) {

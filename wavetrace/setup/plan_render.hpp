@@ -13,7 +13,8 @@ namespace wavetrace {
 RenderPlan plan_render(const Config& config);
 
 // The most rays one camera ray becomes at once in the plan's chain (the largest of its
-// stages' rays_out_per_ray): sizes the flight budget a disk buffer needs to fill.
+// stages' rays_out_per_ray, read from the stages' own counts before they exist): sizes the
+// flight budget a disk buffer needs to fill.
 std::size_t rays_per_camera_ray(const RenderPlan& plan);
 
 // What a world file keeps of the accelerator the plan built: accel.type and the keys of its

@@ -20,7 +20,8 @@ class GatherSpawnStage final : public Stage {
   std::string name() const override { return "spawn"; }
   void process(Batch* batch, StageOutput& out) const override;
   // A diffuse hit's gathering rays and light sample; a specular hit's one bounce.
-  std::size_t rays_out_per_ray() const override { return std::size_t{gather_rays_} + 1; }
+  static constexpr std::size_t rays_out_per_ray(std::uint32_t gather_rays) { return std::size_t{gather_rays} + 1; }
+  std::size_t rays_out_per_ray() const override { return rays_out_per_ray(gather_rays_); }
 
  private:
   const World& world_;

@@ -15,7 +15,8 @@ class SpawnStage final : public Stage {
   SpawnStage(const World& world, const PathRules& rules) : world_(world), rules_(rules) {}
   std::string name() const override { return "spawn"; }
   void process(Batch* batch, StageOutput& out) const override;
-  std::size_t rays_out_per_ray() const override { return 2; }  // a bounce and a light sample
+  static constexpr std::size_t kRaysOutPerRay = 2;  // a bounce and a light sample
+  std::size_t rays_out_per_ray() const override { return kRaysOutPerRay; }
 
   // Appends the rays spawned from the live rays of `range` of `batch` to `bounces` and
   // (when the scene has lights) `shadows`; the megakernel calls it for one ray.
