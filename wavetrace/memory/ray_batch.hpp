@@ -122,6 +122,16 @@ class RayBatch {
     }
   }
 
+  // copy_ray without the approximate hit, which nothing reads once a ray has its key: zsort's
+  // gather moves three columns fewer (a fifth of its flush's time).
+  void copy_keyed_ray(std::size_t to, const RayBatch& source, std::size_t from) {
+    WAVETRACE_RAY_COLUMNS(WAVETRACE_COPY_COLUMN)
+    if (source.has_sort_key()) {
+      if (!has_sort_key()) enable_sort_key();
+      WAVETRACE_SORT_KEY_COLUMNS(WAVETRACE_COPY_COLUMN)
+    }
+  }
+
   RayRange all() const { return {0, static_cast<std::uint32_t>(count)}; }
 
  private:

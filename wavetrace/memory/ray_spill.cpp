@@ -16,8 +16,7 @@ namespace wavetrace {
 namespace {
 
 constexpr std::size_t kSpillIoBytes = std::size_t{1} << 20;
-constexpr std::uint32_t kApproxHitColumns = 1u << 0;
-constexpr std::uint32_t kSortKeyColumns = 1u << 1;
+constexpr std::uint32_t kSortKeyColumns = 1u << 1;  // bit 0 once named the approximate hit
 
 struct BlockHeader {
   std::uint32_t count;
@@ -95,12 +94,13 @@ void SpillRun::write_bytes(const void* data, std::size_t bytes) {
 }
 
 void SpillRun::append(RayBatch& rays) {
-  const BlockHeader header{std::uint32_t(rays.count), (rays.has_approx_hit() ? kApproxHitColumns : 0u) |
-                                                           (rays.has_sort_key() ? kSortKeyColumns : 0u)};
+  // A spilled ray has its key: its approximate hit, which only made the key, stays behind
+  // (a batch from the pool may still hold a stale one).
+  const BlockHeader header{std::uint32_t(rays.count), rays.has_sort_key() ? kSortKeyColumns : 0u};
   write_bytes(&header, sizeof header);
   rays.for_each_column([&](const char*, void* column, std::size_t element_bytes) {
     write_bytes(column, rays.count * element_bytes);
-  });
+  }, /*with_approx_hit=*/false, rays.has_sort_key());
   rays_ += rays.count;
 }
 
@@ -147,13 +147,16 @@ bool SpillRun::read_block(RayBatch& rays) {
     throw SpillError(fmt::format("reorder.spill_dir = {}: a spill block holds {} rays, not 1 to {}", directory_,
                                  header.count, rays.capacity()));
   }
-  const bool approx_hit = header.columns & kApproxHitColumns, sort_key = header.columns & kSortKeyColumns;
-  if (approx_hit) rays.enable_approx_hit();
+  if ((header.columns & ~kSortKeyColumns) != 0) {
+    throw SpillError(fmt::format("reorder.spill_dir = {}: a spill block names columns {:#x}, not a run's", directory_,
+                                 header.columns));
+  }
+  const bool sort_key = header.columns & kSortKeyColumns;
   if (sort_key) rays.enable_sort_key();
   rays.count = header.count;
   rays.for_each_column(
       [&](const char*, void* column, std::size_t element_bytes) { read_bytes(column, rays.count * element_bytes); },
-      approx_hit, sort_key);
+      /*with_approx_hit=*/false, sort_key);
   return true;
 }
 

@@ -7,10 +7,10 @@
 // Run format, one block per batch of rays, blocks back to back from offset 0 (native
 // little-endian x86-64, no padding):
 //   offset 0   u32  count: rays in the block (1 .. the writer's batch capacity)
-//          4   u32  columns: bit 0 set when the approximate hit columns follow, bit 1 when
-//                   the sort key column follows (zsort's runs have both)
-//          8        each present column of RayBatch::for_each_column in its order (origin_x
-//                   ... flags, then approx_hit_x/y/z, then sort_key), count x the column's
+//          4   u32  columns: bit 1 set when the sort key column follows (zsort's runs have
+//                   it); no other bit is set (a keyed ray's approximate hit stays behind)
+//          8        the ray columns of RayBatch::for_each_column in its order (origin_x ...
+//                   flags), then sort_key when present, count x the column's
 //                   element bytes (4, or 2 for depth, 1 for kind and flags, 8 for sort_key)
 #pragma once
 
@@ -50,7 +50,7 @@ class SpillRun {
   SpillRun(const SpillRun&) = delete;
   SpillRun& operator=(const SpillRun&) = delete;
 
-  // Appends the batch's rays (every present column) as one block.
+  // Appends the batch's rays (their columns and key, not an approximate hit) as one block.
   void append(RayBatch& rays);
   // Ends writing (flushes what is buffered); reading starts at the first block.
   void finish_writing();

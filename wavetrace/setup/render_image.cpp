@@ -19,7 +19,7 @@ namespace wavetrace {
 namespace {
 
 // A disk ray buffer writes at most a generation of rays: every path's bounce and shadow ray
-// (two per camera sample), each its ray, approximate hit and key columns. Checked before
+// (two per camera sample), each its ray and key columns. Checked before
 // anything is traced, so that a render never stops for want of disk halfway through.
 void check_spill_space(const RenderPlan& plan) {
   if (plan.reorder.buffer != RayBufferKind::disk) return;
@@ -27,7 +27,7 @@ void check_spill_space(const RenderPlan& plan) {
       plan.reorder.spill_dir.empty() ? std::filesystem::temp_directory_path().string() : plan.reorder.spill_dir;
   const std::uint64_t free = spill_directory_free_bytes(directory);
   const std::uint64_t needed = 2 * std::uint64_t(plan.image.pixel_count()) * plan.image.samples_per_pixel *
-                               (RayBatch::kBytesPerRay + RayBatch::kApproxHitBytesPerRay + RayBatch::kSortKeyBytesPerRay);
+                               (RayBatch::kBytesPerRay + RayBatch::kSortKeyBytesPerRay);
   if (needed > free) {
     throw SpillError(fmt::format("reorder.spill_dir = {}: a generation of this render's rays may need {:.2f} GB on "
                                  "disk and {:.2f} GB are free",

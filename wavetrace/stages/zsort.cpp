@@ -93,7 +93,7 @@ std::vector<Batch*> ZSortStage::sort_held(StageOutput& out) const {
   tbb::parallel_for(std::size_t{0}, sorted.size(), [&](std::size_t s) {
     RayBatch& rays = sorted[s]->rays;
     const std::size_t begin = s * capacity, end = std::min(total, begin + capacity);
-    for (std::size_t k = begin; k < end; ++k) rays.copy_ray(k - begin, held_[entries[k].batch]->rays, entries[k].ray);
+    for (std::size_t k = begin; k < end; ++k) rays.copy_keyed_ray(k - begin, held_[entries[k].batch]->rays, entries[k].ray);
     rays.count = end - begin;
   });
   for (Batch* batch : held_) out.release(batch);
@@ -160,7 +160,7 @@ std::size_t ZSortStage::drain(StageOutput& out, std::size_t max_rays) const {
       const std::size_t run = merge.heads.top().run;
       merge.heads.pop();
       RayBatch& block = merge.blocks[run]->rays;
-      rays.copy_ray(count++, block, merge.positions[run]);
+      rays.copy_keyed_ray(count++, block, merge.positions[run]);
       if (++merge.positions[run] < block.count || merge.refill(run)) {
         merge.heads.push({Merge::key_of(block, merge.positions[run]), run});
       }
