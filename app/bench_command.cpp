@@ -1,5 +1,5 @@
-// `wavetrace bench accel`, `bench leak`, `bench reorder`, `bench pipeline`, `bench image` and
-// `bench photons`.
+// `wavetrace bench accel`, `bench leak`, `bench reorder`, `bench pipeline`, `bench sort`,
+// `bench image` and `bench photons`.
 #include <functional>
 #include <fstream>
 #include <memory>
@@ -15,6 +15,7 @@
 #include "wavetrace/bench/leak_bench.hpp"
 #include "wavetrace/bench/photon_bench.hpp"
 #include "wavetrace/bench/pipeline_bench.hpp"
+#include "wavetrace/bench/sort_bench.hpp"
 #include "wavetrace/bench/reorder_bench.hpp"
 #include "wavetrace/setup/render_setup.hpp"
 #include "wavetrace/setup/world_file.hpp"
@@ -160,21 +161,26 @@ Config render_bench_config(const std::vector<std::string>& defaults, const std::
   return config;
 }
 
-int run_reorder(const ReorderArguments& args) {
-  const Config config = render_bench_config({"render.max_depth=5"}, args.assignments, args.scene, args.spp, args.threads,
-                                            args.size, [&](Config& flags) {
-                                              apply_accelerator_spec(flags, args.accel);
-                                              flags.set("reorder.curve=" + args.curve);
-                                            });
+// `--heuristics a,b,...` as heuristics, in order.
+std::vector<ReorderHeuristic> parse_heuristic_list(const std::string& list) {
   std::vector<ReorderHeuristic> heuristics;
-  for (const std::string& name : split_commas(args.heuristics)) {
+  for (const std::string& name : split_commas(list)) {
     try {
       heuristics.push_back(parse_reorder_heuristic(name));
     } catch (const std::invalid_argument& error) {
       throw ConfigError(fmt::format("--heuristics: {}", error.what()));
     }
   }
-  const ReorderBenchReport report = run_reorder_bench(config, heuristics, args.repeat);
+  return heuristics;
+}
+
+int run_reorder(const ReorderArguments& args) {
+  const Config config = render_bench_config({"render.max_depth=5"}, args.assignments, args.scene, args.spp, args.threads,
+                                            args.size, [&](Config& flags) {
+                                              apply_accelerator_spec(flags, args.accel);
+                                              flags.set("reorder.curve=" + args.curve);
+                                            });
+  const ReorderBenchReport report = run_reorder_bench(config, parse_heuristic_list(args.heuristics), args.repeat);
   fmt::print("{}", to_table(report));
   if (!args.json.empty()) write_text(args.json, to_json(report).dump(2) + "\n");
   return 0;
@@ -196,13 +202,7 @@ int run_pipeline(const PipelineArguments& args) {
   const Config config = render_bench_config({}, args.assignments, args.scene, args.spp, 0, args.size,
                                             [&](Config& flags) { apply_accelerator_spec(flags, args.accel); });
   PipelineBenchRequest request;
-  for (const std::string& name : split_commas(args.heuristics)) {
-    try {
-      request.heuristics.push_back(parse_reorder_heuristic(name));
-    } catch (const std::invalid_argument& error) {
-      throw ConfigError(fmt::format("--heuristics: {}", error.what()));
-    }
-  }
+  request.heuristics = parse_heuristic_list(args.heuristics);
   for (const std::string& count : split_commas(args.threads)) {
     try {
       std::size_t used = 0;
@@ -214,6 +214,36 @@ int run_pipeline(const PipelineArguments& args) {
   }
   request.repeats = args.repeat;
   const PipelineBenchReport report = run_pipeline_bench(config, request);
+  fmt::print("{}", to_table(report));
+  if (!args.json.empty()) write_text(args.json, to_json(report).dump(2) + "\n");
+  return 0;
+}
+
+struct SortArguments {
+  std::string heuristics = "hph,hph_origin";
+  std::string curves = "morton,hilbert";
+  std::size_t rays = 262144;
+  std::size_t batch_size = 1024;
+  int threads = 1;
+  int repeat = 5;
+  std::string json;
+};
+
+int run_sort(const SortArguments& args) {
+  SortBenchRequest request;
+  request.heuristics = parse_heuristic_list(args.heuristics);
+  for (const std::string& name : split_commas(args.curves)) {
+    try {
+      request.curves.push_back(parse_curve_kind(name));
+    } catch (const std::invalid_argument& error) {
+      throw ConfigError(fmt::format("--curves: {}", error.what()));
+    }
+  }
+  request.rays = args.rays;
+  request.batch_size = args.batch_size;
+  request.threads = args.threads;
+  request.repeats = args.repeat;
+  const SortBenchReport report = run_sort_bench(request);
   fmt::print("{}", to_table(report));
   if (!args.json.empty()) write_text(args.json, to_json(report).dump(2) + "\n");
   return 0;
@@ -362,6 +392,18 @@ void add_bench_command(CLI::App& app, int& exit_code) {
   pipeline->add_option("--json", pipeline_args->json, "write results as JSON");
   add_set_option(*pipeline, pipeline_args->assignments, "render.max_depth=8");
   pipeline->callback([pipeline_args, &exit_code] { exit_code = run_pipeline(*pipeline_args); });
+
+  auto sort_args = std::make_shared<SortArguments>();
+  CLI::App* sort = bench->add_subcommand(
+      "sort", "zsort's flush of scattered rays, apart from any render: keys, sort and gather, ns a ray");
+  sort->add_option("--heuristics", sort_args->heuristics, "comma-separated: none, origin, origin_dir, hph, hph_origin, hph_dir");
+  sort->add_option("--curves", sort_args->curves, "comma-separated: morton, hilbert");
+  sort->add_option("--rays", sort_args->rays, "rays in the buffer (reorder.buffer_rays' default)");
+  sort->add_option("--batch-size", sort_args->batch_size, "rays a batch (render.batch_size's default)");
+  sort->add_option("--threads", sort_args->threads, "threads of the flush's parallel loops");
+  sort->add_option("--repeat", sort_args->repeat, "flushes per row (the median is reported)");
+  sort->add_option("--json", sort_args->json, "write results as JSON");
+  sort->callback([sort_args, &exit_code] { exit_code = run_sort(*sort_args); });
 
   auto image_args = std::make_shared<ImageArguments>();
   CLI::App* image = bench->add_subcommand("image", "render the same image with each accelerator, RMSE against the first");

@@ -322,6 +322,34 @@ TEST(Cli, BenchPipelineComparesTheMegakernelWithEachHeuristic) {
   EXPECT_FALSE(json["results"][4]["thread_scaling"].is_null());
 }
 
+TEST(Cli, BenchSortTimesEachPhaseOfZSortsFlush) {
+  const nlohmann::json json = testing::run_bench_json(
+      "sort.json", "sort --heuristics none,hph_origin --curves morton,hilbert --rays 5000 --batch-size 256 --repeat 2");
+  EXPECT_EQ(json["rays"], 5000u);
+  EXPECT_EQ(json["batch_size"], 256u);
+  ASSERT_EQ(json["results"].size(), 4u);  // each heuristic on each curve, curves outermost
+  EXPECT_EQ(json["results"][0]["heuristic"], "none");
+  EXPECT_EQ(json["results"][3]["heuristic"], "hph_origin");
+  EXPECT_EQ(json["results"][3]["curve"], "hilbert");
+  for (const auto& entry : json["results"]) {
+    const double flush = entry["flush_ns_per_ray"].get<double>();
+    EXPECT_GT(flush, 0.0);
+    EXPECT_GE(entry["gather_ns_per_ray"].get<double>(), 0.0);
+    EXPECT_LE(entry["sort_ns_per_ray"].get<double>(), flush);
+  }
+  EXPECT_EQ(json["results"][0]["keys_ns_per_ray"], 0.0);  // none makes no keys
+  EXPECT_GT(json["results"][1]["keys_ns_per_ray"].get<double>(), 0.0);
+}
+
+TEST(Cli, BenchSortRefusesWhatItCannotMeasure) {
+  for (const char* arguments : {"--heuristics sideways", "--curves peano", "--rays 0", "--rays 99999999999", "--batch-size 8", "--repeat 0",
+                                "--threads 0"}) {
+    const auto result = testing::run_wavetrace(std::string("bench sort ") + arguments);
+    EXPECT_NE(result.exit_code, 0) << arguments;
+    EXPECT_EQ(result.output.find("terminate"), std::string::npos) << result.output;
+  }
+}
+
 TEST(Cli, BenchPipelineRefusesWhatItCannotMeasure) {
   for (const char* arguments : {"--threads 1,x", "--heuristics sideways", "--repeat 0", "--set memory.budget=50%"}) {
     const auto result =
