@@ -109,21 +109,17 @@ class RayBatch {
   }
 
   // Copies every present column of ray `from` of `source` into slot `to` of this batch.
-  // Inline: zsort's gather and the chunked walk's rounds call it once a ray.
+  // Inline: approx_hit's compaction and repack call it once a ray.
   void copy_ray(std::size_t to, const RayBatch& source, std::size_t from) {
-    WAVETRACE_RAY_COLUMNS(WAVETRACE_COPY_COLUMN)
+    copy_keyed_ray(to, source, from);
     if (source.has_approx_hit()) {
       if (!has_approx_hit()) enable_approx_hit();
       WAVETRACE_APPROX_HIT_COLUMNS(WAVETRACE_COPY_COLUMN)
     }
-    if (source.has_sort_key()) {
-      if (!has_sort_key()) enable_sort_key();
-      WAVETRACE_SORT_KEY_COLUMNS(WAVETRACE_COPY_COLUMN)
-    }
   }
 
   // copy_ray without the approximate hit, which nothing reads once a ray has its key: zsort's
-  // gather moves three columns fewer (a fifth of its flush's time).
+  // gather moves three columns fewer (a fifth of its time).
   void copy_keyed_ray(std::size_t to, const RayBatch& source, std::size_t from) {
     WAVETRACE_RAY_COLUMNS(WAVETRACE_COPY_COLUMN)
     if (source.has_sort_key()) {
