@@ -65,6 +65,9 @@ int run_build(const BuildArguments& args) {
   if (!is_world_file(args.out)) throw ConfigError(fmt::format("--out {}: a world file is named *.wtw", args.out));
   RenderPlan plan = plan_render(config);
   if (is_world_file(plan.scene.source)) throw ConfigError(fmt::format("{} is already a world", plan.scene.source));
+  // A world is saved to be paged: proxy.share = auto takes the paper's share (a render in core
+  // simplifies it again).
+  if (plan.proxy.share_by_holding) plan.proxy.share = ProxyOptions::kPagedShare;
   // Every parallel phase, ours and Embree's, on at most --threads threads: the builds run in
   // TBB's default arena, which would otherwise take every core.
   std::optional<tbb::global_control> thread_limit;

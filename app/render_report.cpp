@@ -117,7 +117,8 @@ nlohmann::json proxy_json(const Proxy& proxy) {
           {"accel", proxy.accelerator().name()},
           {"quality", quality(report.quality)},
           {"cluster_quality", quality(report.cluster_quality)},
-          {"stochastic_quality", quality(report.stochastic_quality)}};
+          {"stochastic_quality", quality(report.stochastic_quality)},
+          {"coarsened_from", report.coarsened_from > 0 ? nlohmann::json(report.coarsened_from) : nlohmann::json(nullptr)}};
 }
 
 nlohmann::json render_stats_json(const RenderFacts& facts) {
@@ -321,9 +322,11 @@ std::string render_table(const RenderFacts& facts) {
   }
   if (facts.proxy != nullptr) {
     const ProxyReport& proxy = facts.proxy->report();
-    table += fmt::format("proxy: {} triangles by {} in {:.2f} s (+{:.2f} s {} build); hits overlap the scene's on "
+    const std::string from =
+        proxy.coarsened_from > 0 ? fmt::format(" (simplified again from the world's {})", proxy.coarsened_from) : "";
+    table += fmt::format("proxy: {} triangles{} by {} in {:.2f} s (+{:.2f} s {} build); hits overlap the scene's on "
                          "{:.1f}% of test rays (agree on {:.1f}%)\n",
-                         proxy.triangles, to_string(proxy.method), proxy.simplify_seconds, proxy.build_seconds,
+                         proxy.triangles, from, to_string(proxy.method), proxy.simplify_seconds, proxy.build_seconds,
                          facts.proxy->accelerator().name(), 100.0 * proxy.quality.hit_overlap,
                          100.0 * proxy.quality.hit_agreement);
   }

@@ -59,6 +59,23 @@ TEST(PlanKeys, RowsSetTheFieldsTheyName) {
   EXPECT_EQ(accelerator_options(config).hmq.width, 2u);
 }
 
+// proxy.share = auto: the paper's 2% where a pager holds the world, a tenth of it in core; a
+// number is taken as it is either way.
+TEST(PlanKeys, TheProxyShareFollowsWhereTheWorldIsHeld) {
+  Config in_core;
+  EXPECT_EQ(plan_render(in_core).proxy.share, ProxyOptions::kInCoreShare);
+  EXPECT_TRUE(plan_render(in_core).proxy.share_by_holding);
+  Config paged;
+  paged.set("memory.budget=24%");
+  EXPECT_EQ(plan_render(paged).proxy.share, ProxyOptions::kPagedShare);
+  EXPECT_LT(ProxyOptions::kInCoreShare, ProxyOptions::kPagedShare);
+  for (Config* config : {&in_core, &paged}) {
+    config->set("proxy.share=0.05");
+    EXPECT_EQ(plan_render(*config).proxy.share, 0.05);
+    EXPECT_FALSE(plan_render(*config).proxy.share_by_holding);
+  }
+}
+
 // The option structs' own defaults (what a C++ user gets from RenderPlan{}) are the table's:
 // reading any key at its default changes nothing in a default plan.
 TEST(PlanKeys, OptionStructDefaultsEqualTheTable) {

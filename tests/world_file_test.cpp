@@ -346,6 +346,36 @@ TEST(WorldFile, SavedProxyOrdersRaysAsTheFreshOneDoes) {
   fs::remove(path);
 }
 
+// A world is saved with the paper's 2% proxy; rendered in core (proxy.share = auto) its proxy
+// is simplified again to the in-core share, judged against the world, and orders the rays
+// to the same image. Paged, or asked for no fewer triangles, the saved proxy stays.
+TEST(WorldFile, ASavedProxyIsSimplifiedAgainForAnInCoreRender) {
+  const std::string path = temp_path("proxy_again.wtw");
+  const std::vector<std::string> settings = {"accel.type=hmq", "reorder.heuristic=hph"};
+  std::vector<std::string> saved_settings = settings;
+  saved_settings.emplace_back("proxy.share=0.02");
+  const std::vector<float> fresh = build_and_save(saved_settings, path, true);
+
+  const RenderPlan in_core = plan_render(small_render(settings));
+  const std::unique_ptr<LoadedWorld> world = load_world(path, std::nullopt, 2);
+  const Proxy* saved = world->proxy.get();
+  const std::size_t saved_triangles = saved->report().triangles;
+  const float saved_tolerance = saved->surface_tolerance();
+  EXPECT_GT(saved_triangles, proxy_target_triangles(0.015, world->scene.triangle_count));
+  coarsen_world_proxy(*world, ProxyOptions::kPagedShare, 2);
+  EXPECT_EQ(world->proxy.get(), saved);  // already the paged share: kept
+  coarsen_world_proxy(*world, in_core.proxy.share, 2);
+  const Proxy& coarse = *world->proxy;
+  EXPECT_EQ(coarse.report().coarsened_from, saved_triangles);
+  EXPECT_LT(coarse.report().triangles * 4, saved_triangles);
+  EXPECT_GE(coarse.surface_tolerance(), saved_tolerance);
+  EXPECT_GT(coarse.report().quality.hit_overlap, 0.8);
+  const std::vector<float> image = render_with(small_render(settings), World{world->scene, *world->accelerator,
+                                                                              *world->lights, world->proxy.get()});
+  EXPECT_TRUE(image == fresh);
+  fs::remove(path);
+}
+
 // memory.backing = copy: the world read into memory of the process's own (on 2 MiB pages where
 // the kernel gives them) renders the fresh build's image, hands out the copy and not the file's
 // mapping, and checks every section as a mapped load does; a data-parallel rank, which holds
@@ -392,6 +422,35 @@ TEST(WorldFile, ACopiedWorldRendersTheFreshImageFromItsOwnMemory) {
   fs::remove(path);
 }
 
+
+// proxy.share = auto from the command line: build saves the paper's 2%; a render in core
+// simplifies it again to the in-core share and says so, a paged render keeps it.
+TEST(WorldFileCli, AutoProxyShareSavesThePapersAndRendersInCoreWithATenth) {
+  const std::string world = temp_path("cli_proxy.wtw");
+  const auto built =
+      testing::run_wavetrace("build builtin:room:20k --accel hmq --proxy --stats " + temp_path("cli_proxy_build.json") +
+                             " --out " + world);
+  ASSERT_EQ(built.exit_code, 0) << built.output;
+  const nlohmann::json build = nlohmann::json::parse(read_all(temp_path("cli_proxy_build.json")));
+  const std::size_t saved = build.at("proxy_triangles").get<std::size_t>();
+  const double triangles = build.at("scene").at("triangles").get<double>();
+  EXPECT_NEAR(double(saved) / triangles, ProxyOptions::kPagedShare, 0.006) << build.dump();
+  const auto proxy_of = [&](const std::string& extra) {
+    const std::string stats = temp_path("cli_proxy_stats.json");
+    fs::remove(stats);
+    const auto rendered = testing::run_wavetrace("render " + world + " --size 32x24 --spp 1 --set reorder.heuristic=hph " +
+                                                 extra + " --out " + temp_path("cli_proxy.exr") + " --stats " + stats);
+    EXPECT_EQ(rendered.exit_code, 0) << rendered.output;
+    return nlohmann::json::parse(read_all(stats)).at("proxy");
+  };
+  const nlohmann::json in_core = proxy_of("");
+  EXPECT_EQ(in_core.at("coarsened_from").get<std::size_t>(), saved) << in_core.dump();
+  EXPECT_NEAR(in_core.at("triangles").get<double>() / triangles, ProxyOptions::kInCoreShare, 0.002) << in_core.dump();
+  const nlohmann::json paged = proxy_of("--set memory.backing=file --set memory.budget=50% --set memory.page_bytes=4096");
+  EXPECT_EQ(paged.at("triangles").get<std::size_t>(), saved) << paged.dump();
+  EXPECT_TRUE(paged.at("coarsened_from").is_null()) << paged.dump();
+  fs::remove(world);
+}
 
 TEST(WorldFileCli, BuildRenderAndInfo) {
   const std::string world = temp_path("cli.wtw");

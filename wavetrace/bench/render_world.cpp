@@ -23,6 +23,7 @@ RenderWorld::RenderWorld(const RenderPlan& base, bool needs_proxy) {
       throw ConfigError(fmt::format("{} was saved without a proxy, which hit-point heuristics need: build it with --proxy",
                                     base.scene.source));
     }
+    if (needs_proxy) coarsen_world_proxy(*saved_, base.proxy.share, base.pipeline.threads);
     return;
   }
   if (base.memory.file_backing) throw ConfigError("memory.backing = file pages a world file: give one (wavetrace build)");

@@ -125,6 +125,7 @@ ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<Reo
     report.proxy = fmt::format("{} triangles ({:.4g}% of the scene) by {} on {}; hit overlap {:.1f}%", p.triangles,
                                100.0 * double(p.triangles) / double(report.triangles), to_string(p.method),
                                proxy->accelerator().name(), 100.0 * p.quality.hit_overlap);
+    if (p.coarsened_from > 0) *report.proxy += fmt::format(", simplified again from the world's {}", p.coarsened_from);
   }
   report.memory = "off";
   if (base.memory.budget) {

@@ -144,6 +144,11 @@ template <std::size_t CacheGeometry::*Member>
 void read_cache_size(const Config& config, std::string_view key, RenderPlan& plan) {
   if (plan.memory.cache && config.has(key)) (*plan.memory.cache).*Member = static_cast<std::size_t>(config.integer(key));
 }
+void read_proxy_share(const Config& config, std::string_view key, RenderPlan& plan) {
+  // "auto" (no number): resolved from the memory plan in plan_render.
+  plan.proxy.share_by_holding = config.word(key).has_value();
+  if (!plan.proxy.share_by_holding) plan.proxy.share = config.real(key);
+}
 void read_proxy_accel(const Config& config, std::string_view key, RenderPlan& plan) {
   plan.proxy.accelerator.type = config.text(key);  // the main accelerator's options otherwise (copied in plan_render)
 }
@@ -425,8 +430,10 @@ const std::vector<ConfigKey>& config_schema() {
       {"memory.cache_ways", T::integer, std::nullopt, 1, 256, {}, "cache associativity (overrides the preset)",
        read_cache_size<&CacheGeometry::ways>},
 
-      {"proxy.share", T::real, 0.02, 1e-6, 1.0, {}, "proxy triangles as a share of the scene's (the paper: 0.02)",
-       real<&P::proxy, &ProxyOptions::share>},
+      {"proxy.share", T::real, std::string("auto"), 1e-6, 1.0, {"auto"},
+       "proxy triangles as a share of the scene's, or auto: the paper's 0.02 where the world is paged (memory.budget) "
+       "or saved by build, 0.002 in core; a saved world's proxy is simplified again to a smaller share",
+       read_proxy_share},
       {"proxy.method", T::text, std::string("auto"), 0, 0, {"auto", "cluster", "stochastic"},
        "simplification: vertex clustering with quadrics, stochastic pruning, or the better of both on test rays",
        choice<parse_proxy_method, &P::proxy, &ProxyOptions::method>},

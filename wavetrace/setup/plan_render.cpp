@@ -201,6 +201,9 @@ RenderPlan plan_render(const Config& config) {
   const std::string proxy_type = plan.proxy.accelerator.type;
   plan.proxy.accelerator = plan.accelerator;
   plan.proxy.accelerator.type = proxy_type;
+  if (plan.proxy.share_by_holding) {
+    plan.proxy.share = plan.memory.budget ? ProxyOptions::kPagedShare : ProxyOptions::kInCoreShare;
+  }
   if (config.given("reorder.buffer_rays") && config.has("reorder.buffer_bytes")) {
     throw ConfigError("reorder.buffer_rays and reorder.buffer_bytes both size the reorder buffer: set one of them");
   }

@@ -94,4 +94,9 @@ std::unique_ptr<LoadedWorld> load_world(const std::string& path, const std::opti
                                         int threads = 0, CheckedPages checked = CheckedPages::kept,
                                         FileHolding holding = FileHolding::mapped);
 
+// Simplifies the world's proxy again where it holds more than about `share` of the scene's
+// triangles (proxy.share = auto in core: a world is saved with the paper's 2%); its quality is
+// measured against the world's accelerator. `threads` as for load_world.
+void coarsen_world_proxy(LoadedWorld& world, double share, int threads);
+
 }  // namespace wavetrace

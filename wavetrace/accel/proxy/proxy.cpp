@@ -1,6 +1,7 @@
 // Simplify, judge, keep, and build the proxy's accelerator.
 #include "wavetrace/accel/proxy/proxy.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -147,6 +148,32 @@ Proxy::Proxy(const TriangleMesh& mesh, const ProxyOptions& options, const Accele
   } else {
     report_.quality = report_.method == ProxyMethod::cluster ? *report_.cluster_quality : *report_.stochastic_quality;
   }
+}
+
+Proxy::Proxy(const Proxy& finer, std::size_t target, const AcceleratorOptions& accelerator,
+             const Accelerator& scene_accelerator)
+    : scene_bounds_(finer.scene_bounds_) {
+  const auto start = std::chrono::steady_clock::now();
+  report_.method = finer.report_.method;
+  report_.coarsened_from = finer.report_.triangles;
+  // A stochastic proxy stands for aggregate detail (fur) that clustering would merge into
+  // blobs: it is pruned again. The cell size of a clustering of the finer proxy is the new
+  // surface tolerance either way, never below the finer one's.
+  ClusterSimplification clustered = simplify_by_clustering(finer.mesh_, target);
+  if (report_.method == ProxyMethod::stochastic) {
+    const double share = double(target) / double(std::max<std::size_t>(finer.mesh_.triangle_count(), 1));
+    mesh_ = cleaned_proxy_mesh(simplify_stochastically(finer.mesh_, share));
+  } else {
+    mesh_ = cleaned_proxy_mesh(std::move(clustered.mesh));
+  }
+  if (mesh_.triangles.empty()) throw SceneError("the proxy lost every triangle when coarsened: raise proxy.share");
+  surface_tolerance_ = std::max(finer.surface_tolerance_, static_cast<float>(clustered.cell_size));
+  report_.simplify_seconds = seconds_since(start);
+  const auto build_start = std::chrono::steady_clock::now();
+  accelerator_ = make_accelerator(mesh_, accelerator);
+  report_.build_seconds = seconds_since(build_start);
+  report_.triangles = mesh_.triangle_count();
+  report_.quality = measure_proxy_quality(*accelerator_, scene_accelerator, scene_bounds_);
 }
 
 Proxy::Proxy(TriangleMesh simplified, const Bounds3& scene_bounds, float surface_tolerance, const ProxyReport& report,

@@ -21,7 +21,14 @@ ProxyMethod parse_proxy_method(const std::string& text);  // "auto" | "cluster" 
 std::string to_string(ProxyMethod method);
 
 struct ProxyOptions {
-  double share = 0.02;  // of the scene's triangles; the paper: 2% (0.0125%-8% workable)
+  // proxy.share = auto chooses by where the world is held. Paged (a memory budget), or saved by
+  // `wavetrace build` to be paged later: the paper's 2%, whose closer hits save reads. In core
+  // a proxy's walk is a larger part of the render and a coarser one orders the rays as well
+  // (docs/reordering.md, "The proxy in core").
+  static constexpr double kPagedShare = 0.02;
+  static constexpr double kInCoreShare = 0.002;
+  double share = kPagedShare;  // of the scene's triangles; the paper: 2% (0.0125%-8% workable)
+  bool share_by_holding = true;  // auto: plan_render sets `share` from the memory plan
   ProxyMethod method = ProxyMethod::automatic;
   AcceleratorOptions accelerator;
   bool operator==(const ProxyOptions&) const = default;
@@ -44,6 +51,7 @@ struct ProxyReport {
   double build_seconds = 0.0;  // of the proxy's accelerator
   ProxyQuality quality;
   std::optional<ProxyQuality> cluster_quality, stochastic_quality;  // measured under auto
+  std::size_t coarsened_from = 0;  // a saved proxy's triangles, where this one was simplified from it; else 0
 };
 
 class Proxy {
@@ -55,6 +63,10 @@ class Proxy {
   // everything else is as it was.
   Proxy(TriangleMesh simplified, const Bounds3& scene_bounds, float surface_tolerance, const ProxyReport& report,
         const AcceleratorOptions& accelerator);
+  // `finer` (a saved world's) simplified again, by its own method, to about `target`
+  // triangles; its quality measured against `scene_accelerator` as a new proxy's is.
+  Proxy(const Proxy& finer, std::size_t target, const AcceleratorOptions& accelerator,
+        const Accelerator& scene_accelerator);
 
   const Accelerator& accelerator() const { return *accelerator_; }
   const Bounds3& scene_bounds() const { return scene_bounds_; }
