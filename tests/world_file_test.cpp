@@ -373,6 +373,17 @@ TEST(WorldFile, ASavedProxyIsSimplifiedAgainForAnInCoreRender) {
   const std::vector<float> image = render_with(small_render(settings), World{world->scene, *world->accelerator,
                                                                               *world->lights, world->proxy.get()});
   EXPECT_TRUE(image == fresh);
+
+  // A stochastic proxy (the fur's kind) is pruned again, not clustered into blobs.
+  saved_settings.emplace_back("proxy.method=stochastic");
+  build_and_save(saved_settings, path, true);
+  const std::unique_ptr<LoadedWorld> pruned = load_world(path, std::nullopt, 2);
+  const std::size_t pruned_saved = pruned->proxy->report().triangles;
+  ASSERT_EQ(pruned->proxy->report().method, ProxyMethod::stochastic);
+  coarsen_world_proxy(*pruned, in_core.proxy.share, 2);
+  EXPECT_EQ(pruned->proxy->report().method, ProxyMethod::stochastic);
+  EXPECT_EQ(pruned->proxy->report().coarsened_from, pruned_saved);
+  EXPECT_LT(pruned->proxy->report().triangles * 4, pruned_saved);
   fs::remove(path);
 }
 
