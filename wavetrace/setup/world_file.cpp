@@ -107,6 +107,15 @@ TriangleMesh read_mesh(const SectionFile& file, const std::string& prefix) {
   return mesh;
 }
 
+// The proxy's accelerator as the world was built with it: the build's options, of the type
+// proxy.accel named.
+AcceleratorOptions saved_proxy_accelerator(const Config& settings, int threads) {
+  AcceleratorOptions options = accelerator_options(settings);
+  options.type = settings.text("proxy.accel");
+  options.embree.threads = threads;
+  return options;
+}
+
 }  // namespace
 
 std::optional<PagingRequest> world_paging(const RenderPlan& plan) {
@@ -276,11 +285,8 @@ std::unique_ptr<LoadedWorld> load_world(const std::string& path, const std::opti
     report.triangles = proxy_info.triangles;
     report.simplify_seconds = proxy_info.simplify_seconds;
     report.quality = {proxy_info.hit_agreement, proxy_info.hit_overlap, proxy_info.mean_distance_error};
-    AcceleratorOptions proxy_options = accelerator_options(world.settings);
-    proxy_options.type = world.settings.text("proxy.accel");
-    proxy_options.embree.threads = threads;
     world.proxy = std::make_unique<Proxy>(read_mesh(file, "proxy."), scene.bounds, proxy_info.surface_tolerance, report,
-                                          proxy_options);
+                                          saved_proxy_accelerator(world.settings, threads));
   }
   world.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return loaded;
@@ -291,10 +297,8 @@ void coarsen_world_proxy(LoadedWorld& world, double share, int threads) {
   const std::size_t target = proxy_target_triangles(share, world.scene.triangle_count);
   // Clustering lands within about 15% of its target: a proxy that near is left as it is.
   if (world.proxy->report().triangles * 4 <= target * 5) return;
-  AcceleratorOptions options = accelerator_options(world.settings);
-  options.type = world.settings.text("proxy.accel");
-  options.embree.threads = threads;
-  world.proxy = std::make_unique<Proxy>(*world.proxy, target, options, *world.accelerator);
+  world.proxy = std::make_unique<Proxy>(*world.proxy, target, saved_proxy_accelerator(world.settings, threads),
+                                        *world.accelerator);
 }
 
 }  // namespace wavetrace
