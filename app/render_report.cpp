@@ -118,7 +118,8 @@ nlohmann::json proxy_json(const Proxy& proxy) {
           {"quality", quality(report.quality)},
           {"cluster_quality", quality(report.cluster_quality)},
           {"stochastic_quality", quality(report.stochastic_quality)},
-          {"coarsened_from", report.coarsened_from > 0 ? nlohmann::json(report.coarsened_from) : nlohmann::json(nullptr)}};
+          {"coarsened_from", report.coarsened_from > 0 ? nlohmann::json(report.coarsened_from) : nlohmann::json(nullptr)},
+          {"quality_against", report.judged_against_saved ? "saved proxy" : "scene"}};
 }
 
 nlohmann::json render_stats_json(const RenderFacts& facts) {
@@ -324,11 +325,11 @@ std::string render_table(const RenderFacts& facts) {
     const ProxyReport& proxy = facts.proxy->report();
     const std::string from =
         proxy.coarsened_from > 0 ? fmt::format(" (simplified again from the world's {})", proxy.coarsened_from) : "";
-    table += fmt::format("proxy: {} triangles{} by {} in {:.2f} s (+{:.2f} s {} build); hits overlap the scene's on "
+    table += fmt::format("proxy: {} triangles{} by {} in {:.2f} s (+{:.2f} s {} build); hits overlap the {}'s on "
                          "{:.1f}% of test rays (agree on {:.1f}%)\n",
                          proxy.triangles, from, to_string(proxy.method), proxy.simplify_seconds, proxy.build_seconds,
-                         facts.proxy->accelerator().name(), 100.0 * proxy.quality.hit_overlap,
-                         100.0 * proxy.quality.hit_agreement);
+                         facts.proxy->accelerator().name(), proxy.judged_against_saved ? "saved proxy" : "scene",
+                         100.0 * proxy.quality.hit_overlap, 100.0 * proxy.quality.hit_agreement);
   }
   const MemoryReport memory = facts.accelerator.memory();
   const BuildReport build = facts.accelerator.build();

@@ -370,6 +370,7 @@ TEST(WorldFile, ASavedProxyIsSimplifiedAgainForAnInCoreRender) {
   EXPECT_LT(coarse.report().triangles * 4, saved_triangles);
   EXPECT_GE(coarse.surface_tolerance(), saved_tolerance);
   EXPECT_GT(coarse.report().quality.hit_overlap, 0.8);
+  EXPECT_FALSE(coarse.report().judged_against_saved);
   const std::vector<float> image = render_with(small_render(settings), World{world->scene, *world->accelerator,
                                                                               *world->lights, world->proxy.get()});
   EXPECT_TRUE(image == fresh);
@@ -380,7 +381,10 @@ TEST(WorldFile, ASavedProxyIsSimplifiedAgainForAnInCoreRender) {
   const std::unique_ptr<LoadedWorld> pruned = load_world(path, std::nullopt, 2);
   const std::size_t pruned_saved = pruned->proxy->report().triangles;
   ASSERT_EQ(pruned->proxy->report().method, ProxyMethod::stochastic);
-  coarsen_world_proxy(*pruned, in_core.proxy.share, 2);
+  // Judged as a data-mode rank judges it: by the saved proxy, not the world it does not hold.
+  coarsen_world_proxy(*pruned, in_core.proxy.share, 2, ProxyJudge::saved_proxy);
+  EXPECT_TRUE(pruned->proxy->report().judged_against_saved);
+  EXPECT_GT(pruned->proxy->report().quality.hit_overlap, 0.3);
   EXPECT_EQ(pruned->proxy->report().method, ProxyMethod::stochastic);
   EXPECT_EQ(pruned->proxy->report().coarsened_from, pruned_saved);
   EXPECT_LT(pruned->proxy->report().triangles * 4, pruned_saved);

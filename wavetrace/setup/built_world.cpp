@@ -42,9 +42,12 @@ void BuiltWorld::open_world_file(CheckedPages checked) {
     throw ConfigError(fmt::format("{} was saved without a proxy, which the chain's approx_hit needs: build it with --proxy",
                                   plan_.scene.source));
   }
-  // Not in data mode: judging a coarser proxy walks every chunk, which a rank does not hold.
-  if (plan_.needs_proxy() && plan_.distribute.mode != DistributeMode::data) {
-    coarsen_world_proxy(*loaded_, plan_.proxy.share, plan_.pipeline.threads);
+  // A data-mode rank judges a coarser proxy by the saved one: judged by the world, its test
+  // rays would walk every chunk, which the rank does not hold.
+  if (plan_.needs_proxy()) {
+    coarsen_world_proxy(*loaded_, plan_.proxy.share, plan_.pipeline.threads,
+                        plan_.distribute.mode == DistributeMode::data ? ProxyJudge::saved_proxy
+                                                                      : ProxyJudge::whole_world);
   }
   camera_ = resolve_camera(plan_.camera, loaded_->scene);
   world_.emplace(World{loaded_->scene, *loaded_->accelerator, *loaded_->lights,

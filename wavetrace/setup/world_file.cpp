@@ -292,13 +292,13 @@ std::unique_ptr<LoadedWorld> load_world(const std::string& path, const std::opti
   return loaded;
 }
 
-void coarsen_world_proxy(LoadedWorld& world, double share, int threads) {
+void coarsen_world_proxy(LoadedWorld& world, double share, int threads, ProxyJudge judge) {
   if (!world.proxy) return;
   const std::size_t target = proxy_target_triangles(share, world.scene.triangle_count);
   // Clustering lands within about 15% of its target: a proxy that near is left as it is.
   if (world.proxy->report().triangles * 4 <= target * 5) return;
   world.proxy = std::make_unique<Proxy>(*world.proxy, target, saved_proxy_accelerator(world.settings, threads),
-                                        *world.accelerator);
+                                        judge == ProxyJudge::whole_world ? world.accelerator.get() : nullptr);
 }
 
 }  // namespace wavetrace

@@ -96,7 +96,9 @@ std::unique_ptr<LoadedWorld> load_world(const std::string& path, const std::opti
 
 // Simplifies the world's proxy again where it holds more than about `share` of the scene's
 // triangles (proxy.share = auto in core: a world is saved with the paper's 2%); its quality is
-// measured against the world's accelerator. `threads` as for load_world.
-void coarsen_world_proxy(LoadedWorld& world, double share, int threads);
+// measured against the world's accelerator, or against the saved proxy (ProxyJudge::saved_proxy:
+// a data-parallel rank, which touches only the chunks it answers). `threads` as for load_world.
+enum class ProxyJudge { whole_world, saved_proxy };
+void coarsen_world_proxy(LoadedWorld& world, double share, int threads, ProxyJudge judge = ProxyJudge::whole_world);
 
 }  // namespace wavetrace

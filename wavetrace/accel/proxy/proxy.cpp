@@ -151,7 +151,7 @@ Proxy::Proxy(const TriangleMesh& mesh, const ProxyOptions& options, const Accele
 }
 
 Proxy::Proxy(const Proxy& finer, std::size_t target, const AcceleratorOptions& accelerator,
-             const Accelerator& scene_accelerator)
+             const Accelerator* scene_accelerator)
     : scene_bounds_(finer.scene_bounds_) {
   const auto start = std::chrono::steady_clock::now();
   report_.method = finer.report_.method;
@@ -173,7 +173,9 @@ Proxy::Proxy(const Proxy& finer, std::size_t target, const AcceleratorOptions& a
   accelerator_ = make_accelerator(mesh_, accelerator);
   report_.build_seconds = seconds_since(build_start);
   report_.triangles = mesh_.triangle_count();
-  report_.quality = measure_proxy_quality(*accelerator_, scene_accelerator, scene_bounds_);
+  report_.judged_against_saved = scene_accelerator == nullptr;
+  report_.quality = measure_proxy_quality(*accelerator_, scene_accelerator ? *scene_accelerator : *finer.accelerator_,
+                                          scene_bounds_);
 }
 
 Proxy::Proxy(TriangleMesh simplified, const Bounds3& scene_bounds, float surface_tolerance, const ProxyReport& report,

@@ -52,6 +52,9 @@ struct ProxyReport {
   ProxyQuality quality;
   std::optional<ProxyQuality> cluster_quality, stochastic_quality;  // measured under auto
   std::size_t coarsened_from = 0;  // a saved proxy's triangles, where this one was simplified from it; else 0
+  // `quality` against the saved proxy's hits, not the scene's: where the process does not hold
+  // the whole world to judge by (a data-parallel rank).
+  bool judged_against_saved = false;
 };
 
 class Proxy {
@@ -64,9 +67,10 @@ class Proxy {
   Proxy(TriangleMesh simplified, const Bounds3& scene_bounds, float surface_tolerance, const ProxyReport& report,
         const AcceleratorOptions& accelerator);
   // `finer` (a saved world's) simplified again, by its own method, to about `target`
-  // triangles; its quality measured against `scene_accelerator` as a new proxy's is.
+  // triangles; its quality measured against `scene_accelerator` as a new proxy's is, or,
+  // where that is null, against `finer`.
   Proxy(const Proxy& finer, std::size_t target, const AcceleratorOptions& accelerator,
-        const Accelerator& scene_accelerator);
+        const Accelerator* scene_accelerator);
 
   const Accelerator& accelerator() const { return *accelerator_; }
   const Bounds3& scene_bounds() const { return scene_bounds_; }
