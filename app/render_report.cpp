@@ -131,7 +131,8 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
     nlohmann::json entry = stage_json(stage);
     if (stage.pager) entry["pager"] = pager_json(*stage.pager);
     if (stage.disk) {
-      entry["disk"] = {{"page_bytes", stage.disk->page_bytes},
+      entry["disk"] = {{"mapping", to_string(stage.disk->mapping)},
+                       {"page_bytes", stage.disk->page_bytes},
                        {"budget_bytes", stage.disk->budget_bytes},
                        {"faults", stage.disk->counters.faults},
                        {"bytes_read", stage.disk->counters.bytes_read},

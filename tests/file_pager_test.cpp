@@ -1,5 +1,6 @@
-// The real pager on a small file of numbered 4 KiB pages: the bytes it shows, its LRU
-// eviction, faults counted by part, and a file cut short while it is paged.
+// The real pager on a small file of numbered 4 KiB pages, with each way of placing pages
+// (userfaultfd and memfd): the bytes it shows, its LRU eviction, faults counted by part,
+// resident memory, and a file cut short while it is paged.
 #include <gtest/gtest.h>
 
 #include <cctype>
@@ -35,9 +36,65 @@ std::uint32_t word(const FilePager& pager, std::size_t page, std::size_t index) 
   return reinterpret_cast<const volatile std::uint32_t*>(pager.base() + page * kPage)[index];
 }
 
-TEST(FilePager, ShowsTheFileAndEvictsTheLeastRecentlyUsedPage) {
+// userfaultfd where this kernel lets the process use it: a test of that mapping is skipped,
+// saying why, where it does not (memfd is tested everywhere).
+class FilePagerTest : public ::testing::TestWithParam<PageMapping> {
+ protected:
+  void SetUp() override {
+    if (GetParam() != PageMapping::userfaultfd) return;
+    const std::string path = numbered_file("pager_probe.bin", 1);
+    try {
+      FilePager probe(path, kPage, kPage, kPage, 1, PageMapping::userfaultfd);
+    } catch (const std::runtime_error& refused) {
+      std::filesystem::remove(path);
+      GTEST_SKIP() << refused.what();
+    }
+    std::filesystem::remove(path);
+  }
+};
+class FilePagerDeathTest : public FilePagerTest {};
+
+std::string mapping_name(const ::testing::TestParamInfo<PageMapping>& info) { return to_string(info.param); }
+INSTANTIATE_TEST_SUITE_P(Mappings, FilePagerTest, ::testing::Values(PageMapping::userfaultfd, PageMapping::memfd),
+                         mapping_name);
+INSTANTIATE_TEST_SUITE_P(Mappings, FilePagerDeathTest, ::testing::Values(PageMapping::userfaultfd, PageMapping::memfd),
+                         mapping_name);
+
+TEST_P(FilePagerTest, PlacesPagesAsAsked) {
+  const std::string path = numbered_file("pager_mapping.bin");
+  FilePager pager(path, kPages * kPage, kPage, 4 * kPage, 1, GetParam());
+  EXPECT_EQ(pager.mapping(), GetParam());
+  EXPECT_EQ(word(pager, 5, 1), 5001u);
+  FilePager automatic(path, kPages * kPage, kPage, 4 * kPage, 1);
+  EXPECT_NE(automatic.mapping(), PageMapping::automatic);
+  EXPECT_EQ(word(automatic, 6, 2), 6002u);
+  std::filesystem::remove(path);
+}
+
+// A memfd pool maps each resident page on its own, under the kernel's limit on mappings; a
+// userfaultfd range is one mapping whatever the pool holds. (Nothing is read: the file's
+// size only sets the range.)
+TEST_P(FilePagerTest, HoldsMoreThan30000PagesOnlyWithUserfaultfd) {
+  const std::string path = numbered_file("pager_many.bin");
+  constexpr std::size_t kManyPages = 40000, kManySlots = 30001;
+  if (GetParam() == PageMapping::memfd) {
+    try {
+      FilePager pager(path, kManyPages * kPage, kPage, kManySlots * kPage, 1, GetParam());
+      ADD_FAILURE() << "a memfd pool of 30,001 pages was made";
+    } catch (const std::invalid_argument& error) {
+      EXPECT_NE(std::string(error.what()).find("memory.page_bytes"), std::string::npos) << error.what();
+    }
+  } else {
+    FilePager pager(path, kManyPages * kPage, kPage, kManySlots * kPage, 1, GetParam());
+    EXPECT_EQ(pager.budget_bytes(), kManySlots * kPage);
+    EXPECT_EQ(word(pager, 7, 0), 7000u);
+  }
+  std::filesystem::remove(path);
+}
+
+TEST_P(FilePagerTest, ShowsTheFileAndEvictsTheLeastRecentlyUsedPage) {
   const std::string path = numbered_file("pager_lru.bin");
-  FilePager pager(path, kPages * kPage, kPage, 4 * kPage, 1);
+  FilePager pager(path, kPages * kPage, kPage, 4 * kPage, 1, GetParam());
   for (std::size_t page : {0, 1, 2, 3}) pager.touch(pager.base() + page * kPage);
   EXPECT_EQ(pager.total().faults, 4u);
   pager.touch(pager.base());             // page 0 becomes the most recent: page 1 is now the oldest
@@ -52,10 +109,10 @@ TEST(FilePager, ShowsTheFileAndEvictsTheLeastRecentlyUsedPage) {
 
 // memory.page_trace: every touch, in order, as the page numbers the file holds; reads the
 // probes did not announce (faults) are not touches.
-TEST(FilePager, RecordsEveryTouchInOrderWhenTraced) {
+TEST_P(FilePagerTest, RecordsEveryTouchInOrderWhenTraced) {
   const std::string path = numbered_file("pager_trace.bin");
   const std::string trace_path = path + ".pages";
-  FilePager pager(path, kPages * kPage, kPage, 4 * kPage, 1);
+  FilePager pager(path, kPages * kPage, kPage, 4 * kPage, 1, GetParam());
   {
     PageTrace trace(trace_path);
     pager.set_page_trace(&trace);
@@ -86,9 +143,9 @@ TEST(FilePager, RecordsEveryTouchInOrderWhenTraced) {
 
 // A full pool of 16 slots evicts its two least recently used pages at once (an eighth of
 // it): one TLB flush for both.
-TEST(FilePager, AFullPoolEvictsAGroupOfTheLeastRecentlyUsedPages) {
+TEST_P(FilePagerTest, AFullPoolEvictsAGroupOfTheLeastRecentlyUsedPages) {
   const std::string path = numbered_file("pager_group.bin", 32);
-  FilePager pager(path, 32 * kPage, kPage, 16 * kPage, 1);
+  FilePager pager(path, 32 * kPage, kPage, 16 * kPage, 1, GetParam());
   for (std::size_t page = 0; page < 16; ++page) pager.touch(pager.base() + page * kPage);
   pager.touch(pager.base() + 16 * kPage);  // evicts pages 0 and 1
   EXPECT_EQ(pager.total().faults, 17u);
@@ -104,39 +161,51 @@ TEST(FilePager, AFullPoolEvictsAGroupOfTheLeastRecentlyUsedPages) {
   for (std::size_t page = 0; page < 32; ++page) EXPECT_EQ(word(pager, page, 100), page * 1000 + 100) << page;
 }
 
-// Resident kilobytes of this process's mappings of the page pool whose permissions start
-// with `permissions` ("" for all of them).
-std::size_t pool_resident_kb(const std::string& permissions) {
+// Resident kilobytes of this process's mappings that `counted` picks by their smaps header
+// line ("start-end perms offset dev inode name").
+template <typename Pick>
+std::size_t resident_kb(Pick counted) {
   std::ifstream smaps("/proc/self/smaps");
   std::size_t kb = 0;
-  bool pool = false;
+  bool picked = false;
   for (std::string line; std::getline(smaps, line);) {
     if (!line.empty() && std::isxdigit(static_cast<unsigned char>(line[0])) && line.find('-') < line.find(' ')) {
-      pool = line.find("wavetrace-page-pool") != std::string::npos &&
-             line.compare(line.find(' ') + 1, permissions.size(), permissions) == 0;
-    } else if (pool && line.starts_with("Rss:")) {
+      picked = counted(line);
+    } else if (picked && line.starts_with("Rss:")) {
       kb += std::stoul(line.substr(4));
     }
   }
   return kb;
 }
+std::size_t pool_resident_kb() {
+  return resident_kb([](const std::string& line) { return line.find("wavetrace-page-pool") != std::string::npos; });
+}
+// The mappings inside [begin, end): the pager's range.
+std::size_t range_resident_kb(const std::byte* begin, const std::byte* end) {
+  return resident_kb([&](const std::string& line) {
+    const auto start = std::stoull(line.substr(0, line.find('-')), nullptr, 16);
+    return start >= reinterpret_cast<std::uintptr_t>(begin) && start < reinterpret_cast<std::uintptr_t>(end);
+  });
+}
 
 // A page read into the pool is mapped once, at its place: through a writable view of the
 // pool as well, it counted twice in the process's resident memory (a 12 GB pool read 24 GB).
-TEST(FilePager, ResidentMemoryCountsAPagedPageOnce) {
+TEST_P(FilePagerTest, ResidentMemoryCountsAPagedPageOnce) {
   constexpr std::size_t kFilePages = 256, kSlots = 64;
   const std::string path = numbered_file("pager_resident.bin", kFilePages);
-  FilePager pager(path, kFilePages * kPage, kPage, kSlots * kPage, 1);
+  FilePager pager(path, kFilePages * kPage, kPage, kSlots * kPage, 1, GetParam());
   for (std::size_t pass = 0; pass < 2; ++pass) {
     for (std::size_t page = 0; page < kFilePages; ++page) ASSERT_EQ(word(pager, page, 3), page * 1000 + 3);
   }
-  EXPECT_EQ(pool_resident_kb(""), kSlots * kPage / 1024);  // every mapping of the pool together
+  EXPECT_EQ(range_resident_kb(pager.base(), pager.base() + kFilePages * kPage), kSlots * kPage / 1024);
+  // The pool is mapped nowhere else (memfd), or there is none (userfaultfd).
+  EXPECT_EQ(pool_resident_kb(), GetParam() == PageMapping::memfd ? kSlots * kPage / 1024 : 0);
   std::filesystem::remove(path);
 }
 
-TEST(FilePager, CountsFaultsByPartOfTheFile) {
+TEST_P(FilePagerTest, CountsFaultsByPartOfTheFile) {
   const std::string path = numbered_file("pager_parts.bin");
-  FilePager pager(path, kPages * kPage, kPage, 4 * kPage, 2);
+  FilePager pager(path, kPages * kPage, kPage, 4 * kPage, 2, GetParam());
   pager.name_parts({"nodes", "leaves"}, {{8 * kPage, 4 * kPage, 1}, {0, 8 * kPage, 0}});
   ASSERT_EQ(pager.part_names(), (std::vector<std::string>{"nodes", "leaves", "other"}));
   {
@@ -155,9 +224,9 @@ TEST(FilePager, CountsFaultsByPartOfTheFile) {
 
 // Pages the prefetch client loads are prefetched; the first read of one by another client
 // before its eviction is a hit, later reads and reads after the eviction are not.
-TEST(FilePager, CountsAPrefetchedPageReadByAnotherClientAsAHit) {
+TEST_P(FilePagerTest, CountsAPrefetchedPageReadByAnotherClientAsAHit) {
   const std::string path = numbered_file("pager_prefetch.bin");
-  FilePager pager(path, kPages * kPage, kPage, 4 * kPage, 2);
+  FilePager pager(path, kPages * kPage, kPage, 4 * kPage, 2, GetParam());
   pager.set_prefetch_client(1);
   {
     const FilePager::ClientScope prefetcher(1);
@@ -179,10 +248,10 @@ TEST(FilePager, CountsAPrefetchedPageReadByAnotherClientAsAHit) {
   EXPECT_EQ(pager.prefetch_hits(), 0u);
 }
 
-TEST(FilePagerDeathTest, AFileCutShortWhilePagedIsAClearErrorNamingIt) {
+TEST_P(FilePagerDeathTest, AFileCutShortWhilePagedIsAClearErrorNamingIt) {
   GTEST_FLAG_SET(death_test_style, "threadsafe");
   const std::string path = numbered_file("pager_truncated.bin");
-  FilePager pager(path, kPages * kPage, kPage, 4 * kPage, 1);
+  FilePager pager(path, kPages * kPage, kPage, 4 * kPage, 1, GetParam());
   EXPECT_EQ(word(pager, 2, 3), 2003u);
   std::filesystem::resize_file(path, 4 * kPage);
   // A probe's announced read: an exception naming the file.

@@ -474,7 +474,7 @@ TEST(WorldFileCli, BuildRenderAndInfo) {
   EXPECT_NE(built.output.find("bytes/triangle"), std::string::npos) << built.output;
   const std::string stats = temp_path("cli_stats.json");
   const auto rendered = testing::run_wavetrace("render " + world + " --size 64x48 --spp 1 --out " +
-                                               temp_path("cli.exr") + " --set memory.backing=file --set memory.budget=10% "
+                                               temp_path("cli.exr") + " --set memory.backing=file --set memory.budget=30% "
                                                "--set memory.page_bytes=4096 --stats " + stats);
   ASSERT_EQ(rendered.exit_code, 0) << rendered.output;
   EXPECT_NE(rendered.output.find("real faults"), std::string::npos) << rendered.output;
@@ -494,6 +494,27 @@ TEST(WorldFileCli, BuildRenderAndInfo) {
   }
   EXPECT_NE(rendered.output.find("distinct pages touched per 1000 consecutive rays"), std::string::npos)
       << rendered.output;
+  // Pages placed by a memfd's slots instead (auto takes userfaultfd where the kernel allows):
+  // the same image, and the stats say which placed them.
+  const std::string memfd_stats = temp_path("cli_stats_memfd.json");
+  const auto memfd = testing::run_wavetrace("render " + world + " --size 64x48 --spp 1 --out " + temp_path("cli_memfd.exr") +
+                                            " --set memory.backing=file --set memory.budget=30% --set memory.page_bytes=4096 "
+                                            "--set memory.page_mapping=memfd --stats " + memfd_stats);
+  ASSERT_EQ(memfd.exit_code, 0) << memfd.output;
+  EXPECT_EQ(read_all(temp_path("cli.exr")), read_all(temp_path("cli_memfd.exr")));
+  for (const auto& [path, mappings] : {std::pair{stats, std::vector<std::string>{"userfaultfd", "memfd"}},
+                                       std::pair{memfd_stats, std::vector<std::string>{"memfd"}}}) {
+    for (const nlohmann::json& stage : nlohmann::json::parse(read_all(path)).at("stages")) {
+      if (stage["name"] != "trace") continue;
+      const std::string mapping = stage.at("disk").at("mapping").get<std::string>();
+      EXPECT_NE(std::find(mappings.begin(), mappings.end(), mapping), mappings.end()) << path << ": " << mapping;
+    }
+  }
+  const auto bad_mapping = testing::run_wavetrace("render " + world + " --size 8x8 --set memory.backing=file "
+                                                  "--set memory.budget=10% --set memory.page_mapping=mmap --out " +
+                                                  temp_path("z.exr"));
+  EXPECT_EQ(bad_mapping.exit_code, 1);
+  EXPECT_NE(bad_mapping.output.find("memory.page_mapping"), std::string::npos) << bad_mapping.output;
   const auto bench = testing::run_wavetrace("bench accel --scene " + world + " --rays diffuse --count 2000 --repeat 1");
   ASSERT_EQ(bench.exit_code, 0) << bench.output;
   EXPECT_NE(bench.output.find("raystrips (world file)"), std::string::npos) << bench.output;

@@ -1,6 +1,6 @@
-// The real pager: a PROT_NONE reservation for the file's range, page slots in a memfd
-// mapped over it on demand, a SIGSEGV handler for reads no probe announced. Reads happen
-// outside the pool's lock, straight into their slot: threads reading different pages keep
+// The real pager: the file's range reserved once, pages copied into it on demand (by
+// userfaultfd, or as memfd slots mapped over it), a SIGBUS and SIGSEGV handler for reads no
+// probe announced. Reads happen outside the pool's lock: threads reading different pages keep
 // that many reads in flight.
 #include "wavetrace/memory/file_pager.hpp"
 #include "wavetrace/memory/page_trace.hpp"
@@ -17,7 +17,9 @@
 #include <stdexcept>
 
 #include <fcntl.h>
+#include <linux/userfaultfd.h>
 #include <signal.h>
+#include <sys/ioctl.h>
 #include <sys/mman.h>
 #include <sys/syscall.h>
 #include <sys/uio.h>
@@ -32,21 +34,23 @@ namespace {
 // installed before ours (or the default: a crash, as without us).
 constexpr std::size_t kMaxPagers = 16;
 std::array<std::atomic<FilePager*>, kMaxPagers> active_pagers{};
-std::once_flag handler_installed;
-struct sigaction previous_action {};
+std::once_flag handlers_installed;
+// What was installed before ours: [0] for SIGSEGV (the memfd mapping's faults), [1] for
+// SIGBUS (userfaultfd's).
+std::array<struct sigaction, 2> previous_actions{};
 
 void chain_to_previous(int signal, siginfo_t* info, void* context) {
-  if (previous_action.sa_flags & SA_SIGINFO) {
-    if (previous_action.sa_sigaction != nullptr) return previous_action.sa_sigaction(signal, info, context);
-  } else if (previous_action.sa_handler != SIG_IGN && previous_action.sa_handler != SIG_DFL &&
-             previous_action.sa_handler != nullptr) {
-    return previous_action.sa_handler(signal);
+  const struct sigaction& previous = previous_actions[signal == SIGBUS ? 1 : 0];
+  if (previous.sa_flags & SA_SIGINFO) {
+    if (previous.sa_sigaction != nullptr) return previous.sa_sigaction(signal, info, context);
+  } else if (previous.sa_handler != SIG_IGN && previous.sa_handler != SIG_DFL && previous.sa_handler != nullptr) {
+    return previous.sa_handler(signal);
   }
   // Default action: restore it and return, so the faulting read repeats and crashes as usual.
-  ::signal(SIGSEGV, SIG_DFL);
+  ::signal(signal, SIG_DFL);
 }
 
-void on_segmentation_fault(int signal, siginfo_t* info, void* context) {
+void on_fault(int signal, siginfo_t* info, void* context) {
   for (auto& slot : active_pagers) {
     FilePager* pager = slot.load(std::memory_order_acquire);
     if (pager != nullptr && pager->handle_fault(info->si_addr)) return;
@@ -54,14 +58,17 @@ void on_segmentation_fault(int signal, siginfo_t* info, void* context) {
   chain_to_previous(signal, info, context);
 }
 
-void install_handler() {
-  std::call_once(handler_installed, [] {
+void install_handlers() {
+  std::call_once(handlers_installed, [] {
     struct sigaction action {};
-    action.sa_sigaction = on_segmentation_fault;
+    action.sa_sigaction = on_fault;
     action.sa_flags = SA_SIGINFO | SA_NODEFER;
     sigemptyset(&action.sa_mask);
-    if (sigaction(SIGSEGV, &action, &previous_action) != 0) {
-      throw std::runtime_error(fmt::format("cannot install the pager's SIGSEGV handler: {}", std::strerror(errno)));
+    for (const int signal : {SIGSEGV, SIGBUS}) {
+      if (sigaction(signal, &action, &previous_actions[signal == SIGBUS ? 1 : 0]) != 0) {
+        throw std::runtime_error(fmt::format("cannot install the pager's {} handler: {}",
+                                             signal == SIGBUS ? "SIGBUS" : "SIGSEGV", std::strerror(errno)));
+      }
     }
   });
 }
@@ -94,13 +101,56 @@ bool reserve_range(void* address, std::size_t bytes) {
   return ::mmap(address, bytes, PROT_NONE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE | MAP_FIXED, -1, 0) != MAP_FAILED;
 }
 
+// Makes the PROT_NONE reservation [address, +bytes) readable anonymous memory whose missing
+// pages raise SIGBUS in the thread that reads them, and returns the userfaultfd that fills
+// them; on failure puts the reservation back and returns -1 with the kernel's reason. Huge
+// pages stay off the range: a page is the pager's page and no larger.
+int register_missing_pages(std::byte* address, std::size_t bytes, std::string& reason) {
+  const int fd = static_cast<int>(::syscall(SYS_userfaultfd, O_CLOEXEC | O_NONBLOCK));
+  if (fd < 0) {
+    reason = fmt::format("userfaultfd: {}", std::strerror(errno));
+    return -1;
+  }
+  uffdio_api api{};
+  api.api = UFFD_API;
+  api.features = UFFD_FEATURE_SIGBUS;
+  uffdio_register range{};
+  range.range = {reinterpret_cast<std::uint64_t>(address), bytes};
+  range.mode = UFFDIO_REGISTER_MODE_MISSING;
+  const char* step = nullptr;
+  if (::ioctl(fd, UFFDIO_API, &api) != 0) {
+    step = "UFFDIO_API with UFFD_FEATURE_SIGBUS";
+  } else if (::mprotect(address, bytes, PROT_READ) != 0 || ::madvise(address, bytes, MADV_NOHUGEPAGE) != 0) {
+    step = "making the range readable";
+  } else if (::ioctl(fd, UFFDIO_REGISTER, &range) != 0) {
+    step = "UFFDIO_REGISTER";
+  } else if ((range.ioctls & (std::uint64_t{1} << _UFFDIO_COPY)) == 0) {
+    step = "UFFDIO_COPY";
+    errno = ENOTSUP;
+  }
+  if (step == nullptr) return fd;
+  reason = fmt::format("{}: {}", step, std::strerror(errno));
+  ::close(fd);
+  reserve_range(address, bytes);
+  return -1;
+}
+
 }  // namespace
+
+const char* to_string(PageMapping mapping) {
+  switch (mapping) {
+    case PageMapping::automatic: return "auto";
+    case PageMapping::userfaultfd: return "userfaultfd";
+    case PageMapping::memfd: return "memfd";
+  }
+  return "?";
+}
 
 FilePager::ClientScope::ClientScope(std::size_t client) : previous_(current_client) { current_client = client; }
 FilePager::ClientScope::~ClientScope() { current_client = previous_; }
 
 FilePager::FilePager(const std::string& path, std::uint64_t file_bytes, std::size_t page_bytes, std::size_t budget_bytes,
-                     std::size_t clients)
+                     std::size_t clients, PageMapping mapping)
     : path_(path), file_bytes_(file_bytes), page_bytes_(page_bytes) {
   if (!std::has_single_bit(page_bytes) || page_bytes < 4096) {
     throw std::invalid_argument(fmt::format("page size {} bytes: real paging needs a power of two of 4096 or more", page_bytes));
@@ -115,30 +165,40 @@ FilePager::FilePager(const std::string& path, std::uint64_t file_bytes, std::siz
   if (pages >= kNone) throw std::invalid_argument(fmt::format("{}: {} pages of {} bytes is too many", path, pages, page_bytes));
   reserved_bytes_ = pages * page_bytes;
   slots_ = std::clamp<std::size_t>(budget_bytes / page_bytes, 1, std::max<std::size_t>(pages, 1));
-  // Each resident page is a mapping of its own, and a hole between two is another: the
-  // kernel's limit on mappings bounds the pool.
-  constexpr std::size_t kMaxSlots = 30000;
-  if (slots_ > kMaxSlots) {
-    throw std::invalid_argument(fmt::format(
-        "{}: a budget of {} pages of {} KiB is over the {} pages real paging can map; use larger pages "
-        "(memory.page_bytes)", path, slots_, page_bytes >> 10, kMaxSlots));
-  }
   direct_fd_ = ::open(path.c_str(), O_RDONLY | O_DIRECT | O_CLOEXEC);
   if (direct_fd_ < 0) throw std::runtime_error(fmt::format("{}: cannot open for direct reads: {}", path, std::strerror(errno)));
-  pool_fd_ = ::memfd_create("wavetrace-page-pool", MFD_CLOEXEC);
-  if (pool_fd_ < 0 || ::ftruncate(pool_fd_, off_t(slots_ * page_bytes)) != 0) {
-    const std::string reason = std::strerror(errno);
-    ::close(direct_fd_);
-    if (pool_fd_ >= 0) ::close(pool_fd_);
-    throw std::runtime_error(fmt::format("{}: cannot create a page pool of {} bytes: {}", path, slots_ * page_bytes, reason));
-  }
   void* range = ::mmap(nullptr, reserved_bytes_, PROT_NONE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
   if (range == MAP_FAILED) {
     ::close(direct_fd_);
-    ::close(pool_fd_);
     throw std::runtime_error(fmt::format("{}: cannot reserve {} bytes of address space", path, reserved_bytes_));
   }
   base_ = static_cast<std::byte*>(range);
+  if (mapping != PageMapping::memfd) {
+    std::string reason;
+    fault_fd_ = register_missing_pages(base_, reserved_bytes_, reason);
+    if (fault_fd_ < 0 && mapping == PageMapping::userfaultfd) {
+      release();
+      throw std::runtime_error(fmt::format("{}: memory.page_mapping = userfaultfd, but the kernel refused it ({}); "
+                                           "use auto or memfd", path, reason));
+    }
+  }
+  if (fault_fd_ < 0) {
+    // Each resident page is a mapping of its own, and a hole between two is another: the
+    // kernel's limit on mappings bounds the pool.
+    constexpr std::size_t kMaxSlots = 30000;
+    if (slots_ > kMaxSlots) {
+      release();
+      throw std::invalid_argument(fmt::format(
+          "{}: a budget of {} pages of {} KiB is over the {} pages real paging can map without userfaultfd; use larger "
+          "pages (memory.page_bytes)", path, slots_, page_bytes >> 10, kMaxSlots));
+    }
+    pool_fd_ = ::memfd_create("wavetrace-page-pool", MFD_CLOEXEC);
+    if (pool_fd_ < 0 || ::ftruncate(pool_fd_, off_t(slots_ * page_bytes)) != 0) {
+      const std::string reason = std::strerror(errno);
+      release();
+      throw std::runtime_error(fmt::format("{}: cannot create a page pool of {} bytes: {}", path, slots_ * page_bytes, reason));
+    }
+  }
   page_count_ = pages;
   slot_of_ = std::make_unique<std::atomic<std::uint32_t>[]>(pages);
   headed_at_ = std::make_unique<std::atomic<std::uint64_t>[]>(pages);
@@ -153,7 +213,7 @@ FilePager::FilePager(const std::string& path, std::uint64_t file_bytes, std::siz
   clients_.resize(clients + 1);
   part_faults_.assign(clients_.size() * part_names_.size(), 0);
 
-  install_handler();
+  install_handlers();
   for (auto& slot : active_pagers) {
     FilePager* expected = nullptr;
     if (slot.compare_exchange_strong(expected, this)) return;
@@ -171,10 +231,10 @@ void FilePager::release() {
   }
   if (base_ != nullptr) ::munmap(base_, reserved_bytes_);
   base_ = nullptr;
-  if (direct_fd_ >= 0) ::close(direct_fd_);
-  if (pool_fd_ >= 0) ::close(pool_fd_);
-  if (self_pidfd_ >= 0) ::close(self_pidfd_);
-  direct_fd_ = pool_fd_ = self_pidfd_ = -1;
+  for (int* fd : {&direct_fd_, &fault_fd_, &pool_fd_, &self_pidfd_}) {
+    if (*fd >= 0) ::close(*fd);
+    *fd = -1;
+  }
 }
 
 std::size_t FilePager::client_index() const {
@@ -211,11 +271,14 @@ void FilePager::evict_tail_locked(std::size_t count) {
   // over the whole group clears them with one flush (measured on Linux 6.18: the shootdowns
   // fell under 2% of cycles); the PROT_NONE mappings that follow find no page left to flush.
   // Where the kernel refuses (older ones took few advices through process_madvise), each
-  // unmap flushes, as before.
+  // page is unmapped (memfd) or dropped (userfaultfd) on its own, a flush each.
+  bool dropped = false;
   if (taken > 1 && self_pidfd_ >= 0) {
     std::array<iovec, kMaxEvictionGroup> ranges;
     for (std::size_t v = 0; v < taken; ++v) ranges[v] = {base_ + (std::size_t(victims[v]) << page_shift_), page_bytes_};
-    if (::syscall(SYS_process_madvise, self_pidfd_, ranges.data(), taken, MADV_DONTNEED, 0) < 0) {
+    const long advised = ::syscall(SYS_process_madvise, self_pidfd_, ranges.data(), taken, MADV_DONTNEED, 0);
+    dropped = advised == long(taken * page_bytes_);
+    if (advised < 0) {
       ::close(self_pidfd_);
       self_pidfd_ = -1;
     }
@@ -223,7 +286,14 @@ void FilePager::evict_tail_locked(std::size_t count) {
   for (std::size_t v = 0; v < taken; ++v) {
     const std::uint32_t page = victims[v];
     // From here a reader of this page faults and waits for the mutex; its slot is free again.
-    reserve_range(base_ + (std::size_t(page) << page_shift_), page_bytes_);
+    std::byte* place = base_ + (std::size_t(page) << page_shift_);
+    if (fault_fd_ < 0) {
+      reserve_range(place, page_bytes_);
+    } else if (!dropped) {
+      // Its memory freed, the page is missing again. Should the kernel refuse, the page stays
+      // resident past the budget, its bytes still the file's (this range is no slot's).
+      ::madvise(place, page_bytes_, MADV_DONTNEED);
+    }
     free_slots_.push_back(slot_of_[page].load(std::memory_order_relaxed));
     slot_of_[page].store(kNone, std::memory_order_relaxed);
     prefetched_[page].store(0, std::memory_order_relaxed);  // read by nobody else: a prefetch wasted
@@ -281,8 +351,24 @@ std::string FilePager::load(std::uint32_t page, std::uint64_t address_offset, st
     done += got > 0 ? std::size_t(got) : 0;
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (error.empty()) {
-    if (bytes < page_bytes_) std::memset(into + bytes, 0, page_bytes_ - bytes);
+  if (error.empty() && bytes < page_bytes_) std::memset(into + bytes, 0, page_bytes_ - bytes);
+  if (error.empty() && fault_fd_ >= 0) {
+    // Copied in 4 KiB at a time, each mapped once whole: a reader sees the file's bytes or
+    // faults on a part not yet in, and waits for this read.
+    uffdio_copy copy{};
+    copy.dst = reinterpret_cast<std::uint64_t>(base_ + offset);
+    copy.src = reinterpret_cast<std::uint64_t>(into);
+    copy.len = page_bytes_;
+    while (::ioctl(fault_fd_, UFFDIO_COPY, &copy) != 0) {
+      if (errno == EAGAIN && copy.copy >= 0) {  // interrupted part way: go on from there
+        copy.dst += std::uint64_t(copy.copy), copy.src += std::uint64_t(copy.copy), copy.len -= std::uint64_t(copy.copy);
+        copy.copy = 0;
+        continue;
+      }
+      error = fmt::format("{}: placing page {} failed: {}", path_, page, std::strerror(errno));
+      break;
+    }
+  } else if (error.empty()) {
     // Into the slot by a write to the memfd, not through a writable mapping of the pool: a
     // page mapped there and at its address counted twice in the process's resident memory
     // (VmRSS, VmHWM, what the OOM killer weighs: a 12 GB pool showed 24 GB), and unmapping
@@ -308,6 +394,7 @@ std::string FilePager::load(std::uint32_t page, std::uint64_t address_offset, st
   DiskCounters& counters = clients_[client_index()];
   counters.wait_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - *waiting_since).count();
   if (!error.empty()) {
+    if (fault_fd_ >= 0) ::madvise(base_ + offset, page_bytes_, MADV_DONTNEED);  // what part of it came in
     free_slots_.push_back(slot);
     slot_of_[page].store(kNone, std::memory_order_relaxed);
   } else {

@@ -1,12 +1,11 @@
 // Real out-of-core paging of a file, the reordering paper's setting (§5) made real: the
 // file's bytes appear at one fixed address range, but only `budget` bytes of them are ever
-// resident, in a pool of page slots (a memfd), filled on demand by reads that bypass the OS
-// page cache (O_DIRECT) and evicted least recently used, a few at a time (one TLB flush for
-// the group). Pages come in two ways: a probe reports a read (touch, which also keeps the
-// LRU order), or traversal reads a page no probe announced, which faults (SIGSEGV on the
-// reserved range) and is loaded by the signal handler before the read is retried. Either
-// way the bytes a reader sees are the file's; an eviction racing a reader only costs that
-// reader another fault.
+// resident, filled on demand by reads that bypass the OS page cache (O_DIRECT) and evicted
+// least recently used, a few at a time (one TLB flush for the group). Pages come in two
+// ways: a probe reports a read (touch, which also keeps the LRU order), or traversal reads a
+// page no probe announced, which faults (SIGBUS or SIGSEGV on the reserved range) and is
+// loaded by the signal handler before the read is retried. Either way the bytes a reader
+// sees are the file's; an eviction racing a reader only costs that reader another fault.
 #pragma once
 
 #include <cstddef>
@@ -21,6 +20,20 @@
 namespace wavetrace {
 
 class PageTrace;
+
+// How a resident page appears at its address.
+// - userfaultfd: the range is one anonymous read-only mapping registered for missing-page
+//   faults, which the kernel raises as SIGBUS in the reading thread (UFFD_FEATURE_SIGBUS). A
+//   page comes in by one copy from the read's buffer (UFFDIO_COPY) and leaves by
+//   MADV_DONTNEED: two system calls a read, and no change to the process's mappings (which
+//   take the address space's lock for writing, against every thread's faults).
+// - memfd: the range is PROT_NONE; a page is written into a slot of a memfd pool and mapped
+//   over its place (a mapping a resident page; faults are SIGSEGV), and an evicted page's
+//   place is reserved again: four system calls a read, two of them mmap.
+// - automatic: userfaultfd where the kernel allows this process to use it (root, or
+//   vm.unprivileged_userfaultfd = 1; container sandboxes often forbid it), memfd elsewhere.
+enum class PageMapping { automatic, userfaultfd, memfd };
+const char* to_string(PageMapping mapping);
 
 struct DiskCounters {
   std::uint64_t faults = 0;      // pages read from the file
@@ -51,15 +64,18 @@ class FilePager {
   // `page_bytes`: a power of two, at least 4096; `budget_bytes` is rounded down to whole
   // pages, and less than one page is an error naming memory.budget. `clients` counters are kept apart (one per stage that reads), plus
   // one for reads outside any client scope (loading). Throws std::runtime_error naming the
-  // file when it cannot be opened for direct reads or the address range reserved.
+  // file when it cannot be opened for direct reads or the address range reserved, and
+  // naming memory.page_mapping when `mapping` asks for userfaultfd and the kernel refuses it.
   FilePager(const std::string& path, std::uint64_t file_bytes, std::size_t page_bytes, std::size_t budget_bytes,
-            std::size_t clients);
+            std::size_t clients, PageMapping mapping = PageMapping::automatic);
   ~FilePager();
   FilePager(const FilePager&) = delete;
   FilePager& operator=(const FilePager&) = delete;
 
   // Where the file's byte 0 appears.
   const std::byte* base() const { return base_; }
+  // userfaultfd or memfd: the mapping in use, never automatic.
+  PageMapping mapping() const { return fault_fd_ >= 0 ? PageMapping::userfaultfd : PageMapping::memfd; }
   std::uint64_t file_bytes() const { return file_bytes_; }
   bool contains(const void* address) const {
     const auto* p = static_cast<const std::byte*>(address);
@@ -160,13 +176,15 @@ class FilePager {
   std::size_t reserved_bytes_;
   std::size_t slots_;
   int direct_fd_ = -1;  // the file, O_DIRECT
-  int pool_fd_ = -1;    // the memfd of page slots
+  int fault_fd_ = -1;   // the userfaultfd the range is registered with (PageMapping::userfaultfd)
+  int pool_fd_ = -1;    // the memfd of page slots (PageMapping::memfd)
   std::byte* base_ = nullptr;
 
   mutable std::mutex mutex_;
   std::condition_variable loaded_;  // a page finished loading (or failed to)
   std::size_t reads_in_flight_ = 0, reads_in_flight_max_ = 0;
-  // Per page: its pool slot, kNone when not resident. Written under mutex_, read without it
+  // Per page: its pool slot (with userfaultfd, only a count: the kernel holds the bytes),
+  // kNone when not resident. Written under mutex_, read without it
   // by touch's fast path.
   std::unique_ptr<std::atomic<std::uint32_t>[]> slot_of_;
   std::size_t page_count_ = 0;

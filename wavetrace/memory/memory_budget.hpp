@@ -6,6 +6,8 @@
 #include <cstddef>
 #include <string_view>
 
+#include "wavetrace/memory/file_pager.hpp"
+
 namespace wavetrace {
 
 // A pool budget: a share of the world's pages ("20%", rounded up) or bytes ("512MiB",
@@ -25,6 +27,7 @@ struct PagingRequest {
   std::size_t page_bytes = std::size_t{128} << 10;
   MemoryBudget budget;  // a share of the file's bytes, or bytes
   std::size_t clients = 1;
+  PageMapping mapping = PageMapping::automatic;
 };
 
 }  // namespace wavetrace

@@ -188,7 +188,8 @@ std::shared_ptr<const SectionFile> SectionFile::open(const std::string& path, co
       const std::size_t budget_bytes =
           paging->budget.is_share ? static_cast<std::size_t>(std::ceil(paging->budget.share * double(actual_size)))
                                   : paging->budget.bytes;
-      file->pager_ = std::make_unique<FilePager>(path, actual_size, paging->page_bytes, budget_bytes, paging->clients);
+      file->pager_ = std::make_unique<FilePager>(path, actual_size, paging->page_bytes, budget_bytes, paging->clients,
+                                                paging->mapping);
     } catch (const std::exception& error) {
       throw SectionFileError(error.what());
     }

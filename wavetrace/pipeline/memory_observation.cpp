@@ -42,6 +42,7 @@ void MemoryObservation::report(std::vector<StageStats>& stages) const {
       if (caches_) stage.cache = CacheStats{caches_->geometry(), caches_->total(client)};
       if (file_pager_) {
         stage.disk.emplace();
+        stage.disk->mapping = file_pager_->mapping();
         stage.disk->page_bytes = file_pager_->page_bytes();
         stage.disk->budget_bytes = file_pager_->budget_bytes();
         stage.disk->counters = file_pager_->counters(client);

@@ -133,6 +133,12 @@ void read_backing(const Config& config, std::string_view key, RenderPlan& plan) 
   plan.memory.file_backing = config.text(key) == "file";
   plan.memory.copy_world = config.text(key) == "copy";
 }
+void read_page_mapping(const Config& config, std::string_view key, RenderPlan& plan) {
+  const std::string& mapping = config.text(key);
+  plan.memory.page_mapping = mapping == "userfaultfd" ? PageMapping::userfaultfd
+                             : mapping == "memfd"     ? PageMapping::memfd
+                                                      : PageMapping::automatic;
+}
 void read_io(const Config& config, std::string_view key, RenderPlan& plan) { plan.memory.io = io_preset(config.text(key)); }
 void read_cache(const Config& config, std::string_view key, RenderPlan& plan) {
   const std::string& cache = config.text(key);
@@ -399,6 +405,12 @@ const std::vector<ConfigKey>& config_schema() {
        "pages, for walks over gigabytes; mapped where the machine cannot spare the file and 1 GB) or file (real "
        "paging: read on demand with O_DIRECT into a pool of memory.budget, evicted LRU)",
        read_backing},
+      {"memory.page_mapping", T::text, std::string("auto"), 0, 0, {"auto", "userfaultfd", "memfd"},
+       "real paging (memory.backing = file): how a page read appears at its place. userfaultfd: copied into one "
+       "mapping of the whole file (two system calls a read); memfd: a slot of a memfd pool mapped there (four, two of "
+       "them changing the process's mappings; at most 30,000 pages resident); auto: userfaultfd where the kernel "
+       "allows it, else memfd",
+       read_page_mapping},
       {"memory.look_ahead", T::integer, std::int64_t{0}, 0, 64, {},
        "real paging (memory.backing = file): how many of the sorted batches queued for trace a thread of its own "
        "traces ahead (every 4th ray, hits thrown away) so that their pages are read before trace needs them; 0: none "

@@ -120,7 +120,7 @@ AcceleratorOptions saved_proxy_accelerator(const Config& settings, int threads) 
 
 std::optional<PagingRequest> world_paging(const RenderPlan& plan) {
   if (!plan.memory.file_backing) return std::nullopt;
-  return PagingRequest{plan.memory.page_bytes, *plan.memory.budget, kFilePagerClients};
+  return PagingRequest{plan.memory.page_bytes, *plan.memory.budget, kFilePagerClients, plan.memory.page_mapping};
 }
 
 FileHolding world_holding(const RenderPlan& plan) {
