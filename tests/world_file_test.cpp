@@ -504,7 +504,8 @@ TEST(WorldFileCli, BuildRenderAndInfo) {
   EXPECT_EQ(read_all(temp_path("cli.exr")), read_all(temp_path("cli_memfd.exr")));
   for (const auto& [path, mappings] : {std::pair{stats, std::vector<std::string>{"userfaultfd", "memfd"}},
                                        std::pair{memfd_stats, std::vector<std::string>{"memfd"}}}) {
-    for (const nlohmann::json& stage : nlohmann::json::parse(read_all(path)).at("stages")) {
+    const nlohmann::json report_of_run = nlohmann::json::parse(read_all(path));
+    for (const nlohmann::json& stage : report_of_run.at("stages")) {
       if (stage["name"] != "trace") continue;
       const std::string mapping = stage.at("disk").at("mapping").get<std::string>();
       EXPECT_NE(std::find(mappings.begin(), mappings.end(), mapping), mappings.end()) << path << ": " << mapping;
