@@ -29,15 +29,15 @@ class ProbedAccelerator : public Accelerator {
     });
   }
   bool probed() const override { return true; }
-  // Probed walks serve the pager and the cache simulator, whose counts do not depend on the
-  // set; they run the baseline.
+  // Probed walks run the same set as the plain ones: they are what a paged render traces
+  // with (the probe keeps the real pager's LRU order), so they must be as fast.
   void intersect_closest_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
                                 RecordingProbe& probe) const override {
-    self().template traverse<false, KernelIsa::baseline>(rays, hits, range, probe);
+    walk_with(isa_, [&]<KernelIsa kIsa>() { self().template traverse<false, kIsa>(rays, hits, range, probe); });
   }
   void intersect_any_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
                             RecordingProbe& probe) const override {
-    self().template traverse<true, KernelIsa::baseline>(rays, hits, range, probe);
+    walk_with(isa_, [&]<KernelIsa kIsa>() { self().template traverse<true, kIsa>(rays, hits, range, probe); });
   }
 
   std::string isa() const override { return std::string(to_string(isa_)); }

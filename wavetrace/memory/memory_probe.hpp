@@ -7,6 +7,7 @@
 #include <cstdint>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <optional>
 #include <vector>
@@ -20,6 +21,7 @@ namespace wavetrace {
 
 struct NullProbe {
   static constexpr bool kRecords = false;
+  static constexpr bool counts_reads() { return false; }
   void read(const void*, std::size_t) {}
 };
 
@@ -57,6 +59,10 @@ class RecordingProbe {
     if (file_pager_ != nullptr && windows_.windows > 0) file_pager_->add_ray_windows(windows_);
   }
 
+  // Whether reads are counted (the simulated pager, caches, the tally), so that a walk must
+  // read what the paper's model reads; real paging alone sees only the file's pages.
+  bool counts_reads() const { return pager_ != nullptr || cache_ != nullptr || tally_ != nullptr; }
+
   // Real paging only: from now on the probe keeps the pages each window of rays touched.
   void count_ray_windows() { counting_windows_ = file_pager_ != nullptr; }
   // Closes a window of consecutive rays (real paging only): a full one (`counted`) adds the
@@ -71,6 +77,7 @@ class RecordingProbe {
       ++windows_.windows;
     }
     window_pages_.clear();
+    recent_window_pages_.fill(~std::uintptr_t{0});
     last_file_page_ = ~std::uintptr_t{0};  // the next window's first page counts to it
   }
 
@@ -83,11 +90,11 @@ class RecordingProbe {
       const auto last = (reinterpret_cast<std::uintptr_t>(address) + bytes - 1) >> file_page_shift_;
       if (first != last_file_page_) {
         file_pager_->touch(address);
-        if (counting_windows_) window_pages_.push_back(first);
+        if (counting_windows_) note_window_page(first);
       }
       if (last != first) {
         file_pager_->touch(static_cast<const std::byte*>(address) + bytes - 1);
-        if (counting_windows_) window_pages_.push_back(last);
+        if (counting_windows_) note_window_page(last);
       }
       last_file_page_ = last;
     }
@@ -99,6 +106,15 @@ class RecordingProbe {
   }
 
  private:
+  // A walk turns among a few pages (its nodes', its leaves', its vertices'): a page among the
+  // last few noted is not kept again, so the window's sort sees tens of pages, not thousands.
+  void note_window_page(std::uintptr_t page) {
+    std::uintptr_t& recent = recent_window_pages_[page % recent_window_pages_.size()];
+    if (recent == page) return;
+    recent = page;
+    window_pages_.push_back(page);
+  }
+
   // A read of the page this thread read last needs no LRU update: it is still the most
   // recent page (exactly so with one thread; with more, another thread may have moved it).
   void read_page(std::uint32_t page) {
@@ -108,6 +124,12 @@ class RecordingProbe {
     }
     pager_->touch(page, client_);
     last_page_ = page;
+  }
+
+  static std::array<std::uintptr_t, 16> filled_with_no_page() {
+    std::array<std::uintptr_t, 16> pages;
+    pages.fill(~std::uintptr_t{0});
+    return pages;
   }
 
   SimulatedPager* pager_;
@@ -120,6 +142,7 @@ class RecordingProbe {
   std::uintptr_t last_file_page_ = ~std::uintptr_t{0};
   std::optional<FilePager::ClientScope> client_scope_;
   std::vector<std::uintptr_t> window_pages_;  // file pages touched in this window, with repeats
+  std::array<std::uintptr_t, 16> recent_window_pages_ = filled_with_no_page();
   RayWindowCounters windows_;
   bool counting_windows_ = false;
   std::uint32_t last_page_ = SimulatedPager::kNoPage;

@@ -457,7 +457,10 @@ class ChunkedAccelerator final : public Accelerator, public ChunkSet {
     const BoxRay box_ray = make_box_ray(origin, direction);
     const float tmin = rays.tmin[i], tmax = rays.tmax[i];
     const std::size_t begin = visits.size();
-    if (!Probe::kRecords && !chunk_lanes_.empty()) {
+    // The lanes are the process's own memory, not the file's: a probe that counts every read
+    // (the simulated pager and caches, the tally) sees the top BVH's instead, the paper's
+    // reads; one that only keeps the real pager's order has nothing to see.
+    if (!chunk_lanes_.empty() && (!Probe::kRecords || !probe.counts_reads())) {
       // Boxes in lanes: for up to a thousand chunks cheaper than walking the top BVH a box at
       // a time. A ray enters a chunk's box only if it enters its block's (the block's box
       // holds it, and the slab arithmetic is monotonic in the box). Ties leave in chunk order

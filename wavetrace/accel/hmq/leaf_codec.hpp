@@ -71,6 +71,8 @@ struct DecodedLeaf {
   const std::byte* ids;      // the id stream
   const std::byte* corners;  // the corner stream
 
+  // One past the record's last byte: its corner stream ends it.
+  const std::byte* end() const { return corners + stream_bytes(3, layout->triangles); }
   std::uint32_t vertex_of_slot(std::uint32_t slot) const { return header.indexed ? slot_vertex[slot] : slot; }
   glm::vec3 slot_position(std::uint32_t slot) const {
     const std::uint32_t v = vertex_of_slot(slot);

@@ -75,9 +75,11 @@ inline int lane_parts(std::uint32_t entries) { return entries <= 8 ? 1 : entries
 template <typename Probe>
 [[gnu::always_inline]] inline void prepare_leaf(const std::byte* record, const GlobalGrid& grid, const Box& box,
                                                 LeafTriangles& leaf, Probe& probe) {
-  if constexpr (Probe::kRecords) probe.read(record, leaf_record_bytes(record));
   DecodedLeaf& decoded = leaf.decoded;
   decode_leaf(record, grid, snap_outward(grid, box), decoded);
+  // Reported after the decode, which has the record's size at hand (a page the decode reads
+  // is loaded by its fault all the same).
+  if constexpr (Probe::kRecords) probe.read(record, std::size_t(decoded.end() - record));
 #if WAVETRACE_AVX2
   const StripLayoutEntry& layout = *decoded.layout;
   const __m256i index_mask = _mm256_set1_epi32(63);  // lanes past the last triangle pick in bounds
