@@ -132,9 +132,9 @@ ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<Reo
     report.memory = "pager " + config.text("memory.budget") + " of " + std::to_string(base.memory.page_bytes >> 10) +
                     " KiB pages";
     if (file_pager != nullptr) {
-      report.memory += fmt::format(" (simulated, and real: {} of {} pages read with O_DIRECT into a {:.1f} MiB pool, "
+      report.memory += fmt::format(" ({}real: {} of {} pages read with O_DIRECT into a {:.1f} MiB pool, "
                                    "placed by {})",
-                                   base.scene.source, file_pager->page_count(), double(file_pager->budget_bytes()) / (1 << 20),
+                                   base.memory.simulate_beside_file ? "simulated, and " : "", base.scene.source, file_pager->page_count(), double(file_pager->budget_bytes()) / (1 << 20),
                                    to_string(file_pager->mapping()));
       report.page_count = file_pager->page_count();
     }
