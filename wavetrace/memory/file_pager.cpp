@@ -137,15 +137,6 @@ int register_missing_pages(std::byte* address, std::size_t bytes, std::string& r
 
 }  // namespace
 
-const char* to_string(PageMapping mapping) {
-  switch (mapping) {
-    case PageMapping::automatic: return "auto";
-    case PageMapping::userfaultfd: return "userfaultfd";
-    case PageMapping::memfd: return "memfd";
-  }
-  return "?";
-}
-
 FilePager::ClientScope::ClientScope(std::size_t client) : previous_(current_client) { current_client = client; }
 FilePager::ClientScope::~ClientScope() { current_client = previous_; }
 
@@ -300,6 +291,73 @@ void FilePager::evict_tail_locked(std::size_t count) {
   }
 }
 
+// Reads page `page` of the file into `into` (page_bytes_, zero past the file's end), timing
+// the read. The caller holds no lock.
+std::string FilePager::read_page(std::uint32_t page, std::byte* into, double& seconds) const {
+  const std::uint64_t offset = std::uint64_t(page) << page_shift_;
+  const std::size_t bytes = static_cast<std::size_t>(std::min<std::uint64_t>(page_bytes_, file_bytes_ - offset));
+  // O_DIRECT wants whole blocks: read the page's full size (a section file's size is a
+  // multiple of 4096, so the read ends at or before the file's end on a block boundary).
+  const std::size_t request = (bytes + 4095) / 4096 * 4096;
+  std::string error;
+  const auto start = std::chrono::steady_clock::now();
+  for (std::size_t done = 0; done < bytes && error.empty();) {
+    const ssize_t got = ::pread(direct_fd_, into + done, request - done, off_t(offset + done));
+    if (got < 0 && errno == EINTR) continue;
+    if (got <= 0) {
+      error = fmt::format("{}: reading page {} (bytes {}..{}) failed: {}", path_, page, offset, offset + bytes,
+                          got < 0 ? std::strerror(errno)
+                                  : "the file ends early (truncated or replaced while it was paged?)");
+    }
+    done += got > 0 ? std::size_t(got) : 0;
+  }
+  seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (error.empty() && bytes < page_bytes_) std::memset(into + bytes, 0, page_bytes_ - bytes);
+  return error;
+}
+
+// Makes the page read into `into` appear at its address, by the mapping in use. The caller
+// holds no lock: the page is marked loading, so no other thread places or evicts it.
+std::string FilePager::place_page(std::uint32_t page, std::uint32_t slot, const std::byte* into) {
+  const std::uint64_t offset = std::uint64_t(page) << page_shift_;
+  if (fault_fd_ >= 0) {
+    // Copied in 4 KiB at a time, each mapped once whole: a reader sees the file's bytes or
+    // faults on a part not yet in, and waits for this read.
+    uffdio_copy copy{};
+    copy.dst = reinterpret_cast<std::uint64_t>(base_ + offset);
+    copy.src = reinterpret_cast<std::uint64_t>(into);
+    copy.len = page_bytes_;
+    while (::ioctl(fault_fd_, UFFDIO_COPY, &copy) != 0) {
+      if (errno == EAGAIN && copy.copy >= 0) {  // interrupted part way: go on from there
+        copy.dst += std::uint64_t(copy.copy), copy.src += std::uint64_t(copy.copy), copy.len -= std::uint64_t(copy.copy);
+        copy.copy = 0;
+        continue;
+      }
+      return fmt::format("{}: placing page {} failed: {}", path_, page, std::strerror(errno));
+    }
+    return {};
+  }
+  // Into the slot by a write to the memfd, not through a writable mapping of the pool: a
+  // page mapped there and at its address counted twice in the process's resident memory
+  // (VmRSS, VmHWM, what the OOM killer weighs: a 12 GB pool showed 24 GB), and unmapping
+  // the view's pages a group at a time cost 27% of a paged render's time; this copy, no
+  // time we could measure (docs/memory.md).
+  for (std::size_t done = 0; done < page_bytes_;) {
+    const ssize_t put = ::pwrite(pool_fd_, into + done, page_bytes_ - done, off_t(std::size_t(slot) * page_bytes_ + done));
+    if (put < 0 && errno == EINTR) continue;
+    if (put <= 0) return fmt::format("{}: copying page {} into the pool failed: {}", path_, page, std::strerror(errno));
+    done += std::size_t(put);
+  }
+  // The page appears at its address read-only in one mmap, once it is whole: no reader
+  // ever sees it half read. MAP_POPULATE maps every 4 KiB of it now: one call instead of a
+  // minor fault each.
+  if (::mmap(base_ + offset, page_bytes_, PROT_READ, MAP_SHARED | MAP_FIXED | MAP_POPULATE, pool_fd_,
+             off_t(std::size_t(slot) * page_bytes_)) == MAP_FAILED) {
+    return fmt::format("{}: mapping page {} failed: {}", path_, page, std::strerror(errno));
+  }
+  return {};
+}
+
 std::string FilePager::load(std::uint32_t page, std::uint64_t address_offset, std::unique_lock<std::mutex>& lock) {
   std::optional<std::chrono::steady_clock::time_point> waiting_since;
   for (;;) {
@@ -331,63 +389,14 @@ std::string FilePager::load(std::uint32_t page, std::uint64_t address_offset, st
   reads_in_flight_max_ = std::max(reads_in_flight_max_, ++reads_in_flight_);
   lock.unlock();
 
-  std::string error;
   const std::uint64_t offset = std::uint64_t(page) << page_shift_;
   const std::size_t bytes = static_cast<std::size_t>(std::min<std::uint64_t>(page_bytes_, file_bytes_ - offset));
-  // O_DIRECT wants whole blocks: read the page's full size (a section file's size is a
-  // multiple of 4096, so the read ends at or before the file's end on a block boundary).
-  const std::size_t request = (bytes + 4095) / 4096 * 4096;
   std::byte* into = read_buffer.at_least(page_bytes_);
-  if (into == nullptr) error = fmt::format("{}: no memory for a read buffer of {} bytes", path_, page_bytes_);
-  const auto start = std::chrono::steady_clock::now();
-  for (std::size_t done = 0; done < bytes && error.empty();) {
-    const ssize_t got = ::pread(direct_fd_, into + done, request - done, off_t(offset + done));
-    if (got < 0 && errno == EINTR) continue;
-    if (got <= 0) {
-      error = fmt::format("{}: reading page {} (bytes {}..{}) failed: {}", path_, page, offset, offset + bytes,
-                          got < 0 ? std::strerror(errno)
-                                  : "the file ends early (truncated or replaced while it was paged?)");
-    }
-    done += got > 0 ? std::size_t(got) : 0;
-  }
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (error.empty() && bytes < page_bytes_) std::memset(into + bytes, 0, page_bytes_ - bytes);
-  if (error.empty() && fault_fd_ >= 0) {
-    // Copied in 4 KiB at a time, each mapped once whole: a reader sees the file's bytes or
-    // faults on a part not yet in, and waits for this read.
-    uffdio_copy copy{};
-    copy.dst = reinterpret_cast<std::uint64_t>(base_ + offset);
-    copy.src = reinterpret_cast<std::uint64_t>(into);
-    copy.len = page_bytes_;
-    while (::ioctl(fault_fd_, UFFDIO_COPY, &copy) != 0) {
-      if (errno == EAGAIN && copy.copy >= 0) {  // interrupted part way: go on from there
-        copy.dst += std::uint64_t(copy.copy), copy.src += std::uint64_t(copy.copy), copy.len -= std::uint64_t(copy.copy);
-        copy.copy = 0;
-        continue;
-      }
-      error = fmt::format("{}: placing page {} failed: {}", path_, page, std::strerror(errno));
-      break;
-    }
-  } else if (error.empty()) {
-    // Into the slot by a write to the memfd, not through a writable mapping of the pool: a
-    // page mapped there and at its address counted twice in the process's resident memory
-    // (VmRSS, VmHWM, what the OOM killer weighs: a 12 GB pool showed 24 GB), and unmapping
-    // the view's pages a group at a time cost 27% of a paged render's time; this copy, no
-    // time we could measure (docs/memory.md).
-    for (std::size_t done = 0; done < page_bytes_ && error.empty();) {
-      const ssize_t put = ::pwrite(pool_fd_, into + done, page_bytes_ - done, off_t(std::size_t(slot) * page_bytes_ + done));
-      if (put < 0 && errno == EINTR) continue;
-      if (put <= 0) error = fmt::format("{}: copying page {} into the pool failed: {}", path_, page, std::strerror(errno));
-      done += put > 0 ? std::size_t(put) : 0;
-    }
-    // The page appears at its address read-only in one mmap, once it is whole: no reader
-    // ever sees it half read. MAP_POPULATE maps every 4 KiB of it now: one call instead of a
-    // minor fault each.
-    if (error.empty() && ::mmap(base_ + offset, page_bytes_, PROT_READ, MAP_SHARED | MAP_FIXED | MAP_POPULATE, pool_fd_,
-               off_t(std::size_t(slot) * page_bytes_)) == MAP_FAILED) {
-      error = fmt::format("{}: mapping page {} failed: {}", path_, page, std::strerror(errno));
-    }
-  }
+  double seconds = 0.0;
+  std::string error = into == nullptr
+                          ? fmt::format("{}: no memory for a read buffer of {} bytes", path_, page_bytes_)
+                          : read_page(page, into, seconds);
+  if (error.empty()) error = place_page(page, slot, into);
 
   lock.lock();
   --reads_in_flight_;

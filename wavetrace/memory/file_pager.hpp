@@ -17,23 +17,11 @@
 #include <string>
 #include <vector>
 
+#include "wavetrace/memory/page_mapping.hpp"
+
 namespace wavetrace {
 
 class PageTrace;
-
-// How a resident page appears at its address.
-// - userfaultfd: the range is one anonymous read-only mapping registered for missing-page
-//   faults, which the kernel raises as SIGBUS in the reading thread (UFFD_FEATURE_SIGBUS). A
-//   page comes in by one copy from the read's buffer (UFFDIO_COPY) and leaves by
-//   MADV_DONTNEED: two system calls a read, and no change to the process's mappings (which
-//   take the address space's lock for writing, against every thread's faults).
-// - memfd: the range is PROT_NONE; a page is written into a slot of a memfd pool and mapped
-//   over its place (a mapping a resident page; faults are SIGSEGV), and an evicted page's
-//   place is reserved again: four system calls a read, two of them mmap.
-// - automatic: userfaultfd where the kernel allows this process to use it (root, or
-//   vm.unprivileged_userfaultfd = 1; container sandboxes often forbid it), memfd elsewhere.
-enum class PageMapping { automatic, userfaultfd, memfd };
-const char* to_string(PageMapping mapping);
 
 struct DiskCounters {
   std::uint64_t faults = 0;      // pages read from the file
@@ -142,6 +130,9 @@ class FilePager {
   // reader of a page being loaded waits for it. Returns an error message, empty on success,
   // so the signal path never throws.
   std::string load(std::uint32_t page, std::uint64_t offset, std::unique_lock<std::mutex>& lock);
+  // load's two steps outside the lock: the page's bytes into a read buffer, then at its address.
+  std::string read_page(std::uint32_t page, std::byte* into, double& seconds) const;
+  std::string place_page(std::uint32_t page, std::uint32_t slot, const std::byte* into);
   // The part of the file holding byte `offset`.
   std::uint32_t part_of(std::uint64_t offset) const;
   std::uint64_t offset_of(const void* address) const {

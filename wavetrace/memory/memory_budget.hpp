@@ -6,7 +6,7 @@
 #include <cstddef>
 #include <string_view>
 
-#include "wavetrace/memory/file_pager.hpp"
+#include "wavetrace/memory/page_mapping.hpp"
 
 namespace wavetrace {
 

@@ -23,7 +23,7 @@ struct MemoryPlan {
   bool file_backing = false;           // memory.backing = file: a world file really paged under the budget
   bool copy_world = false;             // memory.backing = copy: a world file copied onto huge pages
   std::size_t page_bytes = std::size_t{4} << 20;
-  PageMapping page_mapping = PageMapping::automatic;  // real paging: how resident pages appear (memory/file_pager.hpp)
+  PageMapping page_mapping = PageMapping::automatic;  // real paging: how resident pages appear (memory/page_mapping.hpp)
   // Real paging: sorted batches queued for trace whose pages its look-ahead reads first (0: none).
   std::size_t look_ahead_batches = 0;
   // Threads reading ahead, each on its own queued batch: reads in flight beside trace's own.
