@@ -134,7 +134,8 @@ ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<Reo
     if (file_pager != nullptr) {
       report.memory += fmt::format(" ({}real: {} of {} pages read with O_DIRECT into a {:.1f} MiB pool, "
                                    "placed by {})",
-                                   base.memory.simulate_beside_file ? "simulated, and " : "", base.scene.source, file_pager->page_count(), double(file_pager->budget_bytes()) / (1 << 20),
+                                   base.memory.simulate_beside_file ? "simulated, and " : "", base.scene.source,
+                                   file_pager->page_count(), double(file_pager->budget_bytes()) / (1 << 20),
                                    to_string(file_pager->mapping()));
       report.page_count = file_pager->page_count();
     }

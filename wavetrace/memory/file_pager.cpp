@@ -295,7 +295,7 @@ void FilePager::evict_tail_locked(std::size_t count) {
 // the read. The caller holds no lock.
 std::string FilePager::read_page(std::uint32_t page, std::byte* into, double& seconds) const {
   const std::uint64_t offset = std::uint64_t(page) << page_shift_;
-  const std::size_t bytes = static_cast<std::size_t>(std::min<std::uint64_t>(page_bytes_, file_bytes_ - offset));
+  const std::size_t bytes = file_bytes_in(page);
   // O_DIRECT wants whole blocks: read the page's full size (a section file's size is a
   // multiple of 4096, so the read ends at or before the file's end on a block boundary).
   const std::size_t request = (bytes + 4095) / 4096 * 4096;
@@ -390,7 +390,6 @@ std::string FilePager::load(std::uint32_t page, std::uint64_t address_offset, st
   lock.unlock();
 
   const std::uint64_t offset = std::uint64_t(page) << page_shift_;
-  const std::size_t bytes = static_cast<std::size_t>(std::min<std::uint64_t>(page_bytes_, file_bytes_ - offset));
   std::byte* into = read_buffer.at_least(page_bytes_);
   double seconds = 0.0;
   std::string error = into == nullptr
@@ -412,7 +411,7 @@ std::string FilePager::load(std::uint32_t page, std::uint64_t address_offset, st
     push_front_locked(page);
     ++counters.faults;
     ++part_faults_[client_index() * part_names_.size() + part_of(address_offset)];
-    counters.bytes_read += bytes;
+    counters.bytes_read += file_bytes_in(page);
     counters.read_seconds += seconds;
   }
   loaded_.notify_all();

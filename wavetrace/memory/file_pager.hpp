@@ -133,6 +133,10 @@ class FilePager {
   // load's two steps outside the lock: the page's bytes into a read buffer, then at its address.
   std::string read_page(std::uint32_t page, std::byte* into, double& seconds) const;
   std::string place_page(std::uint32_t page, std::uint32_t slot, const std::byte* into);
+  // The file's bytes in `page`: page_bytes_ but for the last page.
+  std::size_t file_bytes_in(std::uint32_t page) const {
+    return static_cast<std::size_t>(std::min<std::uint64_t>(page_bytes_, file_bytes_ - (std::uint64_t(page) << page_shift_)));
+  }
   // The part of the file holding byte `offset`.
   std::uint32_t part_of(std::uint64_t offset) const;
   std::uint64_t offset_of(const void* address) const {
