@@ -45,10 +45,11 @@ std::string memory_lines(const std::vector<StageStats>& stages) {
     }
     if (stage.disk) {
       const DiskCounters& c = stage.disk->counters;
-      lines += fmt::format("{} disk: {} KiB pages, pool {:.1f} MiB: {} real faults, {:.1f} MB read in {:.3f} s "
-                           "(O_DIRECT, in the measured time), {:.3f} s waited for pages, up to {} reads at once\n",
+      lines += fmt::format("{} disk: {} KiB pages, pool {:.1f} MiB: {} real faults ({} by reads no probe announced), "
+                           "{:.1f} MB read in {:.3f} s (O_DIRECT, in the measured time), {:.3f} s waited for pages, "
+                           "up to {} reads at once\n",
                            stage.name, stage.disk->page_bytes >> 10, double(stage.disk->budget_bytes) / (1 << 20),
-                           c.faults, double(c.bytes_read) * 1e-6, c.read_seconds, c.wait_seconds,
+                           c.faults, c.unannounced, double(c.bytes_read) * 1e-6, c.read_seconds, c.wait_seconds,
                            stage.disk->reads_in_flight_max);
       if (stage.disk->prefetched > 0) {
         lines += fmt::format("{} disk: {} of those pages read ahead by its look-ahead, {} of them used before evicted\n",
@@ -135,6 +136,7 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
                        {"page_bytes", stage.disk->page_bytes},
                        {"budget_bytes", stage.disk->budget_bytes},
                        {"faults", stage.disk->counters.faults},
+                       {"unannounced_faults", stage.disk->counters.unannounced},
                        {"bytes_read", stage.disk->counters.bytes_read},
                        {"read_seconds", stage.disk->counters.read_seconds},
                        {"wait_seconds", stage.disk->counters.wait_seconds},

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -97,6 +98,7 @@ TEST_P(FilePagerTest, ShowsTheFileAndEvictsTheLeastRecentlyUsedPage) {
   FilePager pager(path, kPages * kPage, kPage, 4 * kPage, 1, GetParam());
   for (std::size_t page : {0, 1, 2, 3}) pager.touch(pager.base() + page * kPage);
   EXPECT_EQ(pager.total().faults, 4u);
+  EXPECT_EQ(pager.total().unannounced, 0u);
   pager.touch(pager.base());             // page 0 becomes the most recent: page 1 is now the oldest
   pager.touch(pager.base() + 4 * kPage);  // evicts page 1
   EXPECT_EQ(pager.total().faults, 5u);
@@ -104,7 +106,24 @@ TEST_P(FilePagerTest, ShowsTheFileAndEvictsTheLeastRecentlyUsedPage) {
   EXPECT_EQ(pager.total().faults, 5u);
   EXPECT_EQ(word(pager, 1, 7), 1007u);  // unannounced read of the evicted page: faults and loads it
   EXPECT_EQ(pager.total().faults, 6u);
+  EXPECT_EQ(pager.total().unannounced, 1u);
   for (std::size_t page = 0; page < kPages; ++page) EXPECT_EQ(word(pager, page, 100), page * 1000 + 100) << page;
+}
+
+// A probe numbers a read's page by its address alone (address >> log2(page_bytes)): that is
+// the pager's page only where the file's range starts on a page boundary. Pages larger than
+// the kernel's are not aligned by mmap itself.
+TEST_P(FilePagerTest, StartsTheFileOnAPageBoundary) {
+  const std::string path = numbered_file("pager_aligned.bin");
+  for (const std::size_t page_bytes : {kPage, std::size_t{1} << 16, std::size_t{1} << 20, std::size_t{1} << 22}) {
+    std::vector<std::unique_ptr<FilePager>> pagers;  // held together, so that each is placed anew
+    for (int copy = 0; copy < 4; ++copy) {
+      pagers.push_back(std::make_unique<FilePager>(path, kPages * kPage, page_bytes, page_bytes, 1, GetParam()));
+      EXPECT_EQ(reinterpret_cast<std::uintptr_t>(pagers.back()->base()) % page_bytes, 0u) << page_bytes;
+      EXPECT_EQ(word(*pagers.back(), kPages - 1, 3), (kPages - 1) * 1000 + 3);  // the last page, by a fault
+    }
+  }
+  std::filesystem::remove(path);
 }
 
 // memory.page_trace: every touch, in order, as the page numbers the file holds; reads the

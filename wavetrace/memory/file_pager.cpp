@@ -158,12 +158,22 @@ FilePager::FilePager(const std::string& path, std::uint64_t file_bytes, std::siz
   slots_ = std::clamp<std::size_t>(budget_bytes / page_bytes, 1, std::max<std::size_t>(pages, 1));
   direct_fd_ = ::open(path.c_str(), O_RDONLY | O_DIRECT | O_CLOEXEC);
   if (direct_fd_ < 0) throw std::runtime_error(fmt::format("{}: cannot open for direct reads: {}", path, std::strerror(errno)));
-  void* range = ::mmap(nullptr, reserved_bytes_, PROT_NONE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
+  // The range starts on a page boundary, so that a page of the file is a page_bytes-aligned
+  // block of addresses: probes find a read's page from its address alone (address >>
+  // log2(page_bytes)), and a probe that numbered pages off the pager's would let reads across
+  // the pager's boundaries go unannounced (18% of room:64M's reads came in by fault so).
+  void* range = ::mmap(nullptr, reserved_bytes_ + page_bytes, PROT_NONE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
   if (range == MAP_FAILED) {
     ::close(direct_fd_);
     throw std::runtime_error(fmt::format("{}: cannot reserve {} bytes of address space", path, reserved_bytes_));
   }
-  base_ = static_cast<std::byte*>(range);
+  const auto start = reinterpret_cast<std::uintptr_t>(range);
+  const std::uintptr_t aligned = (start + page_bytes - 1) & ~std::uintptr_t(page_bytes - 1);
+  if (aligned > start) ::munmap(range, aligned - start);
+  if (const std::size_t tail = page_bytes - (aligned - start); tail > 0) {
+    ::munmap(reinterpret_cast<std::byte*>(aligned) + reserved_bytes_, tail);
+  }
+  base_ = reinterpret_cast<std::byte*>(aligned);
   if (mapping != PageMapping::memfd) {
     std::string reason;
     fault_fd_ = register_missing_pages(base_, reserved_bytes_, reason);
@@ -358,7 +368,8 @@ std::string FilePager::place_page(std::uint32_t page, std::uint32_t slot, const 
   return {};
 }
 
-std::string FilePager::load(std::uint32_t page, std::uint64_t address_offset, std::unique_lock<std::mutex>& lock) {
+std::string FilePager::load(std::uint32_t page, std::uint64_t address_offset, std::unique_lock<std::mutex>& lock,
+                            bool by_fault) {
   std::optional<std::chrono::steady_clock::time_point> waiting_since;
   for (;;) {
     const std::uint32_t state = slot_of_[page].load(std::memory_order_relaxed);
@@ -410,6 +421,7 @@ std::string FilePager::load(std::uint32_t page, std::uint64_t address_offset, st
     if (client_index() == prefetch_client_) prefetched_[page].store(1, std::memory_order_relaxed);
     push_front_locked(page);
     ++counters.faults;
+    if (by_fault) ++counters.unannounced;
     ++part_faults_[client_index() * part_names_.size() + part_of(address_offset)];
     counters.bytes_read += file_bytes_in(page);
     counters.read_seconds += seconds;
@@ -437,7 +449,7 @@ void FilePager::touch(const void* address) {
 bool FilePager::handle_fault(const void* address) noexcept {
   if (!contains(address)) return false;
   std::unique_lock lock(mutex_);
-  const std::string error = load(page_of(address), offset_of(address), lock);
+  const std::string error = load(page_of(address), offset_of(address), lock, /*by_fault=*/true);
   if (!error.empty()) {
     // No exception can leave a signal handler, and the read that faulted cannot go on: say
     // what failed and stop as any failed command does (exit 1). Nothing is written after
@@ -516,6 +528,7 @@ DiskCounters FilePager::total() const {
   DiskCounters sum;
   for (const DiskCounters& c : clients_) {
     sum.faults += c.faults;
+    sum.unannounced += c.unannounced;
     sum.bytes_read += c.bytes_read;
     sum.read_seconds += c.read_seconds;
     sum.wait_seconds += c.wait_seconds;

@@ -25,6 +25,9 @@ class PageTrace;
 
 struct DiskCounters {
   std::uint64_t faults = 0;      // pages read from the file
+  // Of those, pages a read no probe announced brought in: the reader faulted (a signal, in
+  // this pager) where an announced read would have loaded the page first.
+  std::uint64_t unannounced = 0;
   std::uint64_t bytes_read = 0;
   double read_seconds = 0.0;     // measured around the reads
   // Time a reader waited for a page to become resident: its own read and mapping, or another
@@ -129,7 +132,7 @@ class FilePager {
   // return, and released while the page is read, so reads of different pages overlap. A
   // reader of a page being loaded waits for it. Returns an error message, empty on success,
   // so the signal path never throws.
-  std::string load(std::uint32_t page, std::uint64_t offset, std::unique_lock<std::mutex>& lock);
+  std::string load(std::uint32_t page, std::uint64_t offset, std::unique_lock<std::mutex>& lock, bool by_fault = false);
   // load's two steps outside the lock: the page's bytes into a read buffer, then at its address.
   std::string read_page(std::uint32_t page, std::byte* into, double& seconds) const;
   std::string place_page(std::uint32_t page, std::uint32_t slot, const std::byte* into);

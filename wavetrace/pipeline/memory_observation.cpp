@@ -53,6 +53,7 @@ void MemoryObservation::report(std::vector<StageStats>& stages) const {
           // The look-ahead reads for trace: its reads are trace's, read earlier.
           const DiskCounters ahead = file_pager_->counters(kLookAheadClient);
           stage.disk->counters.faults += ahead.faults;
+          stage.disk->counters.unannounced += ahead.unannounced;
           stage.disk->counters.bytes_read += ahead.bytes_read;
           stage.disk->counters.read_seconds += ahead.read_seconds;
           stage.disk->prefetched = ahead.faults;
