@@ -118,11 +118,30 @@ TEST_P(FilePagerTest, StartsTheFileOnAPageBoundary) {
   for (const std::size_t page_bytes : {kPage, std::size_t{1} << 16, std::size_t{1} << 20, std::size_t{1} << 22}) {
     std::vector<std::unique_ptr<FilePager>> pagers;  // held together, so that each is placed anew
     for (int copy = 0; copy < 4; ++copy) {
-      pagers.push_back(std::make_unique<FilePager>(path, kPages * kPage, page_bytes, page_bytes, 1, GetParam()));
+      pagers.push_back(std::make_unique<FilePager>(path, kPages * kPage, page_bytes, 2 * page_bytes, 1, GetParam()));
       EXPECT_EQ(reinterpret_cast<std::uintptr_t>(pagers.back()->base()) % page_bytes, 0u) << page_bytes;
       EXPECT_EQ(word(*pagers.back(), kPages - 1, 3), (kPages - 1) * 1000 + 3);  // the last page, by a fault
     }
   }
+  std::filesystem::remove(path);
+}
+
+// A read across a page boundary needs both pages at once: a pool of one page would evict
+// each half for the other for ever, so a budget under two pages is refused, naming the key,
+// unless the file is one page.
+TEST_P(FilePagerTest, RefusesAPoolOfOnePageForAFileOfMore) {
+  const std::string path = numbered_file("pager_one_slot.bin");
+  try {
+    FilePager pager(path, kPages * kPage, kPage, kPage + kPage / 2, 1, GetParam());
+    ADD_FAILURE() << "a pool of one page was made for a file of " << kPages;
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("memory.budget (6144 bytes) holds fewer than two pages"), std::string::npos)
+        << error.what();
+  }
+  FilePager one_page(path, kPage, kPage, kPage, 1, GetParam());  // a file of one page: one slot is enough
+  EXPECT_EQ(word(one_page, 0, 9), 9u);
+  FilePager two_pages(path, kPages * kPage, kPage, 2 * kPage, 1, GetParam());
+  EXPECT_EQ(word(two_pages, 3, 9), 3009u);
   std::filesystem::remove(path);
 }
 

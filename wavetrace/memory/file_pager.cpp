@@ -154,6 +154,13 @@ FilePager::FilePager(const std::string& path, std::uint64_t file_bytes, std::siz
   page_shift_ = static_cast<unsigned>(std::countr_zero(page_bytes));
   const std::size_t pages = (file_bytes + page_bytes - 1) / page_bytes;
   if (pages >= kNone) throw std::invalid_argument(fmt::format("{}: {} pages of {} bytes is too many", path, pages, page_bytes));
+  // One read may cross a page boundary (a record, or one unaligned load, across two pages):
+  // in a pool of one page each half would evict the other, for ever.
+  if (pages >= 2 && budget_bytes < 2 * page_bytes) {
+    throw std::invalid_argument(fmt::format("{}: memory.budget ({} bytes) holds fewer than two pages (memory.page_bytes "
+                                            "= {}): a read across a page boundary needs both pages resident at once",
+                                            path, budget_bytes, page_bytes));
+  }
   reserved_bytes_ = pages * page_bytes;
   slots_ = std::clamp<std::size_t>(budget_bytes / page_bytes, 1, std::max<std::size_t>(pages, 1));
   direct_fd_ = ::open(path.c_str(), O_RDONLY | O_DIRECT | O_CLOEXEC);

@@ -53,7 +53,7 @@ struct RayWindowCounters {
 class FilePager {
  public:
   // `page_bytes`: a power of two, at least 4096; `budget_bytes` is rounded down to whole
-  // pages, and less than one page is an error naming memory.budget. `clients` counters are kept apart (one per stage that reads), plus
+  // pages, and less than one page (two, for a file of two or more) is an error naming memory.budget. `clients` counters are kept apart (one per stage that reads), plus
   // one for reads outside any client scope (loading). Throws std::runtime_error naming the
   // file when it cannot be opened for direct reads or the address range reserved, and
   // naming memory.page_mapping when `mapping` asks for userfaultfd and the kernel refuses it.

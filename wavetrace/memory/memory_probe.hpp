@@ -23,6 +23,7 @@ struct NullProbe {
   static constexpr bool kRecords = false;
   static constexpr bool counts_reads() { return false; }
   void read(const void*, std::size_t) {}
+  void announce(const void*) {}
 };
 
 // What a run observes: the shared page pool and one simulated cache per thread, each
@@ -79,6 +80,18 @@ class RecordingProbe {
     window_pages_.clear();
     recent_window_pages_.fill(~std::uintptr_t{0});
     last_file_page_ = ~std::uintptr_t{0};  // the next window's first page counts to it
+  }
+
+  // A read about to start whose size only the read itself tells (a leaf record, sized by its
+  // decode): its first page is loaded now, for the real pager alone; the read() that follows
+  // with the size counts it for every observer and announces the page it ends on, if another.
+  void announce(const void* address) {
+    if (file_pager_ == nullptr) return;
+    const auto page = reinterpret_cast<std::uintptr_t>(address) >> file_page_shift_;
+    if (page == last_file_page_) return;
+    file_pager_->touch(address);
+    if (counting_windows_) note_window_page(page);
+    last_file_page_ = page;
   }
 
   void read(const void* address, std::size_t bytes) {

@@ -76,9 +76,10 @@ template <typename Probe>
 [[gnu::always_inline]] inline void prepare_leaf(const std::byte* record, const GlobalGrid& grid, const Box& box,
                                                 LeafTriangles& leaf, Probe& probe) {
   DecodedLeaf& decoded = leaf.decoded;
+  // Its first page announced before the decode reads it, its size reported after, by the
+  // decode that finds it (a record ending on the next page faults that page in).
+  if constexpr (Probe::kRecords) probe.announce(record);
   decode_leaf(record, grid, snap_outward(grid, box), decoded);
-  // Reported after the decode, which has the record's size at hand (a page the decode reads
-  // is loaded by its fault all the same).
   if constexpr (Probe::kRecords) probe.read(record, std::size_t(decoded.end() - record));
 #if WAVETRACE_AVX2
   const StripLayoutEntry& layout = *decoded.layout;
