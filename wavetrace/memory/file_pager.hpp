@@ -25,8 +25,8 @@ class PageTrace;
 
 struct DiskCounters {
   std::uint64_t faults = 0;      // pages read from the file
-  // Of those, pages a read no probe announced brought in: the reader faulted (a signal, in
-  // this pager) where an announced read would have loaded the page first.
+  // Of those, pages brought in by a fault in the read itself (a signal, in this pager): a read
+  // no probe announced, or a page another thread evicted between announcement and read.
   std::uint64_t unannounced = 0;
   std::uint64_t bytes_read = 0;
   double read_seconds = 0.0;     // measured around the reads
@@ -53,7 +53,8 @@ struct RayWindowCounters {
 class FilePager {
  public:
   // `page_bytes`: a power of two, at least 4096; `budget_bytes` is rounded down to whole
-  // pages, and less than one page (two, for a file of two or more) is an error naming memory.budget. `clients` counters are kept apart (one per stage that reads), plus
+  // pages, and less than one page (two, for a file of two or more) is an error naming
+  // memory.budget. `clients` counters are kept apart (one per stage that reads), plus
   // one for reads outside any client scope (loading). Throws std::runtime_error naming the
   // file when it cannot be opened for direct reads or the address range reserved, and
   // naming memory.page_mapping when `mapping` asks for userfaultfd and the kernel refuses it.

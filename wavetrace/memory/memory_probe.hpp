@@ -88,9 +88,7 @@ class RecordingProbe {
   void announce(const void* address) {
     if (file_pager_ == nullptr) return;
     const auto page = reinterpret_cast<std::uintptr_t>(address) >> file_page_shift_;
-    if (page == last_file_page_) return;
-    file_pager_->touch(address);
-    if (counting_windows_) note_window_page(page);
+    if (page != last_file_page_) touch_file_page(address, page);
     last_file_page_ = page;
   }
 
@@ -101,14 +99,8 @@ class RecordingProbe {
       // The page is loaded now, before the read it announces; a page change is a touch.
       const auto first = reinterpret_cast<std::uintptr_t>(address) >> file_page_shift_;
       const auto last = (reinterpret_cast<std::uintptr_t>(address) + bytes - 1) >> file_page_shift_;
-      if (first != last_file_page_) {
-        file_pager_->touch(address);
-        if (counting_windows_) note_window_page(first);
-      }
-      if (last != first) {
-        file_pager_->touch(static_cast<const std::byte*>(address) + bytes - 1);
-        if (counting_windows_) note_window_page(last);
-      }
+      if (first != last_file_page_) touch_file_page(address, first);
+      if (last != first) touch_file_page(static_cast<const std::byte*>(address) + bytes - 1, last);
       last_file_page_ = last;
     }
     if (pager_ == nullptr) return;
@@ -119,6 +111,12 @@ class RecordingProbe {
   }
 
  private:
+  // The real pager loads `page` (holding `address`) or marks it recently used.
+  void touch_file_page(const void* address, std::uintptr_t page) {
+    file_pager_->touch(address);
+    if (counting_windows_) note_window_page(page);
+  }
+
   // A walk turns among a few pages (its nodes', its leaves', its vertices'): a page among the
   // last few noted is not kept again, so the window's sort sees tens of pages, not thousands.
   void note_window_page(std::uintptr_t page) {
