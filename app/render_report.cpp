@@ -159,8 +159,12 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
   nlohmann::json render = {{"seconds", facts.output.run.seconds}, {"threads", facts.output.run.threads}};
   render["stages"] = facts.plan.stages;
   render["mode"] = to_string(facts.plan.pipeline.mode);
+  // The camera pass's, with photons; batches: the pool's high-water mark, each of
+  // render.batch_size rays with their hits.
   render["rays_in_memory"] = {{"budget", facts.plan.pipeline.rays_in_flight},
-                              {"peak", facts.output.run.peak_rays_in_core}};  // the camera pass's, with photons
+                              {"peak", facts.output.run.peak_rays_in_core},
+                              {"batches", facts.output.run.batches_allocated},
+                              {"batch_rays", facts.plan.pipeline.batch_size}};
   render["reorder"] = {{"heuristic", to_string(facts.plan.reorder.heuristic)},
                        {"curve", to_string(facts.plan.reorder.curve)},
                        {"buffer_rays", facts.plan.reorder.buffer_rays},
@@ -250,6 +254,7 @@ nlohmann::json distribute_json(const DistributedRender& render, const RenderPlan
       ranks.back()["load_peak_resident_bytes"] = rank.load_peak_resident_bytes;
       ranks.back()["exchange"] = {{"chunks_owned", traffic.chunks_owned},
                                   {"triangles_owned", traffic.triangles_owned},
+                                  {"bytes_owned", traffic.bytes_owned},
                                   {"chunks_copied", traffic.chunks_copied},
                                   {"triangles_copied", traffic.triangles_copied},
                                   {"queries_sent", traffic.queries_sent},
@@ -350,11 +355,12 @@ std::string render_table(const RenderFacts& facts) {
                            rank.wait_seconds, double(rank.peak_resident_bytes) * 1e-9);
       if (facts.plan.distribute.mode == DistributeMode::data) {
         const ChunkTraffic& traffic = rank.traffic;
-        table += fmt::format("    owns {} chunks ({} triangles) and answers {} of others' itself ({} triangles); sent {} "
+        table += fmt::format("    owns {} chunks ({} triangles, {:.1f} MB) and answers {} of others' itself ({} triangles); sent {} "
                              "rays in {} queries ({:.1f} MB with the answers it gave), answered {} rays of others' in {} "
                              "queries; its rounds waited {:.3f} s for answers ({} of them suspended, the thread tracing on); {:.2f} GB resident at most while loading (every "
                              "chunk checked)\n",
-                             traffic.chunks_owned, traffic.triangles_owned, traffic.chunks_copied,
+                             traffic.chunks_owned, traffic.triangles_owned, double(traffic.bytes_owned) * 1e-6,
+                             traffic.chunks_copied,
                              traffic.triangles_copied, traffic.rays_sent, traffic.queries_sent,
                              double(traffic.bytes_sent) * 1e-6, traffic.rays_answered, traffic.queries_answered,
                              traffic.wait_seconds, traffic.rounds_suspended, double(rank.load_peak_resident_bytes) * 1e-9);

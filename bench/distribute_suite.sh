@@ -28,7 +28,7 @@ for repeat in $(seq 1 "${REPEAT:-3}"); do
     else
       mpirun --oversubscribe -np "$ranks" "$wavetrace" "${common[@]}" --threads "$threads" \
           --set "distribute.mode=$mode" --set "distribute.replicate=${share:-0}" \
-          --set "distribute.balance=${balance:-triangles}" \
+          --set "distribute.balance=${balance:-bytes}" \
           --out "$name.exr" --stats "$name.json" > "$name.txt" 2>&1
     fi
   done

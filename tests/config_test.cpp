@@ -98,7 +98,7 @@ TEST(Config, DistributeKeysNameTheirBadValues) {
   expect_config_error([&] { config.set("distribute.replicate=nan"); }, "distribute.replicate = nan is out of range");
   expect_config_error([&] { config.set("distribute.replicate=most"); }, "distribute.replicate");
   expect_config_error([&] { config.set("distribute.balance=work"); },
-                      "distribute.balance = 'work' is not one of: triangles, rays");
+                      "distribute.balance = 'work' is not one of: bytes, triangles, rays");
   expect_config_error([&] { config.set("distribute.mode=mesh"); }, "distribute.mode = 'mesh' is not one of: image, data");
   expect_config_error([&] { config.set("distribute.range_rays=-5"); }, "distribute.range_rays = -5 is out of range");
   config.set("distribute.replicate=0.25");

@@ -219,6 +219,80 @@ TEST(ZSort, EmitsEveryRayOnceInKeyOrderWithShadowRaysLast) {
   EXPECT_EQ(pixels.size(), 250u);
 }
 
+// A flush sorts the held batches' rays in place: every column (but the approximate hit,
+// which only made the key) travels with its ray, the first held batches come out full and
+// the rest go back to the pool, and no batch is taken from it (a second set of batches was
+// a flush's peak). Arrivals of uneven counts make the places in and out differ.
+TEST(ZSort, SortsInPlaceEveryColumnWithItsRay) {
+  BatchPool pool(100);
+  Bounds3 box;
+  box.extend(glm::vec3(-1.0f));
+  box.extend(glm::vec3(1.0f));
+  ZSortOptions options;
+  options.heuristic = ReorderHeuristic::origin_dir;
+  options.curve = CurveKind::hilbert;
+  options.buffer_rays = 100000;
+  const ZSortStage zsort(options, box);
+  std::uint32_t pixel = 0;
+  std::vector<Batch*> arrivals;
+  for (std::size_t count : {37, 100, 5, 64, 90, 1}) {
+    Batch* batch = pool.acquire();
+    for (std::size_t i = 0; i < count; ++i, ++pixel) {
+      const UnitPair xy = unit_pair(random_bits(pixel, 0, 0, RandomPurpose::benchmark));
+      const UnitPair zd = unit_pair(random_bits(pixel, 0, 1, RandomPurpose::benchmark));
+      batch->rays.set_geometry(i, glm::vec3(xy.first, xy.second, zd.first) * 2.0f - 1.0f,
+                               glm::normalize(glm::vec3(zd.second - 0.5f, xy.first - 0.5f, 0.3f)), 0.5f * pixel,
+                               1000.0f + pixel);
+      batch->rays.pixel[i] = pixel;
+      batch->rays.sample[i] = 3 * pixel + 1;
+      batch->rays.depth[i] = std::uint16_t(pixel % 9);
+      batch->rays.kind[i] = RayKind(pixel % 4);
+      batch->rays.throughput_r[i] = 0.25f * pixel;
+      batch->rays.throughput_g[i] = 0.5f * pixel;
+      batch->rays.throughput_b[i] = 2.0f * pixel;
+      batch->rays.flags[i] = std::uint8_t(ray_flags::alive | (pixel % 2 ? ray_flags::continues : 0));
+    }
+    batch->rays.count = count;
+    arrivals.push_back(batch);
+    zsort.buffer(batch);
+  }
+  const std::uint32_t rays = pixel;
+  const std::size_t batches_before = pool.allocated();
+  CollectingOutput out(pool);
+  ASSERT_EQ(zsort.flush(out), rays);
+  EXPECT_EQ(pool.allocated(), batches_before);
+  ASSERT_EQ(out.emitted.size(), 3u);  // 297 rays in batches of 100
+  EXPECT_EQ(out.released, arrivals.size() - 3);
+  std::set<std::uint32_t> pixels;
+  std::uint64_t previous = 0;
+  for (std::size_t b = 0; b < out.emitted.size(); ++b) {
+    const RayBatch& sorted = out.emitted[b]->rays;
+    EXPECT_EQ(out.emitted[b], arrivals[b]);
+    EXPECT_EQ(sorted.count, b + 1 < out.emitted.size() ? 100u : rays - 200u);
+    for (std::size_t i = 0; i < sorted.count; ++i) {
+      const std::uint32_t p = sorted.pixel[i];
+      EXPECT_GE(sorted.sort_key[i], previous);
+      previous = sorted.sort_key[i];
+      const UnitPair xy = unit_pair(random_bits(p, 0, 0, RandomPurpose::benchmark));
+      const UnitPair zd = unit_pair(random_bits(p, 0, 1, RandomPurpose::benchmark));
+      EXPECT_EQ(sorted.origin_x[i], xy.first * 2.0f - 1.0f);
+      EXPECT_EQ(sorted.origin_z[i], zd.first * 2.0f - 1.0f);
+      EXPECT_EQ(sorted.direction_x[i], glm::normalize(glm::vec3(zd.second - 0.5f, xy.first - 0.5f, 0.3f)).x);
+      EXPECT_EQ(sorted.tmin[i], 0.5f * p);
+      EXPECT_EQ(sorted.tmax[i], 1000.0f + p);
+      EXPECT_EQ(sorted.sample[i], 3 * p + 1);
+      EXPECT_EQ(sorted.depth[i], p % 9);
+      EXPECT_EQ(sorted.kind[i], RayKind(p % 4));
+      EXPECT_EQ(sorted.throughput_r[i], 0.25f * p);
+      EXPECT_EQ(sorted.throughput_g[i], 0.5f * p);
+      EXPECT_EQ(sorted.throughput_b[i], 2.0f * p);
+      EXPECT_EQ(sorted.flags[i], std::uint8_t(ray_flags::alive | (p % 2 ? ray_flags::continues : 0)));
+      pixels.insert(p);
+    }
+  }
+  EXPECT_EQ(pixels.size(), rays);
+}
+
 // `ray_count` bounce rays in batches of 100 (in pixel order; the pool's batches must hold
 // 100), scattered over the box [-1, 1]^3 in origin, direction and approximate hit.
 std::vector<Batch*> scattered_arrivals(BatchPool& pool, std::uint32_t ray_count) {

@@ -4,6 +4,8 @@
 // in answers when no worker does. So no rank waits on one that cannot move.
 #include "wavetrace/distribute/chunk_exchange.hpp"
 
+#include "wavetrace/distribute/chunk_deal.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -153,21 +155,16 @@ ChunkExchange::ChunkExchange(const MpiSession& session, ChunkSet& chunks, const 
     triangles += chunks.chunk_triangles(c);
     if (needs_rays) rays += sharing.rays_due[c];
   }
-  // A probe that met nothing cannot weigh the chunks: triangles do.
-  const bool by_rays = sharing.balance == DistributeBalance::rays && rays > 0;
-  const auto weight = [&](std::size_t c) {
-    return by_rays ? sharing.rays_due[c] : std::uint64_t(chunks.chunk_triangles(c));
-  };
-  const std::uint64_t total = by_rays ? rays : triangles;
-  // Rank r owns the chunks whose weight's middle falls in [r, r + 1) * total / ranks: runs of
-  // about equal weight, every rank at least one chunk where there are enough.
-  std::uint64_t before = 0;
-  for (std::size_t c = 0; c < chunks.chunk_count(); ++c) {
-    const std::uint64_t middle = before + weight(c) / 2;
-    owner_[c] = static_cast<int>(std::min<std::uint64_t>(std::uint64_t(session.ranks()) * middle / std::max<std::uint64_t>(total, 1),
-                                                         std::uint64_t(session.ranks() - 1)));
-    before += weight(c);
+  // A probe that met nothing cannot weigh the chunks: their structures' bytes do.
+  const DistributeBalance balance =
+      sharing.balance == DistributeBalance::rays && rays == 0 ? DistributeBalance::bytes : sharing.balance;
+  std::vector<std::uint64_t> weights(chunks.chunk_count());
+  for (std::size_t c = 0; c < weights.size(); ++c) {
+    weights[c] = balance == DistributeBalance::rays        ? sharing.rays_due[c]
+                 : balance == DistributeBalance::triangles ? std::uint64_t(chunks.chunk_triangles(c))
+                                                           : std::uint64_t(chunks.chunk_bytes(c));
   }
+  owner_ = deal_chunk_runs(weights, session.ranks());
   if (sharing.replicate > 0.0) {
     // The most rays a triangle first: the traffic a copy saves for the memory it costs. Ties in chunk order.
     const std::vector<std::uint64_t>& rays_due = sharing.rays_due;
@@ -491,6 +488,7 @@ ChunkTraffic ChunkExchange::traffic() const {
     if (owner_[c] == session_.rank()) {
       ++traffic.chunks_owned;
       traffic.triangles_owned += chunks_.chunk_triangles(c);
+      traffic.bytes_owned += chunks_.chunk_bytes(c);
     } else if (replicated_[c]) {
       ++traffic.chunks_copied;
       traffic.triangles_copied += chunks_.chunk_triangles(c);

@@ -18,7 +18,7 @@ namespace wavetrace {
 
 // What one rank's exchange did.
 struct ChunkTraffic {
-  std::uint64_t chunks_owned = 0, triangles_owned = 0;
+  std::uint64_t chunks_owned = 0, triangles_owned = 0, bytes_owned = 0;  // bytes: the owned chunks' structures
   std::uint64_t chunks_copied = 0, triangles_copied = 0;  // others' chunks it answers itself (distribute.replicate)
   std::uint64_t queries_sent = 0, rays_sent = 0, bytes_sent = 0;  // its rounds' rays to owners, and their answers back
   std::uint64_t queries_answered = 0, rays_answered = 0;          // others' rays it answered
@@ -31,8 +31,9 @@ struct ChunkTraffic {
 // How the ranks share a chunked world's chunks.
 struct ChunkSharing {
   // Runs of consecutive chunks (chunks follow the scene's order, so a run is a region) are
-  // dealt about equal in triangles (memory) or in `rays_due` (work).
-  DistributeBalance balance = DistributeBalance::triangles;
+  // dealt with the heaviest as light as it can be, weighed in structure bytes (a rank's
+  // memory), triangles or `rays_due` (work): chunk_deal.hpp.
+  DistributeBalance balance = DistributeBalance::bytes;
   // This share of the world's triangles, the chunks with the most `rays_due` a triangle first,
   // is answered by every rank itself.
   double replicate = 0.0;

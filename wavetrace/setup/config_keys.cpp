@@ -504,8 +504,9 @@ const std::vector<ConfigKey>& config_schema() {
        "data mode: the share of the world's triangles every rank answers itself instead of asking their owner: "
        "the chunks a probe of the view (a coarse image's camera rays and a bounce) asks most a triangle first",
        real<&P::distribute, &DistributePlan::replicate>},
-      {"distribute.balance", T::text, std::string("triangles"), 0, 0, {"triangles", "rays"},
-       "data mode: the ranks' runs of chunks are equal in triangles (memory) or in the rays a probe of the view "
+      {"distribute.balance", T::text, std::string("bytes"), 0, 0, {"bytes", "triangles", "rays"},
+       "data mode: what the ranks' runs of chunks are weighed by, the heaviest run made as light as it can be: "
+       "the bytes of the chunks' structures (a rank's memory), their triangles, or the rays a probe of the view "
        "(a coarse image's camera rays and a bounce) asks of them (work)",
        choice<parse_distribute_balance, &P::distribute, &DistributePlan::balance>},
   };

@@ -31,11 +31,19 @@ DistributeMode parse_distribute_mode(const std::string& text) {
 std::string to_string(DistributeMode mode) { return mode == DistributeMode::image ? "image" : "data"; }
 
 DistributeBalance parse_distribute_balance(const std::string& text) {
+  if (text == "bytes") return DistributeBalance::bytes;
   if (text == "triangles") return DistributeBalance::triangles;
   if (text == "rays") return DistributeBalance::rays;
-  throw std::invalid_argument("unknown distribute balance '" + text + "' (triangles, rays)");
+  throw std::invalid_argument("unknown distribute balance '" + text + "' (bytes, triangles, rays)");
 }
 
-std::string to_string(DistributeBalance balance) { return balance == DistributeBalance::triangles ? "triangles" : "rays"; }
+std::string to_string(DistributeBalance balance) {
+  switch (balance) {
+    case DistributeBalance::bytes: return "bytes";
+    case DistributeBalance::triangles: return "triangles";
+    case DistributeBalance::rays: return "rays";
+  }
+  return "bytes";
+}
 
 }  // namespace wavetrace

@@ -36,14 +36,14 @@ enum class DistributeMode { image, data };
 DistributeMode parse_distribute_mode(const std::string& text);
 std::string to_string(DistributeMode mode);
 // Data mode deals runs of chunks equal in triangles (memory) or in a probe's rays (work).
-enum class DistributeBalance { triangles, rays };
+enum class DistributeBalance { bytes, triangles, rays };
 DistributeBalance parse_distribute_balance(const std::string& text);
 std::string to_string(DistributeBalance balance);
 struct DistributePlan {
   DistributeMode mode = DistributeMode::image;
   std::uint64_t range_rays = 0;  // camera rays handed out at a time (0: chosen from the image and ranks)
   double replicate = 0.0;        // data mode: share of the triangles every rank answers itself
-  DistributeBalance balance = DistributeBalance::triangles;  // data mode: what the ranks' chunks are equal in
+  DistributeBalance balance = DistributeBalance::bytes;  // data mode: what the ranks' chunks are weighed by
   bool operator==(const DistributePlan&) const = default;
 };
 

@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include <tbb/enumerable_thread_specific.h>
+
 #include "wavetrace/memory/cache_aligned_allocator.hpp"
 #include "wavetrace/memory/ray_spill.hpp"
 #include "wavetrace/stages/buffering_stage.hpp"
@@ -87,9 +89,20 @@ class ZSortStage final : public BufferingStage {
   const ZSortOptions& options() const { return options_; }
 
  private:
-  // The held batches' rays in key order, in batches acquired from `out` (the held ones
-  // released); arrival order among equal keys.
+  // The held batches' rays in key order, in the first of the held batches (full; the others
+  // released to `out`); arrival order among equal keys.
   std::vector<Batch*> sort_held(StageOutput& out) const;
+  // The held batches' ray columns, column-major (columns[column * batches + batch]).
+  struct ColumnTable {
+    std::size_t batches = 0, capacity = 0;
+    int ray_bits = 0;       // from_'s packing: batch << ray_bits | ray
+    std::size_t total = 0;  // rays held
+    std::vector<std::size_t> element_bytes;
+    std::vector<void*> columns;
+  };
+  // Column `column` of the held rays in from_'s order, written into the first held batches.
+  template <typename T>
+  void gather_column(const ColumnTable& table, std::size_t column, std::byte* scratch) const;
   // Writes the in-core part, sorted, as one more run of the next generation.
   void spill_held(StageOutput& out) const;
   struct Merge;  // the runs of the generation being drained, merged by (key, run)
@@ -100,6 +113,10 @@ class ZSortStage final : public BufferingStage {
   mutable std::vector<Batch*> held_;
   mutable std::size_t held_rays_ = 0;
   mutable LargeArray<SortEntry> entries_, scratch_;  // kept across flushes, on huge pages: few page faults
+  // A thread's ray column in key order, kept across flushes: bytes, storage for values of any
+  // column's type (8 bytes at most).
+  mutable tbb::enumerable_thread_specific<UnfilledLargeArray<std::byte>> column_;
+  mutable UnfilledLargeArray<std::uint32_t> from_;  // the held ray each place in key order takes, packed
   mutable std::atomic<std::size_t> buffered_rays_{0}, spilled_rays_{0};
   mutable std::atomic<bool> draining_{false};
   mutable std::vector<std::unique_ptr<SpillRun>> runs_;  // the next generation's

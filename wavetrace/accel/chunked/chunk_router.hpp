@@ -42,6 +42,7 @@ class ChunkSet {
   virtual ~ChunkSet() = default;
   virtual std::size_t chunk_count() const = 0;
   virtual std::size_t chunk_triangles(std::size_t chunk) const = 0;
+  virtual std::size_t chunk_bytes(std::size_t chunk) const = 0;  // its structure's (MemoryReport::total)
   // Rays [range) of `rays` against chunk `chunk` alone, as a round would ask it.
   virtual void query_chunk(std::size_t chunk, ChunkQuery query, const RayBatch& rays, HitBatch& hits,
                            RayRange range) const = 0;

@@ -304,6 +304,7 @@ class ChunkedAccelerator final : public Accelerator, public ChunkSet {
   ChunkSet* chunk_set() override { return this; }
   std::size_t chunk_count() const override { return chunks_.size(); }
   std::size_t chunk_triangles(std::size_t chunk) const override { return chunks_[chunk].count; }
+  std::size_t chunk_bytes(std::size_t chunk) const override { return chunks_[chunk].memory.total(); }
   void query_chunk(std::size_t chunk, ChunkQuery query, const RayBatch& rays, HitBatch& hits,
                    RayRange range) const override {
     const Accelerator& sub = *chunks_[chunk].accelerator;
