@@ -206,8 +206,11 @@ ChunkExchange::~ChunkExchange() {
 
 void ChunkExchange::poll_until_stopped() {
   // A short sleep when nothing came: the poller shares the cores with the workers, and an
-  // answer waits at most this long when no worker looks.
-  constexpr auto kIdle = std::chrono::microseconds(20);
+  // answer waits at most this long when no worker looks. 100 us rather than 20: each wake is
+  // a system call and a switch that a rank's one worker pays for (two ranks of one thread on
+  // room:64M, 7.5-7.9 s against 8.2-8.5; 200 us no faster; four ranks, or two of two
+  // threads, the same either way: distributed.md, "The poller's sleep").
+  constexpr auto kIdle = std::chrono::microseconds(100);
   try {
     while (!stop_polling_.load(std::memory_order_acquire)) {
       bool worked = receive_one_answer();
