@@ -175,11 +175,17 @@ TEST(Proxy, StochasticPruningKeepsItsShareAndTheExpectedArea) {
 
 using testing::CollectingOutput;
 
-TEST(ZSort, EmitsEveryRayOnceInKeyOrderWithShadowRaysLast) {
-  BatchPool pool(64);
+// [-1, 1]^3: the box the zsort tests' rays are scattered over.
+Bounds3 cube_around_origin() {
   Bounds3 box;
   box.extend(glm::vec3(-1.0f));
   box.extend(glm::vec3(1.0f));
+  return box;
+}
+
+TEST(ZSort, EmitsEveryRayOnceInKeyOrderWithShadowRaysLast) {
+  BatchPool pool(64);
+  const Bounds3 box = cube_around_origin();
   ZSortOptions options;
   options.heuristic = ReorderHeuristic::origin;
   options.curve = CurveKind::hilbert;
@@ -225,9 +231,7 @@ TEST(ZSort, EmitsEveryRayOnceInKeyOrderWithShadowRaysLast) {
 // a flush's peak). Arrivals of uneven counts make the places in and out differ.
 TEST(ZSort, SortsInPlaceEveryColumnWithItsRay) {
   BatchPool pool(100);
-  Bounds3 box;
-  box.extend(glm::vec3(-1.0f));
-  box.extend(glm::vec3(1.0f));
+  const Bounds3 box = cube_around_origin();
   ZSortOptions options;
   options.heuristic = ReorderHeuristic::origin_dir;
   options.curve = CurveKind::hilbert;
@@ -322,9 +326,7 @@ std::vector<Batch*> scattered_arrivals(BatchPool& pool, std::uint32_t ray_count)
 // and emits them in non-decreasing key order: the image tests above cannot tell a sort that
 // does nothing from one that works.
 TEST(ZSort, EveryHeuristicReordersWhatNoneKeepsInArrivalOrder) {
-  Bounds3 box;
-  box.extend(glm::vec3(-1.0f));
-  box.extend(glm::vec3(1.0f));
+  const Bounds3 box = cube_around_origin();
   constexpr std::uint32_t kRays = 400;
   const auto arrivals = [](BatchPool& pool) { return scattered_arrivals(pool, kRays); };
   std::map<std::string, std::vector<std::uint32_t>> orders;
@@ -370,9 +372,7 @@ TEST(ZSort, EveryHeuristicReordersWhatNoneKeepsInArrivalOrder) {
 // The disk buffer's runs merge into the order one in-core sort of the whole generation
 // gives, every column travelling with its ray, for a hit-point heuristic as for origin.
 TEST(ZSort, DiskRunsMergeIntoTheOrderOfOneInCoreSort) {
-  Bounds3 box;
-  box.extend(glm::vec3(-1.0f));
-  box.extend(glm::vec3(1.0f));
+  const Bounds3 box = cube_around_origin();
   const auto order = [](const CollectingOutput& out) {
     std::vector<std::uint32_t> pixels;
     for (const Batch* batch : out.emitted) {
@@ -420,9 +420,7 @@ TEST(ZSort, DiskRunsMergeIntoTheOrderOfOneInCoreSort) {
 // A ray's key is its curve's index of the cell its point falls in (origin for `origin`,
 // approximate hit for `hph`, 20 bits per axis), with bit 63 set for shadow rays.
 TEST(ReorderKeys, AreTheCurveIndexOfTheQuantizedPoint) {
-  Bounds3 box;
-  box.extend(glm::vec3(-1.0f));
-  box.extend(glm::vec3(1.0f));
+  const Bounds3 box = cube_around_origin();
   const std::vector<std::array<std::uint32_t, 3>> cells = {{3, 1000, 77}, {524287, 0, 1048575}, {1048575, 1, 65536}};
   RayBatch rays(4);
   rays.enable_approx_hit();
@@ -454,9 +452,7 @@ TEST(ReorderKeys, AreTheCurveIndexOfTheQuantizedPoint) {
 // Hilbert keys are made eight rays at a time: a batch of 13 (a full block and a tail) keys
 // every ray as a batch of one ray keys it, for every heuristic.
 TEST(ReorderKeys, HilbertKeysInBlocksEqualKeysRayByRay) {
-  Bounds3 box;
-  box.extend(glm::vec3(-1.0f));
-  box.extend(glm::vec3(1.0f));
+  const Bounds3 box = cube_around_origin();
   std::mt19937 random(11);
   std::uniform_real_distribution<float> coordinate(-1.0f, 1.0f);
   RayBatch rays(16), one(1);
