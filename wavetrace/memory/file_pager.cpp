@@ -283,7 +283,7 @@ void FilePager::evict_tail_locked(std::size_t count) {
   bool dropped = false;
   if (taken > 1 && self_pidfd_ >= 0) {
     std::array<iovec, kMaxEvictionGroup> ranges;
-    for (std::size_t v = 0; v < taken; ++v) ranges[v] = {base_ + (std::size_t(victims[v]) << page_shift_), page_bytes_};
+    for (std::size_t v = 0; v < taken; ++v) ranges[v] = {base_ + offset_of_page(victims[v]), page_bytes_};
     const long advised = ::syscall(SYS_process_madvise, self_pidfd_, ranges.data(), taken, MADV_DONTNEED, 0);
     dropped = advised == long(taken * page_bytes_);
     if (advised < 0) {
@@ -294,7 +294,7 @@ void FilePager::evict_tail_locked(std::size_t count) {
   for (std::size_t v = 0; v < taken; ++v) {
     const std::uint32_t page = victims[v];
     // From here a reader of this page faults and waits for the mutex; its slot is free again.
-    std::byte* place = base_ + (std::size_t(page) << page_shift_);
+    std::byte* place = base_ + offset_of_page(page);
     if (fault_fd_ < 0) {
       reserve_range(place, page_bytes_);
     } else if (!dropped) {
@@ -311,7 +311,7 @@ void FilePager::evict_tail_locked(std::size_t count) {
 // Reads page `page` of the file into `into` (page_bytes_, zero past the file's end), timing
 // the read. The caller holds no lock.
 std::string FilePager::read_page(std::uint32_t page, std::byte* into, double& seconds) const {
-  const std::uint64_t offset = std::uint64_t(page) << page_shift_;
+  const std::uint64_t offset = offset_of_page(page);
   const std::size_t bytes = file_bytes_in(page);
   // O_DIRECT wants whole blocks: read the page's full size (a section file's size is a
   // multiple of 4096, so the read ends at or before the file's end on a block boundary).
@@ -336,7 +336,7 @@ std::string FilePager::read_page(std::uint32_t page, std::byte* into, double& se
 // Makes the page read into `into` appear at its address, by the mapping in use. The caller
 // holds no lock: the page is marked loading, so no other thread places or evicts it.
 std::string FilePager::place_page(std::uint32_t page, std::uint32_t slot, const std::byte* into) {
-  const std::uint64_t offset = std::uint64_t(page) << page_shift_;
+  const std::uint64_t offset = offset_of_page(page);
   if (fault_fd_ >= 0) {
     // Copied in 4 KiB at a time, each mapped once whole: a reader sees the file's bytes or
     // faults on a part not yet in, and waits for this read.
@@ -407,7 +407,7 @@ std::string FilePager::load(std::uint32_t page, std::uint64_t address_offset, st
   reads_in_flight_max_ = std::max(reads_in_flight_max_, ++reads_in_flight_);
   lock.unlock();
 
-  const std::uint64_t offset = std::uint64_t(page) << page_shift_;
+  const std::uint64_t offset = offset_of_page(page);
   std::byte* into = read_buffer.at_least(page_bytes_);
   double seconds = 0.0;
   std::string error = into == nullptr

@@ -137,9 +137,11 @@ class FilePager {
   // load's two steps outside the lock: the page's bytes into a read buffer, then at its address.
   std::string read_page(std::uint32_t page, std::byte* into, double& seconds) const;
   std::string place_page(std::uint32_t page, std::uint32_t slot, const std::byte* into);
+  // Where `page` starts, in the file and from base_ (the file starts on a page boundary).
+  std::uint64_t offset_of_page(std::uint32_t page) const { return std::uint64_t(page) << page_shift_; }
   // The file's bytes in `page`: page_bytes_ but for the last page.
   std::size_t file_bytes_in(std::uint32_t page) const {
-    return static_cast<std::size_t>(std::min<std::uint64_t>(page_bytes_, file_bytes_ - (std::uint64_t(page) << page_shift_)));
+    return static_cast<std::size_t>(std::min<std::uint64_t>(page_bytes_, file_bytes_ - offset_of_page(page)));
   }
   // The part of the file holding byte `offset`.
   std::uint32_t part_of(std::uint64_t offset) const;

@@ -78,8 +78,8 @@ class RecordingProbe {
       ++windows_.windows;
     }
     window_pages_.clear();
-    recent_window_pages_.fill(~std::uintptr_t{0});
-    last_file_page_ = ~std::uintptr_t{0};  // the next window's first page counts to it
+    recent_window_pages_ = filled_with_no_page();
+    last_file_page_ = kNoFilePage;  // the next window's first page counts to it
   }
 
   // A read about to start whose size only the read itself tells (a leaf record, sized by its
@@ -137,9 +137,10 @@ class RecordingProbe {
     last_page_ = page;
   }
 
+  static constexpr std::uintptr_t kNoFilePage = ~std::uintptr_t{0};  // no address's page number
   static std::array<std::uintptr_t, 16> filled_with_no_page() {
     std::array<std::uintptr_t, 16> pages;
-    pages.fill(~std::uintptr_t{0});
+    pages.fill(kNoFilePage);
     return pages;
   }
 
@@ -150,7 +151,7 @@ class RecordingProbe {
   std::size_t client_;
   std::size_t thread_;
   unsigned file_page_shift_ = 0;
-  std::uintptr_t last_file_page_ = ~std::uintptr_t{0};
+  std::uintptr_t last_file_page_ = kNoFilePage;
   std::optional<FilePager::ClientScope> client_scope_;
   std::vector<std::uintptr_t> window_pages_;  // file pages touched in this window, with repeats
   std::array<std::uintptr_t, 16> recent_window_pages_ = filled_with_no_page();
