@@ -96,7 +96,7 @@ class ChunkExchange final : public ChunkRouter {
   mutable std::vector<Outgoing*> outbox_;
   mutable std::atomic<std::uint64_t> queries_sent_{0}, rays_sent_{0}, bytes_sent_{0};
   mutable std::atomic<std::uint64_t> queries_answered_{0}, rays_answered_{0};
-  mutable std::atomic<std::uint64_t> wait_nanoseconds_{0}, rounds_suspended_{0}, rounds_suspended_now_{0};
+  mutable std::atomic<std::uint64_t> wait_nanoseconds_{0}, rounds_suspended_{0}, rounds_awaiting_answers_{0};
   // Rounds waiting for answers, by the reply tag their queries carry (each round its own).
   mutable std::mutex waiters_mutex_;
   mutable std::unordered_map<int, Waiter*> waiters_;
