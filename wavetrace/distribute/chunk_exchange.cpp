@@ -4,8 +4,6 @@
 // in answers when no worker does. So no rank waits on one that cannot move.
 #include "wavetrace/distribute/chunk_exchange.hpp"
 
-#include "wavetrace/distribute/chunk_deal.hpp"
-
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -22,6 +20,8 @@
 #if WAVETRACE_HAVE_MPI
 #include <mpi.h>
 #endif
+
+#include "wavetrace/distribute/chunk_deal.hpp"
 
 namespace wavetrace {
 namespace {

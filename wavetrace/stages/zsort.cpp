@@ -5,9 +5,9 @@
 
 #include <bit>
 #include <chrono>
-#include <limits>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <queue>
 #include <stdexcept>
 
