@@ -158,6 +158,7 @@ TEST(Distribute, DataModeOnTwoAndThreeRanksIsTheSingleProcessImage) {
   const auto single = testing::run_wavetrace(arguments + "--threads 2 --out " + alone);
   ASSERT_EQ(single.exit_code, 0) << single.output;
   // Several threads a rank: several rounds in flight, and answers found by their own thread.
+  std::uint64_t world_bytes = 0;
   for (const auto& [ranks, threads] : {std::pair{2, 1}, std::pair{3, 1}, std::pair{2, 3}}) {
     const std::string image = testing::write_temp_file(fmt::format("data_{}x{}.exr", ranks, threads), "");
     const std::string stats = testing::write_temp_file(fmt::format("data_{}x{}.json", ranks, threads), "");
@@ -169,17 +170,22 @@ TEST(Distribute, DataModeOnTwoAndThreeRanksIsTheSingleProcessImage) {
     const nlohmann::json report = nlohmann::json::parse(std::ifstream(stats))["distribute"];
     EXPECT_EQ(report["mode"], "data");
     ASSERT_EQ(report["per_rank"].size(), std::size_t(ranks));
-    std::uint64_t chunks = 0, triangles = 0, sent = 0, answered = 0;
+    EXPECT_EQ(report["balance"], "bytes");  // the default: runs weighed by their structures' bytes
+    std::uint64_t chunks = 0, triangles = 0, bytes = 0, sent = 0, answered = 0;
     for (const nlohmann::json& rank : report["per_rank"]) {
       const nlohmann::json& exchange = rank["exchange"];
       EXPECT_GT(exchange["chunks_owned"].get<std::uint64_t>(), 0u) << rank.dump();
       chunks += exchange["chunks_owned"].get<std::uint64_t>();
       triangles += exchange["triangles_owned"].get<std::uint64_t>();
+      bytes += exchange["bytes_owned"].get<std::uint64_t>();
       sent += exchange["rays_sent"].get<std::uint64_t>();
       answered += exchange["rays_answered"].get<std::uint64_t>();
     }
     EXPECT_EQ(chunks, 18u);  // the room's objects and parts, each cut every 2,048 triangles
     EXPECT_EQ(triangles, 20472u);
+    if (world_bytes == 0) world_bytes = bytes;
+    EXPECT_GT(bytes, 0u);
+    EXPECT_EQ(bytes, world_bytes);  // every chunk's structure owned once, however many ranks
     EXPECT_GT(sent, 0u);
     EXPECT_EQ(sent, answered);  // every ray sent was answered by its chunk's owner
   }
