@@ -198,7 +198,7 @@ TEST(AccelChoice, AChunkedBuildThatFitsOneChunkAtATimeIsBuiltSo) {
 // smaller chunks, measured in the same pass: a quarter of the size each step, down to
 // kSmallestAutoChunk; a roomy one keeps the options' chunks.
 TEST(AccelChoice, ABudgetTooSmallForTheBuildTakesSmallerChunks) {
-  const Scene scene = make_builtin_scene("builtin:room:300k");
+  const Scene scene = make_builtin_scene("builtin:room:600k");
   const std::size_t default_chunk = AcceleratorOptions{}.chunk_triangles;
   const SceneTraits traits =
       measure_scene_traits(MeshTriangleSource(scene.mesh, scene.object_starts), default_chunk, nullptr, nullptr, true);

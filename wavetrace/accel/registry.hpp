@@ -37,7 +37,7 @@ struct AcceleratorOptions {
   // The kernel set of our walks (memory/kernel_isa.hpp): auto, avx2 or avx512.
   std::string isa = "auto";
   // Scenes of more triangles are built in chunks of at most this many (hmq, raystrips, bvh).
-  std::size_t chunk_triangles = std::size_t{1} << 22;
+  std::size_t chunk_triangles = std::size_t{1} << 21;
   // At most this many chunks built at the same time; 0: one per thread, as memory allows.
   std::size_t chunks_at_once = 0;
   bool operator==(const AcceleratorOptions&) const = default;

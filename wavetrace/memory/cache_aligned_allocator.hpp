@@ -35,8 +35,22 @@ inline void* allocate_large_array(std::size_t bytes) {
   const std::size_t alignment = huge ? kHugePageBytes : kColumnAlignment;
   void* memory = std::aligned_alloc(alignment, align_up(bytes, alignment));
   if (memory == nullptr) throw std::bad_alloc();
-  if (huge) madvise(memory, align_up(bytes, alignment), MADV_HUGEPAGE);  // advice only: failure is harmless
+  // Only the whole 2 MiB the array fills are advised: a huge page over its last, partial
+  // stretch would hold up to 2 MiB it never uses, per array (room:8M's hmq:width=8 chunks
+  // kept 29 MB so). Advice only: failure is harmless.
+  if (huge) madvise(memory, bytes / kHugePageBytes * kHugePageBytes, MADV_HUGEPAGE);
   return memory;
+}
+
+// Hands back the pages of a large array's allocation past its last element (a vector's
+// spare capacity, and the rest of the huge page its end lies in: the kernel splits that
+// page's mapping), for an array that is final and will not grow again. Advice only.
+inline void release_spare_capacity(const void* data, std::size_t used_bytes, std::size_t capacity_bytes) {
+  constexpr std::uintptr_t kPage = 4096;
+  const auto begin = reinterpret_cast<std::uintptr_t>(data);
+  const std::uintptr_t first = (begin + used_bytes + kPage - 1) & ~(kPage - 1);
+  const std::uintptr_t last = (begin + capacity_bytes) & ~(kPage - 1);
+  if (capacity_bytes >= kHugePageBytes && first < last) madvise(reinterpret_cast<void*>(first), last - first, MADV_DONTNEED);
 }
 
 // Hands the whole 4 KiB pages within [begin, end) back to the OS: for a large temporary read

@@ -21,8 +21,11 @@ class StoredArray {
   using value_type = T;
 
   StoredArray() = default;
-  // Takes a built array; moving a vector keeps its buffer, so the view stays valid.
-  explicit StoredArray(LargeArray<T> owned) : owned_(std::move(owned)), view_(owned_.data(), owned_.size()) {}
+  // Takes a built array; moving a vector keeps its buffer, so the view stays valid. The
+  // array is final: pages past its end that a reserve or a growth touched go back to the OS.
+  explicit StoredArray(LargeArray<T> owned) : owned_(std::move(owned)), view_(owned_.data(), owned_.size()) {
+    release_spare_capacity(owned_.data(), owned_.size() * sizeof(T), owned_.capacity() * sizeof(T));
+  }
   // Bytes of a mapped file, which `keep_alive` keeps mapped for as long as this array lives.
   StoredArray(std::span<const T> view, std::shared_ptr<const void> keep_alive)
       : view_(view), keep_alive_(std::move(keep_alive)) {}

@@ -385,7 +385,7 @@ const std::vector<ConfigKey>& config_schema() {
       {"accel.bvh.width", T::integer, std::int64_t{2}, 2, 8, {}, "2: binary 32-byte nodes; 8: AVX2 8-wide nodes",
        integer<&P::accelerator, &A::bvh, &BvhOptions::width>, recorded_integer<&P::accelerator, &A::bvh, &BvhOptions::width>},
 
-      {"build.chunk_triangles", T::integer, std::int64_t{1} << 22, std::int64_t{1024}, std::int64_t{1} << 30, {},
+      {"build.chunk_triangles", T::integer, std::int64_t{1} << 21, std::int64_t{1024}, std::int64_t{1} << 30, {},
        "scenes of more triangles are built in chunks of at most this many under a top BVH (hmq, raystrips, bvh)",
        integer<&P::accelerator, &A::chunk_triangles>},
       {"build.chunks_at_once", T::integer, std::int64_t{0}, 0, 1024, {},
