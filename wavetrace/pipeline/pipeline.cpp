@@ -9,6 +9,8 @@
 #include <string>
 #include <thread>
 
+#include <tbb/task_arena.h>
+
 #include "wavetrace/pipeline/tracing_arena.hpp"
 
 namespace wavetrace {
@@ -156,8 +158,13 @@ void OrderedHandOff::close() {
 
 std::unique_ptr<BatchNode> make_stage_node(tbb::flow::graph& graph, const Stage& stage, PipelineContext& context,
                                            StageCounters& counters, OrderedHandOff* hand_off) {
+  // Calls that never suspend are never more than the threads. A data-mode rank's trace calls
+  // suspend while other ranks answer, and unbounded, its one thread started a fresh call
+  // whenever one suspended while resumed calls waited behind the fresh ones, each holding a
+  // round's scratch: 171-198 calls, 25-29 MB a rank (distributed.md, "Calls a stage runs at once").
+  const std::size_t calls_at_once = std::size_t(tbb::this_task_arena::max_concurrency()) + kSuspendedCallsPerStage;
   return std::make_unique<BatchNode>(
-      graph, tbb::flow::unlimited, [&stage, &context, &counters, hand_off](Batch* batch, BatchNode::output_ports_type& ports) {
+      graph, calls_at_once, [&stage, &context, &counters, hand_off](Batch* batch, BatchNode::output_ports_type& ports) {
         if (hand_off != nullptr) batch = hand_off->pop();
         const Clock::time_point start = Clock::now();
         const std::size_t rays_in = batch->rays.count;

@@ -123,8 +123,12 @@ class OrderedHandOff {
   bool closed_ = false;
 };
 
-// A node running `stage` on any number of batches at once. With `hand_off`, each message
-// stands for the oldest batch in it.
+// Calls of a stage running at once beyond one a thread: those suspended (a data-mode rank's
+// trace waiting for answers); more wait in the node's queue.
+inline constexpr std::size_t kSuspendedCallsPerStage = 32;
+
+// A node running `stage` on up to the arena's threads plus kSuspendedCallsPerStage batches at
+// once. With `hand_off`, each message stands for the oldest batch in it.
 std::unique_ptr<BatchNode> make_stage_node(tbb::flow::graph& graph, const Stage& stage, PipelineContext& context,
                                            StageCounters& counters, OrderedHandOff* hand_off = nullptr);
 
