@@ -22,6 +22,7 @@
 #endif
 
 #include "wavetrace/distribute/chunk_deal.hpp"
+#include "wavetrace/pipeline/pipeline.hpp"
 
 namespace wavetrace {
 namespace {
@@ -33,7 +34,9 @@ constexpr int kDone = 7102;
 // rounds a rank has waiting at once (one or a few a batch in flight).
 constexpr int kFirstReplyTag = 8000;
 constexpr std::uint64_t kReplyTags = 24000;
-constexpr std::uint64_t kMaxSuspendedRounds = 32;
+// Rounds suspended at once: as many as a stage runs calls beyond one a thread (pipeline.hpp);
+// past that, a thread that suspended one more round would find no call to start in its place.
+constexpr std::uint64_t kMaxSuspendedRounds = kSuspendedCallsPerStage;
 using Clock = std::chrono::steady_clock;
 
 // TBB's resumable tasks switch stacks, which AddressSanitizer cannot follow without
