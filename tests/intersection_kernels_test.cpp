@@ -22,7 +22,7 @@ namespace {
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
 bool watertight_hit(glm::vec3 o, glm::vec3 d, glm::vec3 a, glm::vec3 b, glm::vec3 c, TriangleHit* out = nullptr) {
-  TriangleHit hit;
+  TriangleHit hit{};  // a miss leaves it as it was: zeros, never stack garbage (a NaN there failed a run)
   const bool found = intersect_watertight(make_watertight_ray(o, d), a, b, c, 0.0f, kInf, hit);
   if (out) *out = hit;
   return found;
