@@ -94,6 +94,10 @@ nlohmann::json stage_json(const StageStats& stage) {
           {"mrays_per_s", stage.mrays_per_s()}};
 }
 
+nlohmann::json cpu_json(const ProcessCpuTime& cpu) {
+  return {{"user", cpu.user_seconds}, {"system", cpu.system_seconds}};
+}
+
 nlohmann::json spill_json(const SpillCounters& spill) {
   return {{"bytes_written", spill.bytes_written}, {"bytes_read", spill.bytes_read}, {"seconds", spill.seconds}, {"runs", spill.runs}};
 }
@@ -156,7 +160,9 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
   for (const DepthHitRate& rate : facts.output.hit_rates) {
     hit_rates.push_back({{"depth", rate.depth}, {"rays", rate.rays}, {"hits", rate.hits}, {"hit_rate", rate.rate()}});
   }
-  nlohmann::json render = {{"seconds", facts.output.run.seconds}, {"threads", facts.output.run.threads}};
+  nlohmann::json render = {{"seconds", facts.output.run.seconds},
+                            {"threads", facts.output.run.threads},
+                            {"cpu_seconds", cpu_json(facts.output.run.cpu)}};
   render["stages"] = facts.plan.stages;
   render["mode"] = to_string(facts.plan.pipeline.mode);
   // The camera pass's, with photons; batches: the pool's high-water mark, each of
@@ -213,6 +219,7 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
                         {"radius", photons->radius},
                         {"gather_rays", facts.plan.photon.gather_rays},
                         {"seconds", photons->run.seconds},
+                        {"cpu_seconds", cpu_json(photons->run.cpu)},
                         {"map_seconds", photons->map_seconds},
                         {"precomputed", photons->precomputed},
                         {"stages", photon_stages}};
@@ -247,6 +254,7 @@ nlohmann::json distribute_json(const DistributedRender& render, const RenderPlan
                      {"camera_rays", rank.camera_rays},
                      {"rays_traced", rank.rays_traced},
                      {"render_seconds", rank.render_seconds},
+                     {"cpu_seconds", cpu_json(rank.cpu)},
                      {"wait_seconds", rank.wait_seconds},
                      {"peak_resident_bytes", rank.peak_resident_bytes}});
     if (plan.distribute.mode == DistributeMode::data) {
@@ -341,18 +349,21 @@ std::string render_table(const RenderFacts& facts) {
   }
   const MemoryReport memory = facts.accelerator.memory();
   const BuildReport build = facts.accelerator.build();
-  table += fmt::format("render ({}): {:.3f} s wall on {} threads ({:.3f} thread-seconds), {:.2f} Mrays/s traced\n",
-                       to_string(facts.plan.pipeline.mode), run.seconds, run.threads, thread_seconds, traced / run.seconds * 1e-6);
+  table += fmt::format("render ({}): {:.3f} s wall on {} threads ({:.3f} thread-seconds; the process's CPU {:.3f} s user, "
+                       "{:.3f} s system), {:.2f} Mrays/s traced\n",
+                       to_string(facts.plan.pipeline.mode), run.seconds, run.threads, thread_seconds, run.cpu.user_seconds,
+                       run.cpu.system_seconds, traced / run.seconds * 1e-6);
   if (const DistributedRender* shared = facts.distributed) {
     table += fmt::format("distributed ({} mode, {} ranks, ranges of {} camera rays): {:.3f} s wall, {:.2f} Mrays/s "
                          "traced by all; the table above is rank 0's\n",
                          to_string(facts.plan.distribute.mode), shared->ranks.size(), shared->range_rays,
                          shared->wall_seconds, double(shared->rays_traced()) / shared->wall_seconds * 1e-6);
     for (const RankReport& rank : shared->ranks) {
-      table += fmt::format("  rank {} on {}: {} ranges, {} camera rays, {} traced in {:.3f} s (waited {:.3f} s for "
-                           "ranges), {:.2f} GB resident at most\n",
+      table += fmt::format("  rank {} on {}: {} ranges, {} camera rays, {} traced in {:.3f} s (CPU {:.3f} s user, {:.3f} s "
+                           "system; waited {:.3f} s for ranges), {:.2f} GB resident at most\n",
                            rank.rank, rank.host, rank.ranges, rank.camera_rays, rank.rays_traced, rank.render_seconds,
-                           rank.wait_seconds, double(rank.peak_resident_bytes) * 1e-9);
+                           rank.cpu.user_seconds, rank.cpu.system_seconds, rank.wait_seconds,
+                           double(rank.peak_resident_bytes) * 1e-9);
       if (facts.plan.distribute.mode == DistributeMode::data) {
         const ChunkTraffic& traffic = rank.traffic;
         table += fmt::format("    owns {} chunks ({} triangles, {:.1f} MB) and answers {} of others' itself ({} triangles); sent {} "

@@ -3,7 +3,8 @@
 # the rays/s of one process x 2 threads): the same world, camera and settings, alternately
 # alone and under mpirun, REPEAT times each; a table of medians and the ratio.
 # Data mode (goal: each rank's peak resident <= 60% of one process's, rays/s >= 0.8x) needs a
-# chunked world: RUNS="alone:1:2 image:2:1 data:2:1 data:4:1".
+# chunked world: RUNS="alone:1:2 image:2:1 data:2:1 data:4:1". The render's CPU (every rank's process,
+# user and system, from the common start until all were done) shows what sharing costs in cores.
 # Usage: bench/distribute_suite.sh SCENE OUT_DIR   (SCENE: a saved world .wtw, or builtin:...)
 # Settings (environment): SIZE (640x480), SPP (8), DEPTH (5), HEURISTIC (hph), REPEAT (3),
 #   RUNS ("alone:1:2 image:2:1"): MODE:RANKS:THREADS each, alone = without mpirun; data mode may
@@ -38,15 +39,17 @@ python3 - "$out" ${RUNS:-alone:1:2 image:2:1} <<'PY'
 import glob, json, statistics, sys, filecmp
 out, runs = sys.argv[1], sys.argv[2:]
 rows, base = [], None
-print("| run | ranks x threads | render s (median) | rays traced | Mrays/s (median) | vs alone | peak resident GB a rank (most) | of alone's | while loading GB | bytes sent a ray | image |")
-print("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |")
+print("| run | ranks x threads | render s (median) | rays traced | Mrays/s (median) | vs alone | render CPU core-s (median, all ranks) | CPU vs alone | peak resident GB a rank (most) | of alone's | while loading GB | bytes sent a ray | image |")
+print("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |")
 alone_peak = None
+base_cpu = None
+core_seconds = lambda cpu: cpu["user"] + cpu["system"]
 for run in runs:
     mode, ranks, threads, *extra = run.split(":")
     share, balance = (extra + [None, None])[:2]
     tag = (f"_r{share}" if share else "") + (f"_{balance}" if balance else "")
     files = sorted(glob.glob(f"{out}/{mode}_{ranks}x{threads}{tag}_[0-9]*.json"))
-    seconds, rates, peaks, loads, sent, traced = [], [], [], [], [], 0
+    seconds, rates, peaks, loads, sent, cpus, traced = [], [], [], [], [], [], 0
     for path in files:
         stats = json.load(open(path))
         if "distribute" in stats:
@@ -55,19 +58,23 @@ for run in runs:
             peaks.append(max(r["peak_resident_bytes"] for r in d["per_rank"]) * 1e-9)
             loads.append(max(r.get("load_peak_resident_bytes", 0) for r in d["per_rank"]) * 1e-9)
             sent.append(sum(r.get("exchange", {}).get("bytes_sent", 0) for r in d["per_rank"]) / d["rays_traced"])
+            cpus.append(sum(core_seconds(r["cpu_seconds"]) for r in d["per_rank"]))
         else:
             seconds.append(stats["render"]["seconds"])
             traced = next(s["rays_in"] for s in stats["stages"] if s["name"] == "trace")
             peaks.append(stats["memory"]["peak_rss_bytes"] * 1e-9)
+            cpus.append(core_seconds(stats["render"]["cpu_seconds"]))
         rates.append(traced / seconds[-1] * 1e-6)
     rate = statistics.median(rates)
     base = base or rate
     first = f"{out}/{runs[0].split(':')[0]}_{runs[0].split(':')[1]}x{runs[0].split(':')[2]}_1.exr"
     identical = all(filecmp.cmp(p.replace(".json", ".exr"), first, shallow=False) for p in files)
     alone_peak = alone_peak or max(peaks)
+    cpu = statistics.median(cpus)
+    base_cpu = base_cpu or cpu
     label = mode + "".join(f", {k} {v}" for k, v in (("replicate", share), ("balance", balance)) if v)
     print(f"| {label} | {ranks} x {threads} | {statistics.median(seconds):.3f} | {traced:,} | {rate:.3f} | "
-          f"{rate / base:.3f} | {max(peaks):.2f} | {max(peaks) / alone_peak:.0%} | "
+          f"{rate / base:.3f} | {cpu:.2f} | {cpu / base_cpu:.2f} | {max(peaks):.2f} | {max(peaks) / alone_peak:.0%} | "
           f"{max(loads) if loads and max(loads) > 0 else float('nan'):.2f} | "
           f"{statistics.median(sent) if sent else 0:.1f} | {'identical' if identical else 'DIFFERS'} |")
 PY

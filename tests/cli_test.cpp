@@ -2,6 +2,7 @@
 // with a one-line error naming the problem.
 #include <filesystem>
 #include <fstream>
+#include <thread>
 #include <map>
 #include <string>
 #include <vector>
@@ -50,6 +51,21 @@ TEST(Cli, RenderWritesExrPngAndStats) {
   EXPECT_EQ(stats["image"]["width"], 32);
   EXPECT_EQ(stats["image"]["spp"], 1);
   EXPECT_EQ(stats["image"]["path"], dir + "/image.exr");
+}
+
+TEST(Cli, RenderReportsTheCpuItsRenderTook) {
+  const std::string dir = temp_dir();
+  const auto result = run_wavetrace("render builtin:room:100k --size 96x72 --spp 2 --threads 2 --out " + dir +
+                                    "/cpu.exr --stats " + dir + "/cpu.json");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("the process's CPU"), std::string::npos) << result.output;
+  const nlohmann::json render = nlohmann::json::parse(std::ifstream(dir + "/cpu.json"))["render"];
+  const double user = render["cpu_seconds"]["user"].get<double>(), system = render["cpu_seconds"]["system"].get<double>();
+  EXPECT_GT(user + system, 0.0);  // the kernel splits the two by ticks: either alone may read 0
+  EXPECT_GE(user, 0.0);
+  EXPECT_GE(system, 0.0);
+  // The process's threads together: never more than the cores over the render's wall time.
+  EXPECT_LE(user + system, render["seconds"].get<double>() * std::thread::hardware_concurrency() + 0.05);
 }
 
 TEST(Cli, RenderReportsResidentMemoryByPhaseFromTheOs) {

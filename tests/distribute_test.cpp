@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdint>
 #include <fstream>
+#include <thread>
 #include <iterator>
 #include <memory>
 #include <string>
@@ -135,6 +136,12 @@ TEST(Distribute, ImageModeOnTwoAndThreeRanksIsTheSingleProcessImage) {
       const nlohmann::json& own = report["per_rank"][rank];
       EXPECT_EQ(own["rank"], rank);
       EXPECT_GT(own["peak_resident_bytes"].get<std::uint64_t>(), 0u);
+      // Its process's CPU over its render: some where it traced (user and system apart are
+      // the kernel's split by ticks, so a short render may show either as 0), never more than
+      // its cores gave.
+      const double cpu = own["cpu_seconds"]["user"].get<double>() + own["cpu_seconds"]["system"].get<double>();
+      if (own["camera_rays"].get<std::uint64_t>() > 0) EXPECT_GT(cpu, 0.0);
+      EXPECT_LE(cpu, (own["render_seconds"].get<double>() + 1.0) * std::thread::hardware_concurrency());
       ranges += own["ranges"].get<std::uint64_t>();
       camera_rays += own["camera_rays"].get<std::uint64_t>();
       traced += own["rays_traced"].get<std::uint64_t>();

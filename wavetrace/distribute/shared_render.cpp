@@ -29,6 +29,7 @@ struct PackedRankReport {
   char host[64];
   std::uint64_t ranges, camera_rays, rays_traced;
   double render_seconds, wait_seconds;
+  double cpu_user_seconds, cpu_system_seconds;
   std::uint64_t peak_resident_bytes, load_peak_resident_bytes;
   ChunkTraffic traffic;  // plain numbers
 };
@@ -42,6 +43,8 @@ PackedRankReport pack(const RankReport& report) {
   packed.rays_traced = report.rays_traced;
   packed.render_seconds = report.render_seconds;
   packed.wait_seconds = report.wait_seconds;
+  packed.cpu_user_seconds = report.cpu.user_seconds;
+  packed.cpu_system_seconds = report.cpu.system_seconds;
   packed.peak_resident_bytes = report.peak_resident_bytes;
   packed.load_peak_resident_bytes = report.load_peak_resident_bytes;
   packed.traffic = report.traffic;
@@ -49,11 +52,19 @@ PackedRankReport pack(const RankReport& report) {
 }
 
 RankReport unpack(const PackedRankReport& packed) {
-  return {packed.rank,          std::string(packed.host, strnlen(packed.host, sizeof packed.host)),
-          packed.ranges,        packed.camera_rays,
-          packed.rays_traced,   packed.render_seconds,
-          packed.wait_seconds,  packed.peak_resident_bytes,
-          packed.load_peak_resident_bytes, packed.traffic};
+  RankReport report;
+  report.rank = packed.rank;
+  report.host = std::string(packed.host, strnlen(packed.host, sizeof packed.host));
+  report.ranges = packed.ranges;
+  report.camera_rays = packed.camera_rays;
+  report.rays_traced = packed.rays_traced;
+  report.render_seconds = packed.render_seconds;
+  report.cpu = {packed.cpu_user_seconds, packed.cpu_system_seconds};
+  report.wait_seconds = packed.wait_seconds;
+  report.peak_resident_bytes = packed.peak_resident_bytes;
+  report.load_peak_resident_bytes = packed.load_peak_resident_bytes;
+  report.traffic = packed.traffic;
+  return report;
 }
 
 const StageStats* find_stage(const PipelineRun& run, const std::string& name) {
@@ -111,6 +122,7 @@ DistributedRender render_shared(const MpiSession& session, const RenderPlan& pla
   }
 #endif
   const Clock::time_point start = Clock::now();
+  const ProcessCpuTime cpu_at_start = read_process_cpu_time();
   RayRangeDealer dealer(session, total, result.range_rays);
   RankReport own;
   ImageShare share;
@@ -121,6 +133,7 @@ DistributedRender render_shared(const MpiSession& session, const RenderPlan& pla
     // wait for the dealer, whose last answers go to ranks finishing their renders).
     if (exchange != nullptr) exchange->finish();
     dealer.finish();
+    own.cpu = read_process_cpu_time() - cpu_at_start;
 #if WAVETRACE_HAVE_MPI
     if (!session.distributed()) return;
     const auto count = static_cast<int>(sums.size());

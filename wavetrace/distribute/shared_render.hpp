@@ -11,6 +11,7 @@
 
 #include "wavetrace/distribute/chunk_exchange.hpp"
 #include "wavetrace/distribute/mpi_session.hpp"
+#include "wavetrace/memory/process_cpu.hpp"
 #include "wavetrace/setup/render_image.hpp"
 
 namespace wavetrace {
@@ -23,6 +24,9 @@ struct RankReport {
   std::uint64_t camera_rays = 0;  // camera rays it generated
   std::uint64_t rays_traced = 0;  // rays its trace stage took (camera, bounce, shadow)
   double render_seconds = 0.0;    // its render, from the common start to its last ray
+  // Its process's CPU, every thread, from the common start until every rank was done: in data
+  // mode the rays it answered for others after its own were done count too.
+  ProcessCpuTime cpu;
   double wait_seconds = 0.0;      // waiting for ranges from rank 0
   std::uint64_t peak_resident_bytes = 0;  // VmHWM after its render (data mode: since the load, see below)
   // Data mode: VmHWM at the end of the load, whose checks read every chunk; its world's pages

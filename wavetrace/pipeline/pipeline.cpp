@@ -250,6 +250,7 @@ PipelineRun Pipeline::run(const std::function<void(const Progress&)>& on_progres
   for (const Stage* stage : chain_) rays_per_source_ray = std::max(rays_per_source_ray, stage->rays_out_per_ray());
   PipelineContext context(options_.batch_size, options_.rays_in_flight, shared_pool_, rays_per_source_ray);
   const Clock::time_point start = Clock::now();
+  const ProcessCpuTime cpu_at_start = read_process_cpu_time();
 
   std::optional<ProgressReporter> reporter;
   reporter.emplace(
@@ -338,6 +339,7 @@ PipelineRun Pipeline::run(const std::function<void(const Progress&)>& on_progres
 
   PipelineRun result;
   result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  result.cpu = read_process_cpu_time() - cpu_at_start;
   reporter.reset();
   result.threads = threads;
   result.stages.push_back(generate_counters.snapshot());

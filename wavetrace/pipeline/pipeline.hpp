@@ -27,6 +27,7 @@
 #include <tbb/flow_graph.h>
 
 #include "wavetrace/memory/batch_pool.hpp"
+#include "wavetrace/memory/process_cpu.hpp"
 #include "wavetrace/stages/generate.hpp"
 #include "wavetrace/pipeline/progress_reporter.hpp"
 #include "wavetrace/stages/stage.hpp"
@@ -167,6 +168,9 @@ struct PipelineRun {
   int threads = 0;
   std::size_t batches_allocated = 0;
   std::size_t peak_rays_in_core = 0;  // the most rays alive in memory at once
+  // The process's CPU over the run, every thread of it (the arena's, a stage's readers ahead,
+  // a data-parallel rank's exchange): against seconds x threads, how busy the cores were.
+  ProcessCpuTime cpu;
 };
 
 class Pipeline {
