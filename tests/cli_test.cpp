@@ -258,9 +258,14 @@ TEST(Cli, BenchReorderReportsEveryHeuristicWithTheIssuesKeys) {
   for (const auto& entry : json["results"]) {
     for (const char* key : {"heuristic", "render_seconds", "trace_seconds", "trace_mrays_per_s", "approx_hit_seconds",
                             "sort_seconds", "overhead_share", "page_faults", "simulated_io_seconds", "cache_misses",
-                            "image_identical"}) {
+                            "cpu_user_seconds", "cpu_system_seconds", "image_identical"}) {
       EXPECT_TRUE(entry.contains(key)) << key;
     }
+    // The render's CPU, every thread of it: some, and never more than the cores over its time
+    // (render_image's own set-up beside the render's: a second's slack).
+    const double cpu = entry["cpu_user_seconds"].get<double>() + entry["cpu_system_seconds"].get<double>();
+    EXPECT_GT(cpu, 0.0);
+    EXPECT_LE(cpu, (entry["render_seconds"].get<double>() + 1.0) * std::thread::hardware_concurrency());
     EXPECT_TRUE(entry["image_identical"].get<bool>()) << entry["heuristic"];
     EXPECT_GT(entry["page_faults"].get<std::uint64_t>(), 0u);
   }

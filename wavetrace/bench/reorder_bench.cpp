@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "wavetrace/bench/render_world.hpp"
+#include "wavetrace/memory/process_cpu.hpp"
 #include "wavetrace/setup/render_setup.hpp"
 
 namespace wavetrace {
@@ -151,10 +152,14 @@ ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<Reo
     for (std::size_t h = 0; h < heuristics.size(); ++h) {
       const ReorderHeuristic heuristic = heuristics[h];
       const RenderPlan plan = plan_render(heuristic_variant(config, heuristic));
+      const ProcessCpuTime cpu_before = read_process_cpu_time();
       const RenderOutput output = render_image(plan, world, camera);
+      const ProcessCpuTime cpu = read_process_cpu_time() - cpu_before;
       report.threads = output.run.threads;
 
       ReorderBenchResult result = result_of(heuristic, output);
+      result.cpu_user_seconds = cpu.user_seconds;
+      result.cpu_system_seconds = cpu.system_seconds;
       if (first_image.empty()) first_image = output.image;
       result.image_identical = output.image == first_image;
       rounds_of[h].push_back(std::move(result));
@@ -185,6 +190,8 @@ nlohmann::json to_json(const ReorderBenchReport& report) {
     }
     results.push_back({{"heuristic", r.heuristic},
                        {"render_seconds", r.render_seconds},
+                       {"cpu_user_seconds", r.cpu_user_seconds},
+                       {"cpu_system_seconds", r.cpu_system_seconds},
                        {"photon_seconds", r.photon_seconds},
                        {"trace_seconds", r.trace_seconds},
                        {"trace_mrays_per_s", r.trace_mrays_per_s},
@@ -232,8 +239,8 @@ std::string to_table(const ReorderBenchReport& report) {
   if (report.proxy) table += "proxy: " + *report.proxy + "\n";
   const bool disk = !report.results.empty() && report.results.front().disk_faults.has_value();
   const bool photons = !report.results.empty() && report.results.front().photon_seconds > 0.0;
-  table += fmt::format("{:<11} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>8} {:>9} {:>10} {:>9} {:>11} {:>11} {:>9} {:>10}",
-                       "heuristic", "render s", "trace s", "Mr/s/thr", "closest", "shadow", "approx s", "sort s",
+  table += fmt::format("{:<11} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>8} {:>9} {:>10} {:>9} {:>11} {:>11} {:>9} {:>10}",
+                       "heuristic", "render s", "cpu usr s", "cpu sys s", "trace s", "Mr/s/thr", "closest", "shadow", "approx s", "sort s",
                        "overhead", "faults", "sim I/O s", "misses", "vs first", "speedup", "identical");
   table += disk ? fmt::format(" {:>11} {:>9} {:>9} {:>9} {:>11} {:>10} {:>10} {:>10} {:>10} {:>9}", "disk faults",
                               "disk MB", "read s", "wait s", "disk vs 1st", "rays/page", "pages/1k", "read ahead",
@@ -248,9 +255,9 @@ std::string to_table(const ReorderBenchReport& report) {
     return base && value && *value > 0 ? fmt::format("{:.2f}x", double(*base) / double(*value)) : std::string("-");
   };
   for (const ReorderBenchResult& r : report.results) {
-    table += fmt::format("{:<11} {:>9.3f} {:>9.3f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.3f} {:>8.3f} {:>8.1f}% {:>10} {:>9} {:>11} {:>11} "
-                         "{:>8.2f}x {:>10}",
-                         r.heuristic, r.render_seconds, r.trace_seconds, r.trace_mrays_per_s, r.closest_mrays_per_s,
+    table += fmt::format("{:<11} {:>9.3f} {:>9.2f} {:>9.2f} {:>9.3f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.3f} {:>8.3f} {:>8.1f}% {:>10} "
+                         "{:>9} {:>11} {:>11} {:>8.2f}x {:>10}",
+                         r.heuristic, r.render_seconds, r.cpu_user_seconds, r.cpu_system_seconds, r.trace_seconds, r.trace_mrays_per_s, r.closest_mrays_per_s,
                          r.shadow_mrays_per_s, r.approx_hit_seconds,
                          r.sort_seconds, 100.0 * r.overhead_share, optional(r.page_faults, "{}"),
                          optional(r.simulated_io_seconds, "{:.1f}"), optional(r.cache_misses, "{}"),

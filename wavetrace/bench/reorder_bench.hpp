@@ -21,6 +21,9 @@ struct ReorderBenchResult {
   std::string heuristic;
   double render_seconds = 0.0;  // the whole render: with photon mapping, both passes
   double photon_seconds = 0.0;  // photon mapping's photon pass and maps (within render_seconds)
+  // The process's CPU over the render, every thread: a paged render's reads cost the kernel's
+  // time (system) beside the walks' (user).
+  double cpu_user_seconds = 0.0, cpu_system_seconds = 0.0;
   double trace_seconds = 0.0;       // thread-seconds in trace
   double trace_mrays_per_s = 0.0;   // per trace thread-second
   double closest_mrays_per_s = 0.0; // camera and bounce rays alone
