@@ -2,9 +2,9 @@
 // with a one-line error naming the problem.
 #include <filesystem>
 #include <fstream>
-#include <thread>
 #include <map>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>

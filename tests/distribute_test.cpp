@@ -4,10 +4,10 @@
 #include <chrono>
 #include <cstdint>
 #include <fstream>
-#include <thread>
 #include <iterator>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <fmt/format.h>

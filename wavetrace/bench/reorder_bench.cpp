@@ -239,9 +239,11 @@ std::string to_table(const ReorderBenchReport& report) {
   if (report.proxy) table += "proxy: " + *report.proxy + "\n";
   const bool disk = !report.results.empty() && report.results.front().disk_faults.has_value();
   const bool photons = !report.results.empty() && report.results.front().photon_seconds > 0.0;
-  table += fmt::format("{:<11} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>8} {:>9} {:>10} {:>9} {:>11} {:>11} {:>9} {:>10}",
-                       "heuristic", "render s", "cpu usr s", "cpu sys s", "trace s", "Mr/s/thr", "closest", "shadow", "approx s", "sort s",
-                       "overhead", "faults", "sim I/O s", "misses", "vs first", "speedup", "identical");
+  table += fmt::format("{:<11} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>8} {:>9} {:>10} {:>9} {:>11} {:>11} "
+                       "{:>9} {:>10}",
+                       "heuristic", "render s", "cpu usr s", "cpu sys s", "trace s", "Mr/s/thr", "closest", "shadow",
+                       "approx s", "sort s", "overhead", "faults", "sim I/O s", "misses", "vs first", "speedup",
+                       "identical");
   table += disk ? fmt::format(" {:>11} {:>9} {:>9} {:>9} {:>11} {:>10} {:>10} {:>10} {:>10} {:>9}", "disk faults",
                               "disk MB", "read s", "wait s", "disk vs 1st", "rays/page", "pages/1k", "read ahead",
                               "ahead hits", "in flight")
@@ -257,8 +259,8 @@ std::string to_table(const ReorderBenchReport& report) {
   for (const ReorderBenchResult& r : report.results) {
     table += fmt::format("{:<11} {:>9.3f} {:>9.2f} {:>9.2f} {:>9.3f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.3f} {:>8.3f} {:>8.1f}% {:>10} "
                          "{:>9} {:>11} {:>11} {:>8.2f}x {:>10}",
-                         r.heuristic, r.render_seconds, r.cpu_user_seconds, r.cpu_system_seconds, r.trace_seconds, r.trace_mrays_per_s, r.closest_mrays_per_s,
-                         r.shadow_mrays_per_s, r.approx_hit_seconds,
+                         r.heuristic, r.render_seconds, r.cpu_user_seconds, r.cpu_system_seconds, r.trace_seconds,
+                         r.trace_mrays_per_s, r.closest_mrays_per_s, r.shadow_mrays_per_s, r.approx_hit_seconds,
                          r.sort_seconds, 100.0 * r.overhead_share, optional(r.page_faults, "{}"),
                          optional(r.simulated_io_seconds, "{:.1f}"), optional(r.cache_misses, "{}"),
                          ratio(first->page_faults, r.page_faults), first->render_seconds / r.render_seconds,
