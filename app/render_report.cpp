@@ -45,11 +45,13 @@ std::string memory_lines(const std::vector<StageStats>& stages) {
     }
     if (stage.disk) {
       const DiskCounters& c = stage.disk->counters;
-      lines += fmt::format("{} disk: {} KiB pages, pool {:.1f} MiB: {} real faults ({} by reads no probe announced), "
+      const std::string frames =
+          stage.disk->frames > 0 ? fmt::format(", {} of them in frames", stage.disk->frames) : std::string();
+      lines += fmt::format("{} disk: {} KiB pages, pool {:.1f} MiB{}: {} real faults ({} by reads no probe announced), "
                            "{:.1f} MB read in {:.3f} s (O_DIRECT, in the measured time), {:.3f} s waited for pages, "
                            "up to {} reads at once\n",
                            stage.name, stage.disk->page_bytes >> 10, double(stage.disk->budget_bytes) / (1 << 20),
-                           c.faults, c.unannounced, double(c.bytes_read) * 1e-6, c.read_seconds, c.wait_seconds,
+                           frames, c.faults, c.unannounced, double(c.bytes_read) * 1e-6, c.read_seconds, c.wait_seconds,
                            stage.disk->reads_in_flight_max);
       if (stage.disk->prefetched > 0) {
         lines += fmt::format("{} disk: {} of those pages read ahead by its look-ahead, {} of them used before evicted\n",
@@ -137,6 +139,7 @@ nlohmann::json render_stats_json(const RenderFacts& facts) {
     if (stage.pager) entry["pager"] = pager_json(*stage.pager);
     if (stage.disk) {
       entry["disk"] = {{"mapping", to_string(stage.disk->mapping)},
+                       {"frames", stage.disk->frames},
                        {"page_bytes", stage.disk->page_bytes},
                        {"budget_bytes", stage.disk->budget_bytes},
                        {"faults", stage.disk->counters.faults},

@@ -3,12 +3,15 @@
 // resident memory, and a file cut short while it is paged.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cctype>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <unistd.h>
@@ -284,6 +287,137 @@ TEST_P(FilePagerTest, CountsAPrefetchedPageReadByAnotherClientAsAHit) {
   EXPECT_EQ(pager.counters(0).faults, 5u);
   pager.reset();
   EXPECT_EQ(pager.prefetch_hits(), 0u);
+}
+
+// Frames (FilePager::use_frames): pages of 32 KiB, eight 4 KiB blocks of the numbered file each.
+constexpr std::size_t kFramePage = 32 * 1024, kBlocksPerFramePage = kFramePage / kPage;
+// Eleven pages of budget: two for the mapped pool, nine of 32 KiB as eight frames of 36 KiB.
+constexpr std::size_t kFrameBudget = 11 * kFramePage, kFrames = 8;
+
+// Every word a frame shows for `page`, the tail's included, is the file's.
+bool frame_shows_page(const std::byte* frame, std::size_t page, std::size_t file_blocks) {
+  const auto* words = reinterpret_cast<const std::uint32_t*>(frame);
+  for (std::size_t b = 0; b < kBlocksPerFramePage + FilePager::kFrameTailBytes / kPage; ++b) {
+    const std::size_t block = page * kBlocksPerFramePage + b;
+    for (std::size_t i = 0; i < kPage / 4; i += 97) {
+      const std::uint32_t expected = block < file_blocks ? std::uint32_t(block * 1000 + i) : 0u;  // zero past the end
+      if (words[b * kPage / 4 + i] != expected) return false;
+    }
+  }
+  return true;
+}
+
+TEST_P(FilePagerTest, FramesShowEachPageAndTheFilesNextBytes) {
+  constexpr std::size_t kBlocks = 16 * kBlocksPerFramePage;
+  const std::string path = numbered_file("pager_frames.bin", kBlocks);
+  FilePager pager(path, kBlocks * kPage, kFramePage, kFrameBudget, 1, GetParam());
+  EXPECT_FALSE(pager.framed());
+  ASSERT_TRUE(pager.use_frames(true));
+  EXPECT_EQ(pager.frame_count(), kFrames);
+  EXPECT_EQ(pager.budget_bytes(), kFrameBudget);
+  for (std::size_t page = 0; page < 16; ++page) {
+    std::uint32_t frame = 0;
+    const std::byte* shown = pager.pin(pager.base() + page * kFramePage + 100, frame);
+    ASSERT_NE(shown, nullptr) << page;
+    EXPECT_TRUE(frame_shows_page(shown, page, kBlocks)) << page;  // the last page's tail: zeros
+    pager.unpin(frame);
+  }
+  EXPECT_EQ(pager.total().faults, 16u);
+  EXPECT_EQ(pager.total().unannounced, 0u);
+  // A read through the file's range still shows the file, from the mapped pool.
+  EXPECT_EQ(word(pager, 3 * kBlocksPerFramePage + 2, 5), (3 * kBlocksPerFramePage + 2) * 1000 + 5);
+  std::uint32_t frame = 0;
+  EXPECT_EQ(pager.pin(&frame, frame), nullptr);  // not the file's
+  // Switching needs an empty pool; switched off, the whole budget maps pages again.
+  EXPECT_THROW(pager.use_frames(false), std::logic_error);
+  pager.reset();
+  EXPECT_FALSE(pager.use_frames(false));
+  EXPECT_FALSE(pager.framed());
+  EXPECT_EQ(pager.pin(pager.base(), frame), nullptr);
+  std::filesystem::remove(path);
+}
+
+TEST_P(FilePagerTest, FramesAreRefusedForSmallPagesOrFewFrames) {
+  const std::string path = numbered_file("pager_frames_small.bin", 64);
+  FilePager small_pages(path, 64 * kPage, kPage, 32 * kPage, 1, GetParam());
+  EXPECT_FALSE(small_pages.use_frames(true));
+  FilePager few(path, 64 * kPage, kFramePage, kFrameBudget - kFramePage, 1, GetParam());
+  EXPECT_FALSE(few.use_frames(true));
+  EXPECT_EQ(word(few, 9, 3), 9003u);
+  std::filesystem::remove(path);
+}
+
+TEST_P(FilePagerTest, AFrameLeavesLeastRecentlyUsedButNeverWhilePinned) {
+  constexpr std::size_t kBlocks = 32 * kBlocksPerFramePage;
+  const std::string path = numbered_file("pager_frames_lru.bin", kBlocks);
+  FilePager pager(path, kBlocks * kPage, kFramePage, kFrameBudget, 1, GetParam());
+  ASSERT_TRUE(pager.use_frames(true));
+  std::uint32_t held = 0;
+  const std::byte* page0 = pager.pin(pager.base(), held);  // pinned throughout
+  ASSERT_NE(page0, nullptr);
+  for (std::size_t page = 1; page < 20; ++page) {  // more than the frames: page 0 would be evicted first
+    std::uint32_t frame = 0;
+    ASSERT_NE(pager.pin(pager.base() + page * kFramePage, frame), nullptr) << page;
+    pager.unpin(frame);
+  }
+  EXPECT_EQ(pager.total().faults, 20u);
+  EXPECT_TRUE(frame_shows_page(page0, 0, kBlocks));
+  std::uint32_t again = 0;
+  EXPECT_EQ(pager.pin(pager.base() + 7, again), page0);  // still resident, in the same frame
+  EXPECT_EQ(again, held);
+  EXPECT_EQ(pager.total().faults, 20u);
+  pager.unpin(again);
+  // Every frame pinned: no frame for another page, until one is let go.
+  std::vector<std::uint32_t> pinned = {held};
+  for (std::size_t page = 20; pinned.size() < kFrames; ++page) {
+    std::uint32_t frame = 0;
+    ASSERT_NE(pager.pin(pager.base() + page * kFramePage, frame), nullptr) << page;
+    pinned.push_back(frame);
+  }
+  std::uint32_t none = 0;
+  EXPECT_EQ(pager.pin(pager.base() + 30 * kFramePage, none), nullptr);
+  pager.unpin(pinned.back());
+  const std::byte* freed = pager.pin(pager.base() + 30 * kFramePage, none);
+  ASSERT_NE(freed, nullptr);
+  EXPECT_TRUE(frame_shows_page(freed, 30, kBlocks));
+  pager.unpin(none);
+  for (std::size_t k = 0; k + 1 < pinned.size(); ++k) pager.unpin(pinned[k]);
+  std::filesystem::remove(path);
+}
+
+// Readers on four threads pinning, reading and letting go of pages at random in a pool of
+// eight frames: every word each one reads is the file's, whatever the evictions around it.
+TEST_P(FilePagerTest, FramesShowTheFileToManyReadersAtOnce) {
+  constexpr std::size_t kPagesInFile = 48, kBlocks = kPagesInFile * kBlocksPerFramePage;
+  const std::string path = numbered_file("pager_frames_threads.bin", kBlocks);
+  FilePager pager(path, kBlocks * kPage, kFramePage, kFrameBudget, 1, GetParam());
+  ASSERT_TRUE(pager.use_frames(true));
+  std::atomic<std::size_t> wrong{0}, read{0};
+  std::vector<std::thread> readers;
+  for (unsigned t = 0; t < 4; ++t) {
+    readers.emplace_back([&, t] {
+      std::mt19937 random(t);
+      for (int round = 0; round < 400; ++round) {
+        std::uint32_t frames[2];
+        const std::size_t pages[2] = {random() % kPagesInFile, random() % kPagesInFile};
+        const std::byte* shown[2];
+        for (int k = 0; k < 2; ++k) shown[k] = pager.pin(pager.base() + pages[k] * kFramePage, frames[k]);
+        for (int k = 0; k < 2; ++k) {
+          if (shown[k] == nullptr) continue;  // every frame pinned or being read at that moment
+          read.fetch_add(1);
+          if (!frame_shows_page(shown[k], pages[k], kBlocks)) wrong.fetch_add(1);
+        }
+        for (int k = 0; k < 2; ++k) {
+          if (shown[k] != nullptr) pager.unpin(frames[k]);
+        }
+      }
+    });
+  }
+  for (std::thread& reader : readers) reader.join();
+  EXPECT_EQ(wrong.load(), 0u);
+  EXPECT_GT(read.load(), 3000u);
+  EXPECT_GT(pager.total().faults, 100u);
+  std::filesystem::remove(path);
 }
 
 TEST_P(FilePagerDeathTest, AFileCutShortWhilePagedIsAClearErrorNamingIt) {

@@ -503,6 +503,42 @@ TEST(WorldFileCli, AutoProxyShareSavesThePapersAndRendersInCoreWithATenth) {
   fs::remove(world);
 }
 
+// hmq:width=8's walks read a paged world's pages in frames (FilePager::use_frames), chunked
+// or not: the in-core image on two threads, every read announced, and the stats say how
+// many frames; with memory.page_frames = false, none, and the same image.
+TEST(WorldFileCli, PagedWideHmqReadsInFramesTheInCoreImage) {
+  for (const char* chunks : {"", " --set build.chunk_triangles=65536"}) {
+    const std::string world = temp_path("cli_frames.wtw");
+    const auto built = testing::run_wavetrace(std::string("build builtin:room:200k --accel hmq:width=8:leaves_beside_nodes=true") +
+                                              chunks + " --out " + world);
+    ASSERT_EQ(built.exit_code, 0) << built.output;
+    const std::string render = "render " + world + " --size 64x48 --spp 2 --threads 2 --set render.max_depth=3 ";
+    const auto in_core = testing::run_wavetrace(render + "--out " + temp_path("cli_frames_core.exr"));
+    ASSERT_EQ(in_core.exit_code, 0) << in_core.output;
+    for (const char* frames : {"true", "false"}) {
+      const std::string stats = temp_path("cli_frames.json");
+      const auto paged = testing::run_wavetrace(render + "--set memory.backing=file --set memory.budget=50% "
+                                                "--set memory.page_bytes=65536 --set memory.page_frames=" + frames +
+                                                " --out " + temp_path("cli_frames_paged.exr") + " --stats " + stats);
+      ASSERT_EQ(paged.exit_code, 0) << paged.output;
+      EXPECT_EQ(read_all(temp_path("cli_frames_core.exr")), read_all(temp_path("cli_frames_paged.exr"))) << chunks << frames;
+      const nlohmann::json report = nlohmann::json::parse(read_all(stats));
+      bool traced = false;
+      for (const nlohmann::json& stage : report.at("stages")) {
+        if (stage["name"] != "trace") continue;
+        const nlohmann::json& disk = stage.at("disk");
+        EXPECT_EQ(disk.at("frames").get<std::size_t>() > 0, std::string(frames) == "true") << chunks << disk.dump();
+        EXPECT_GT(disk.at("faults").get<std::uint64_t>(), 50u) << chunks << disk.dump();
+        EXPECT_LE(double(disk.at("unannounced_faults").get<std::uint64_t>()),
+                  0.03 * double(disk.at("faults").get<std::uint64_t>())) << chunks << disk.dump();
+        traced = true;
+      }
+      EXPECT_TRUE(traced);
+    }
+    fs::remove(world);
+  }
+}
+
 TEST(WorldFileCli, BuildRenderAndInfo) {
   const std::string world = temp_path("cli.wtw");
   const auto built = testing::run_wavetrace("build builtin:room:20k --accel raystrips --out " + world);

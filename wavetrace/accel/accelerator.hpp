@@ -72,6 +72,10 @@ class Accelerator {
                                         RecordingProbe& probe) const;
   virtual void intersect_any_probed(const RayBatch& rays, HitBatch& hits, RayRange range,
                                     RecordingProbe& probe) const;
+  // Whether the probed walks read the paged file through the probe's frames (RecordingProbe::
+  // resident and resident_record, each ray ending in end_ray) wherever they read it much, so
+  // that a real pager may keep its pages in frames (FilePager::use_frames).
+  virtual bool reads_through_frames() const { return false; }
 
   // The instruction set its walks run (accel.isa in the stats): one of the kernel sets
   // compiled into this binary (kernels/kernel_isa.hpp), or Embree's setting; empty where

@@ -134,10 +134,11 @@ ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<Reo
                     " KiB pages";
     if (file_pager != nullptr) {
       report.memory += fmt::format(" ({}real: {} of {} pages read with O_DIRECT into a {:.1f} MiB pool, "
-                                   "placed by {})",
+                                   "placed by {}{})",
                                    base.memory.simulate_beside_file ? "simulated, and " : "", base.scene.source,
                                    file_pager->page_count(), double(file_pager->budget_bytes()) / (1 << 20),
-                                   to_string(file_pager->mapping()));
+                                   to_string(file_pager->mapping()),
+                                   base.memory.page_frames ? ", in frames for walks that read there" : "");
       report.page_count = file_pager->page_count();
     }
   }

@@ -4,6 +4,7 @@
 // that many reads in flight.
 #include "wavetrace/memory/file_pager.hpp"
 #include "wavetrace/memory/page_trace.hpp"
+#include "wavetrace/memory/cache_aligned_allocator.hpp"  // kHugePageBytes, huge_pages_advised
 
 #include <algorithm>
 #include <array>
@@ -162,7 +163,8 @@ FilePager::FilePager(const std::string& path, std::uint64_t file_bytes, std::siz
                                             path, budget_bytes, page_bytes));
   }
   reserved_bytes_ = pages * page_bytes;
-  slots_ = std::clamp<std::size_t>(budget_bytes / page_bytes, 1, std::max<std::size_t>(pages, 1));
+  budget_pages_ = std::clamp<std::size_t>(budget_bytes / page_bytes, 1, std::max<std::size_t>(pages, 1));
+  slots_ = budget_pages_;
   direct_fd_ = ::open(path.c_str(), O_RDONLY | O_DIRECT | O_CLOEXEC);
   if (direct_fd_ < 0) throw std::runtime_error(fmt::format("{}: cannot open for direct reads: {}", path, std::strerror(errno)));
   // The range starts on a page boundary, so that a page of the file is a page_bytes-aligned
@@ -212,12 +214,10 @@ FilePager::FilePager(const std::string& path, std::uint64_t file_bytes, std::siz
   headed_at_ = std::make_unique<std::atomic<std::uint64_t>[]>(pages);
   prefetched_ = std::make_unique<std::atomic<std::uint8_t>[]>(pages);
   for (std::size_t p = 0; p < pages; ++p) slot_of_[p].store(kNone, std::memory_order_relaxed);
-  fresh_ticks_ = std::max<std::uint64_t>(slots_ / 4, 1);
-  eviction_group_ = std::clamp<std::size_t>(slots_ / 8, 1, kMaxEvictionGroup);
   self_pidfd_ = static_cast<int>(::syscall(SYS_pidfd_open, ::getpid(), 0));
   previous_.assign(pages, kNone);
   next_.assign(pages, kNone);
-  for (std::size_t s = slots_; s-- > 0;) free_slots_.push_back(static_cast<std::uint32_t>(s));
+  size_mapped_pool_locked(budget_pages_);
   clients_.resize(clients + 1);
   part_faults_.assign(clients_.size() * part_names_.size(), 0);
 
@@ -232,7 +232,16 @@ FilePager::FilePager(const std::string& path, std::uint64_t file_bytes, std::siz
 
 FilePager::~FilePager() { release(); }
 
+void FilePager::size_mapped_pool_locked(std::size_t slots) {
+  slots_ = slots;
+  fresh_ticks_ = std::max<std::uint64_t>(slots_ / 4, 1);
+  eviction_group_ = std::clamp<std::size_t>(slots_ / 8, 1, kMaxEvictionGroup);
+  free_slots_.clear();
+  for (std::size_t s = slots_; s-- > 0;) free_slots_.push_back(static_cast<std::uint32_t>(s));
+}
+
 void FilePager::release() {
+  release_frames();
   for (auto& slot : active_pagers) {
     FilePager* expected = this;
     slot.compare_exchange_strong(expected, nullptr);
@@ -308,28 +317,28 @@ void FilePager::evict_tail_locked(std::size_t count) {
   }
 }
 
-// Reads page `page` of the file into `into` (page_bytes_, zero past the file's end), timing
-// the read. The caller holds no lock.
-std::string FilePager::read_page(std::uint32_t page, std::byte* into, double& seconds) const {
+// Reads `bytes` of the file from page `page`'s start into `into` (zero past the file's end),
+// timing the read. The caller holds no lock.
+std::string FilePager::read_page(std::uint32_t page, std::byte* into, std::size_t bytes, double& seconds) const {
   const std::uint64_t offset = offset_of_page(page);
-  const std::size_t bytes = file_bytes_in(page);
-  // O_DIRECT wants whole blocks: read the page's full size (a section file's size is a
-  // multiple of 4096, so the read ends at or before the file's end on a block boundary).
-  const std::size_t request = (bytes + 4095) / 4096 * 4096;
+  const std::size_t available = static_cast<std::size_t>(std::min<std::uint64_t>(bytes, file_bytes_ - offset));
+  // O_DIRECT wants whole blocks: read whole 4 KiB (a section file's size is a multiple of
+  // 4096, so the read ends at or before the file's end on a block boundary).
+  const std::size_t request = (available + 4095) / 4096 * 4096;
   std::string error;
   const auto start = std::chrono::steady_clock::now();
-  for (std::size_t done = 0; done < bytes && error.empty();) {
+  for (std::size_t done = 0; done < available && error.empty();) {
     const ssize_t got = ::pread(direct_fd_, into + done, request - done, off_t(offset + done));
     if (got < 0 && errno == EINTR) continue;
     if (got <= 0) {
-      error = fmt::format("{}: reading page {} (bytes {}..{}) failed: {}", path_, page, offset, offset + bytes,
+      error = fmt::format("{}: reading page {} (bytes {}..{}) failed: {}", path_, page, offset, offset + available,
                           got < 0 ? std::strerror(errno)
                                   : "the file ends early (truncated or replaced while it was paged?)");
     }
     done += got > 0 ? std::size_t(got) : 0;
   }
   seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (error.empty() && bytes < page_bytes_) std::memset(into + bytes, 0, page_bytes_ - bytes);
+  if (error.empty() && available < bytes) std::memset(into + available, 0, bytes - available);
   return error;
 }
 
@@ -412,7 +421,7 @@ std::string FilePager::load(std::uint32_t page, std::uint64_t address_offset, st
   double seconds = 0.0;
   std::string error = into == nullptr
                           ? fmt::format("{}: no memory for a read buffer of {} bytes", path_, page_bytes_)
-                          : read_page(page, into, seconds);
+                          : read_page(page, into, page_bytes_, seconds);
   if (error.empty()) error = place_page(page, slot, into);
 
   lock.lock();
@@ -427,14 +436,19 @@ std::string FilePager::load(std::uint32_t page, std::uint64_t address_offset, st
     slot_of_[page].store(slot, std::memory_order_relaxed);
     if (client_index() == prefetch_client_) prefetched_[page].store(1, std::memory_order_relaxed);
     push_front_locked(page);
-    ++counters.faults;
-    if (by_fault) ++counters.unannounced;
-    ++part_faults_[client_index() * part_names_.size() + part_of(address_offset)];
-    counters.bytes_read += file_bytes_in(page);
-    counters.read_seconds += seconds;
+    count_read_locked(page, address_offset, seconds, by_fault);
   }
   loaded_.notify_all();
   return error;
+}
+
+void FilePager::count_read_locked(std::uint32_t page, std::uint64_t address_offset, double seconds, bool by_fault) {
+  DiskCounters& counters = clients_[client_index()];
+  ++counters.faults;
+  if (by_fault) ++counters.unannounced;
+  ++part_faults_[client_index() * part_names_.size() + part_of(address_offset)];
+  counters.bytes_read += file_bytes_in(page);
+  counters.read_seconds += seconds;
 }
 
 void FilePager::touch(const void* address) {
@@ -451,6 +465,188 @@ void FilePager::touch(const void* address) {
   }
   std::unique_lock lock(mutex_);
   if (std::string error = load(page, offset_of(address), lock); !error.empty()) throw std::runtime_error(error);
+}
+
+bool FilePager::use_frames(bool wanted) {
+  std::lock_guard lock(mutex_);
+  if (tail_ != kNone || frame_tail_ != kNone || reads_in_flight_ > 0) {
+    throw std::logic_error(fmt::format("{}: frames switched while pages are resident", path_));
+  }
+  release_frames();
+  size_mapped_pool_locked(budget_pages_);
+  if (!wanted || page_bytes_ < kMinFramePageBytes) return false;
+  const std::size_t mapped = std::clamp<std::size_t>(budget_pages_ / kMappedPoolShare, 2, kMappedPoolMaxPages);
+  const std::size_t stride = page_bytes_ + kFrameTailBytes;
+  const std::size_t frames = budget_pages_ > mapped ? (budget_pages_ - mapped) * page_bytes_ / stride : 0;
+  if (frames < kMinFrames) return false;
+  // On 2 MiB pages where the system allows: fewer TLB misses for the walks that read there,
+  // and every 4 KiB of the frames made present now, once, not at each one's first read.
+  const std::size_t bytes = (frames * stride + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;
+  void* region = ::mmap(nullptr, bytes + kHugePageBytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  if (region == MAP_FAILED) {
+    throw std::runtime_error(fmt::format("{}: cannot allocate {} frames of {} bytes: {}", path_, frames, stride,
+                                         std::strerror(errno)));
+  }
+  const auto start = reinterpret_cast<std::uintptr_t>(region);
+  const std::uintptr_t aligned = (start + kHugePageBytes - 1) & ~std::uintptr_t(kHugePageBytes - 1);
+  if (aligned > start) ::munmap(region, aligned - start);
+  if (const std::size_t tail = kHugePageBytes - (aligned - start); tail > 0) {
+    ::munmap(reinterpret_cast<std::byte*>(aligned) + bytes, tail);
+  }
+  frames_ = reinterpret_cast<std::byte*>(aligned);
+  frames_bytes_ = bytes;
+  if (huge_pages_advised()) ::madvise(frames_, bytes, MADV_HUGEPAGE);  // advice only
+  ::madvise(frames_, bytes, MADV_POPULATE_WRITE);  // where the kernel has it; else each 4 KiB at its first read
+  frame_stride_ = stride;
+  frame_count_ = frames;
+  if (frame_of_ == nullptr) {
+    frame_of_ = std::make_unique<std::atomic<std::uint32_t>[]>(page_count_);
+    for (std::size_t p = 0; p < page_count_; ++p) frame_of_[p].store(kNone, std::memory_order_relaxed);
+  }
+  pins_ = std::make_unique<std::atomic<std::uint32_t>[]>(frames);
+  frame_headed_at_ = std::make_unique<std::atomic<std::uint64_t>[]>(frames);
+  page_in_frame_.assign(frames, kNone);
+  frame_previous_.assign(frames, kNone);
+  frame_next_.assign(frames, kNone);
+  frame_head_ = frame_tail_ = kNone;
+  free_frames_.clear();
+  for (std::size_t f = frames; f-- > 0;) free_frames_.push_back(static_cast<std::uint32_t>(f));
+  frame_fresh_ticks_ = std::max<std::uint64_t>(frames / 4, 1);
+  size_mapped_pool_locked(mapped);
+  return true;
+}
+
+void FilePager::release_frames() {
+  if (frames_ != nullptr) ::munmap(frames_, frames_bytes_);
+  frames_ = nullptr;
+  frames_bytes_ = frame_stride_ = frame_count_ = 0;
+  free_frames_.clear();
+  frame_head_ = frame_tail_ = kNone;
+}
+
+void FilePager::unlink_frame_locked(std::uint32_t frame) {
+  const std::uint32_t before = frame_previous_[frame], after = frame_next_[frame];
+  (before == kNone ? frame_head_ : frame_next_[before]) = after;
+  (after == kNone ? frame_tail_ : frame_previous_[after]) = before;
+  frame_previous_[frame] = frame_next_[frame] = kNone;
+}
+
+void FilePager::push_frame_front_locked(std::uint32_t frame) {
+  frame_headed_at_[frame].store(frame_clock_.fetch_add(1, std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+  frame_previous_[frame] = kNone;
+  frame_next_[frame] = frame_head_;
+  if (frame_head_ != kNone) frame_previous_[frame_head_] = frame;
+  frame_head_ = frame;
+  if (frame_tail_ == kNone) frame_tail_ = frame;
+}
+
+bool FilePager::evict_frame_locked() {
+  // A pinned frame is passed over and put at the head, as read now: once round the list
+  // finds every frame pinned.
+  for (std::size_t tries = 0; tries < frame_count_ && frame_tail_ != kNone; ++tries) {
+    const std::uint32_t frame = frame_tail_, page = page_in_frame_[frame];
+    unlink_frame_locked(frame);
+    frame_of_[page].store(kNone, std::memory_order_seq_cst);
+    if (pins_[frame].load(std::memory_order_seq_cst) != 0) {
+      frame_of_[page].store(frame, std::memory_order_seq_cst);
+      push_frame_front_locked(frame);
+      continue;
+    }
+    page_in_frame_[frame] = kNone;
+    prefetched_[page].store(0, std::memory_order_relaxed);
+    free_frames_.push_back(frame);
+    return true;
+  }
+  return false;
+}
+
+std::uint32_t FilePager::load_frame(std::uint32_t page, std::uint64_t address_offset, std::unique_lock<std::mutex>& lock) {
+  std::optional<std::chrono::steady_clock::time_point> waiting_since;
+  for (;;) {
+    const std::uint32_t state = frame_of_[page].load(std::memory_order_relaxed);
+    if (state != kNone) count_prefetch_hit(page);
+    if (state != kNone && state != kLoading) {
+      if (frame_head_ != state) {
+        unlink_frame_locked(state);
+        push_frame_front_locked(state);
+      }
+      if (waiting_since) {
+        clients_[client_index()].wait_seconds +=
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - *waiting_since).count();
+      }
+      return state;
+    }
+    if (!waiting_since) waiting_since = std::chrono::steady_clock::now();
+    if (state == kLoading) {  // another thread reads this page
+      loaded_.wait(lock);
+      continue;
+    }
+    break;
+  }
+  if (free_frames_.empty() && !evict_frame_locked()) return kNone;
+  const std::uint32_t frame = free_frames_.back();
+  free_frames_.pop_back();
+  frame_of_[page].store(kLoading, std::memory_order_relaxed);
+  reads_in_flight_max_ = std::max(reads_in_flight_max_, ++reads_in_flight_);
+  lock.unlock();
+
+  // Straight into the frame: no buffer, no copy. A frame taken off the free list holds no
+  // pin but a fast-path reader's passing one, which finds the page gone and lets go.
+  double seconds = 0.0;
+  const std::string error = read_page(page, frame_bytes(frame), frame_stride_, seconds);
+
+  lock.lock();
+  --reads_in_flight_;
+  clients_[client_index()].wait_seconds +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - *waiting_since).count();
+  if (!error.empty()) {
+    free_frames_.push_back(frame);
+    frame_of_[page].store(kNone, std::memory_order_relaxed);
+    loaded_.notify_all();
+    throw std::runtime_error(error);
+  }
+  page_in_frame_[frame] = page;
+  frame_of_[page].store(frame, std::memory_order_release);
+  if (client_index() == prefetch_client_) prefetched_[page].store(1, std::memory_order_relaxed);
+  push_frame_front_locked(frame);
+  count_read_locked(page, address_offset, seconds, /*by_fault=*/false);
+  loaded_.notify_all();
+  return frame;
+}
+
+const std::byte* FilePager::pin(const void* address, std::uint32_t& frame) {
+  if (!contains(address) || frame_count_ == 0) return nullptr;
+  const std::uint32_t page = page_of(address);
+  if (page_trace_ != nullptr) page_trace_->record(page);
+  // Resident: pin, then make sure the page is still the frame's (an eviction between the
+  // two either saw the pin and kept the page, or this check sees it gone).
+  const std::uint32_t seen = frame_of_[page].load(std::memory_order_acquire);
+  if (seen < kLoading) {
+    pins_[seen].fetch_add(1, std::memory_order_seq_cst);
+    if (frame_of_[page].load(std::memory_order_seq_cst) == seen) {
+      frame = seen;
+      // Near the head of the LRU order: left where it is, no lock taken (as touch does).
+      if (frame_clock_.load(std::memory_order_relaxed) - frame_headed_at_[seen].load(std::memory_order_relaxed) <
+          frame_fresh_ticks_) {
+        count_prefetch_hit(page);
+        return frame_bytes(seen);
+      }
+      std::lock_guard lock(mutex_);  // pinned, it cannot leave its frame: only its place in the order moves
+      count_prefetch_hit(page);
+      if (frame_head_ != seen) {
+        unlink_frame_locked(seen);
+        push_frame_front_locked(seen);
+      }
+      return frame_bytes(seen);
+    }
+    pins_[seen].fetch_sub(1, std::memory_order_relaxed);
+  }
+  std::unique_lock lock(mutex_);
+  const std::uint32_t loaded = load_frame(page, offset_of(address), lock);
+  if (loaded == kNone) return nullptr;
+  pins_[loaded].fetch_add(1, std::memory_order_relaxed);  // under the lock: no eviction runs meanwhile
+  frame = loaded;
+  return frame_bytes(loaded);
 }
 
 bool FilePager::handle_fault(const void* address) noexcept {
@@ -472,6 +668,14 @@ bool FilePager::handle_fault(const void* address) noexcept {
 void FilePager::reset() {
   std::lock_guard lock(mutex_);
   while (tail_ != kNone) evict_tail_locked(kMaxEvictionGroup);
+  while (frame_tail_ != kNone) {
+    const std::uint32_t frame = frame_tail_;
+    unlink_frame_locked(frame);
+    frame_of_[page_in_frame_[frame]].store(kNone, std::memory_order_relaxed);
+    prefetched_[page_in_frame_[frame]].store(0, std::memory_order_relaxed);
+    page_in_frame_[frame] = kNone;
+    free_frames_.push_back(frame);
+  }
   for (DiskCounters& counters : clients_) counters = {};
   std::fill(part_faults_.begin(), part_faults_.end(), 0);
   prefetch_hits_.store(0, std::memory_order_relaxed);

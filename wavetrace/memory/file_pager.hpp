@@ -6,6 +6,8 @@
 // page no probe announced, which faults (SIGBUS or SIGSEGV on the reserved range) and is
 // loaded by the signal handler before the read is retried. Either way the bytes a reader
 // sees are the file's; an eviction racing a reader only costs that reader another fault.
+// With frames (use_frames), walks that ask for it read a page where it lies in a frame of
+// fixed address instead, pinned while they read it: no page is mapped or unmapped a read.
 #pragma once
 
 #include <cstddef>
@@ -79,6 +81,33 @@ class FilePager {
   void touch(const void* address);
   // Evicts every page and zeroes the counters, so a render starts from an empty pool.
   void reset();
+
+  // Frames: most of the budget becomes frames, buffers at addresses that never change, each
+  // holding one page and the file's next kFrameTailBytes after it, so that a record that
+  // starts in the page and runs on into the next (up to that much) reads whole. A page comes
+  // in by one direct read into a free frame and leaves by that frame's reuse: no page is
+  // mapped, copied or unmapped, and no 4 KiB of a frame is ever new to the MMU (in this
+  // virtual machine, a hypervisor exit of about 2 us each: 35 us of a 64 KiB page's read).
+  // Walks that read through pin() use them; every other read goes through the file's range
+  // as before, into the rest of the budget: a kMappedPoolShare-th of it, 2 to
+  // kMappedPoolMaxPages pages (a chunked world's top tree, a leaf no frame was free for).
+  // Switched only while the pool is empty and no reader runs (after reset); refused (false)
+  // for pages under kMinFramePageBytes, whose tail would cost over an eighth of each frame,
+  // and for budgets of fewer than kMinFrames frames.
+  static constexpr std::size_t kFrameTailBytes = 4096;
+  static constexpr std::size_t kMinFramePageBytes = 32 * 1024;
+  static constexpr std::size_t kMinFrames = 8;
+  static constexpr std::size_t kMappedPoolShare = 64, kMappedPoolMaxPages = 64;
+  bool use_frames(bool wanted);
+  bool framed() const { return frame_count_ > 0; }
+  std::size_t frame_count() const { return frame_count_; }
+  // Framed: makes the page holding `address` resident in a frame (reading it first if it is
+  // not) and pins it there until unpin(frame); returns where that frame shows the page's
+  // first byte, the page's bytes then the tail. Null where `address` is not the file's or
+  // every frame is pinned or being read (the caller then reads through the file's range).
+  // Thread-safe; throws std::runtime_error naming the file when the read fails.
+  const std::byte* pin(const void* address, std::uint32_t& frame);
+  void unpin(std::uint32_t frame) { pins_[frame].fetch_sub(1, std::memory_order_release); }
   // Every touch from now on is also recorded in `trace` (null: none). Set while no reader runs.
   void set_page_trace(PageTrace* trace) { page_trace_ = trace; }
 
@@ -107,7 +136,7 @@ class FilePager {
   // The most page reads under way at once since the last reset (one per thread reading).
   std::size_t reads_in_flight_max() const;
   std::size_t page_bytes() const { return page_bytes_; }
-  std::size_t budget_bytes() const { return slots_ * page_bytes_; }
+  std::size_t budget_bytes() const { return budget_pages_ * page_bytes_; }
   std::size_t page_count() const { return page_count_; }
 
   // The client this thread's faults count to while the scope lives.
@@ -135,7 +164,8 @@ class FilePager {
   // so the signal path never throws.
   std::string load(std::uint32_t page, std::uint64_t offset, std::unique_lock<std::mutex>& lock, bool by_fault = false);
   // load's two steps outside the lock: the page's bytes into a read buffer, then at its address.
-  std::string read_page(std::uint32_t page, std::byte* into, double& seconds) const;
+  // `bytes` (at most the page and a frame's tail) from the page's start; zero past the file's end.
+  std::string read_page(std::uint32_t page, std::byte* into, std::size_t bytes, double& seconds) const;
   std::string place_page(std::uint32_t page, std::uint32_t slot, const std::byte* into);
   // Where `page` starts, in the file and from base_ (the file starts on a page boundary).
   std::uint64_t offset_of_page(std::uint32_t page) const { return std::uint64_t(page) << page_shift_; }
@@ -153,6 +183,19 @@ class FilePager {
   }
   // Evicts the `count` least recently used pages (at most kMaxEvictionGroup) in one go.
   void evict_tail_locked(std::size_t count);
+  // Sizes the mapped pool to `slots` pages (empty, under the lock).
+  void size_mapped_pool_locked(std::size_t slots);
+  // Counts one page read for the calling thread's client.
+  void count_read_locked(std::uint32_t page, std::uint64_t address_offset, double seconds, bool by_fault);
+  // Framed: the frame holding `page`, read into one first if need be, moved to the head of
+  // the frames' LRU order; kNone when no frame could be freed. `lock` as in load().
+  std::uint32_t load_frame(std::uint32_t page, std::uint64_t address_offset, std::unique_lock<std::mutex>& lock);
+  // Frees the least recently used frame no reader has pinned; false when every one is.
+  bool evict_frame_locked();
+  void unlink_frame_locked(std::uint32_t frame);
+  void push_frame_front_locked(std::uint32_t frame);
+  std::byte* frame_bytes(std::uint32_t frame) const { return frames_ + std::size_t(frame) * frame_stride_; }
+  void release_frames();
   // A full pool evicts an eighth of itself, up to 8 pages, at a time: a shootdown per group,
   // not per fault. room:8M, hph_origin, 128 KiB pages (A/B, one run each): at 24% (140
   // slots) 14.7 s with 1, 12.1 with 4, 12.3 with 8, 13.3 with 16 (the pool partly idle); at
@@ -175,7 +218,8 @@ class FilePager {
   std::size_t page_bytes_;
   unsigned page_shift_;
   std::size_t reserved_bytes_;
-  std::size_t slots_;
+  std::size_t budget_pages_;  // the budget in pages
+  std::size_t slots_;         // the mapped pool's: the budget's pages, or with frames the mapped pool's share
   int direct_fd_ = -1;  // the file, O_DIRECT
   int fault_fd_ = -1;   // the userfaultfd the range is registered with (PageMapping::userfaultfd)
   int pool_fd_ = -1;    // the memfd of page slots (PageMapping::memfd)
@@ -212,6 +256,22 @@ class FilePager {
   std::vector<std::uint64_t> part_faults_;       // clients_.size() rows of part_names_.size()
   RayWindowCounters ray_windows_;
   PageTrace* page_trace_ = nullptr;
+
+  // Frames (use_frames): frame_count_ buffers of frame_stride_ bytes from frames_.
+  std::byte* frames_ = nullptr;
+  std::size_t frames_bytes_ = 0, frame_stride_ = 0, frame_count_ = 0;
+  // Per page: its frame, kNone, or kLoading while a thread reads it into one. Read without
+  // the lock by pin's fast path, which pins the frame and then checks the page is still
+  // there; eviction marks the page gone and then checks the frame is unpinned (both seq_cst:
+  // one of the two sees the other).
+  std::unique_ptr<std::atomic<std::uint32_t>[]> frame_of_;
+  std::unique_ptr<std::atomic<std::uint32_t>[]> pins_;          // per frame: readers holding it
+  std::atomic<std::uint64_t> frame_clock_{0};  // the frames' LRU clock, as lru_clock_
+  std::unique_ptr<std::atomic<std::uint64_t>[]> frame_headed_at_;  // per frame, on frame_clock_
+  std::vector<std::uint32_t> page_in_frame_, frame_previous_, frame_next_;  // per frame; the frames' LRU list
+  std::uint32_t frame_head_ = kNone, frame_tail_ = kNone;
+  std::vector<std::uint32_t> free_frames_;
+  std::uint64_t frame_fresh_ticks_ = 1;
 };
 
 }  // namespace wavetrace

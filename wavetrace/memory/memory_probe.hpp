@@ -24,6 +24,11 @@ struct NullProbe {
   static constexpr bool counts_reads() { return false; }
   void read(const void*, std::size_t) {}
   void announce(const void*) {}
+  template <typename T>
+  const T* resident(const T* address, std::size_t) { return address; }
+  const std::byte* resident_record(const std::byte* address, std::size_t) { return address; }
+  void record_read(const void*, std::size_t) {}
+  void end_ray() {}
 };
 
 // What a run observes: the shared page pool and one simulated cache per thread, each
@@ -51,11 +56,13 @@ class RecordingProbe {
     if (file_pager_ != nullptr) {
       file_page_shift_ = static_cast<unsigned>(std::countr_zero(file_pager_->page_bytes()));
       client_scope_.emplace(client);  // faults this thread takes count to this stage
+      framed_ = file_pager_->framed();
     }
   }
   RecordingProbe(const RecordingProbe&) = delete;
   RecordingProbe& operator=(const RecordingProbe&) = delete;
   ~RecordingProbe() {
+    end_ray();
     if (pager_ != nullptr && repeated_page_reads_ > 0) pager_->add_accesses(repeated_page_reads_, client_);
     if (file_pager_ != nullptr && windows_.windows > 0) file_pager_->add_ray_windows(windows_);
   }
@@ -94,7 +101,6 @@ class RecordingProbe {
 
   void read(const void* address, std::size_t bytes) {
     if (tally_ != nullptr) tally_->count(thread_, address);
-    if (cache_ != nullptr) cache_->access(address, bytes, client_);
     if (file_pager_ != nullptr) {
       // The page is loaded now, before the read it announces; a page change is a touch.
       const auto first = reinterpret_cast<std::uintptr_t>(address) >> file_page_shift_;
@@ -103,6 +109,50 @@ class RecordingProbe {
       if (last != first) touch_file_page(static_cast<const std::byte*>(address) + bytes - 1, last);
       last_file_page_ = last;
     }
+    observe_read(address, bytes);
+  }
+
+  // Walks that read through these may be given the bytes in a pager's frame (file_pager.hpp,
+  // "Frames") instead of at `address`: they read there, and keep what they got until
+  // end_ray(), which lets the frames go. Unframed, these are read() and announce().
+  // A read of `bytes` (at most FilePager::kFrameTailBytes) at `address`: where to read them.
+  template <typename T>
+  const T* resident(const T* address, std::size_t bytes) {
+    if (!framed_ || bytes > FilePager::kFrameTailBytes) {
+      read(address, bytes);
+      return address;
+    }
+    if (tally_ != nullptr) tally_->count(thread_, address);
+    observe_read(address, bytes);
+    return reinterpret_cast<const T*>(in_frame(reinterpret_cast<const std::byte*>(address)));
+  }
+  // A read that starts at `address` and whose size only the read tells, at most `max_bytes`
+  // (at most FilePager::kFrameTailBytes): where to read it. record_read() follows, with the size.
+  const std::byte* resident_record(const std::byte* address, [[maybe_unused]] std::size_t max_bytes) {
+    if (!framed_) {
+      announce(address);
+      return address;
+    }
+    return in_frame(address);
+  }
+  void record_read(const void* address, std::size_t bytes) {
+    if (!framed_) return read(address, bytes);
+    if (tally_ != nullptr) tally_->count(thread_, address);
+    observe_read(address, bytes);
+  }
+  // The walk of one ray is done: the frames it read are let go.
+  void end_ray() {
+    for (std::size_t k = 0; k < pinned_count_; ++k) {
+      if (pinned_[k].frame != kNoFrame) file_pager_->unpin(pinned_[k].frame);
+    }
+    pinned_count_ = 0;
+    current_pinned_ = kNoFilePage;
+  }
+
+ private:
+  // The reads the cache and the simulated pager count (not the real pager's).
+  void observe_read(const void* address, std::size_t bytes) {
+    if (cache_ != nullptr) cache_->access(address, bytes, client_);
     if (pager_ == nullptr) return;
     const std::uint32_t first = pager_->page_of(address);
     const std::uint32_t last = pager_->page_of(static_cast<const std::byte*>(address) + bytes - 1);
@@ -110,7 +160,35 @@ class RecordingProbe {
     if (last != first) read_page(last);  // reads are far smaller than a page: two at most
   }
 
- private:
+  // Where `address` reads in a frame, the frame pinned for this ray: the page read last
+  // without a look, one this ray pinned before by a short search, else a pin. Where the
+  // address is not the file's, or no frame is free (or this ray holds kMaxPinned already),
+  // it reads where it is (through the file's range: the pager's mapped pool).
+  const std::byte* in_frame(const std::byte* address) {
+    const auto page = reinterpret_cast<std::uintptr_t>(address) >> file_page_shift_;
+    if (page == current_pinned_) return address + current_offset_;
+    if (counting_windows_) note_window_page(page);
+    for (std::size_t k = 0; k < pinned_count_; ++k) {
+      if (pinned_[k].page == page) {
+        current_pinned_ = page;
+        current_offset_ = pinned_[k].offset;
+        return address + current_offset_;
+      }
+    }
+    Pinned pinned{page, kNoFrame, 0};
+    const std::byte* frame = pinned_count_ < kMaxPinned ? file_pager_->pin(address, pinned.frame) : nullptr;
+    if (frame != nullptr) {
+      pinned.offset = frame - reinterpret_cast<const std::byte*>(page << file_page_shift_);
+    } else {
+      file_pager_->touch(address);  // ignored where the address is not the file's
+    }
+    if (pinned_count_ < kMaxPinned) pinned_[pinned_count_++] = pinned;
+    current_pinned_ = page;
+    current_offset_ = pinned.offset;
+    return address + current_offset_;
+  }
+
+
   // The real pager loads `page` (holding `address`) or marks it recently used.
   void touch_file_page(const void* address, std::uintptr_t page) {
     file_pager_->touch(address);
@@ -159,6 +237,21 @@ class RecordingProbe {
   bool counting_windows_ = false;
   std::uint32_t last_page_ = SimulatedPager::kNoPage;
   std::uint64_t repeated_page_reads_ = 0;
+
+  // Frames this ray reads (in_frame): each page's offset from the file's address to the
+  // frame's (0 where it reads in place) and its frame (kNoFrame then).
+  static constexpr std::size_t kMaxPinned = 32;
+  static constexpr std::uint32_t kNoFrame = ~std::uint32_t{0};
+  struct Pinned {
+    std::uintptr_t page;
+    std::uint32_t frame;
+    std::ptrdiff_t offset;
+  };
+  bool framed_ = false;
+  std::array<Pinned, kMaxPinned> pinned_;
+  std::size_t pinned_count_ = 0;
+  std::uintptr_t current_pinned_ = kNoFilePage;
+  std::ptrdiff_t current_offset_ = 0;
 };
 
 }  // namespace wavetrace

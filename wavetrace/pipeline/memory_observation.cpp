@@ -9,10 +9,11 @@
 namespace wavetrace {
 
 MemoryObservation::MemoryObservation(const MemoryPlan& plan, std::vector<std::span<const std::byte>> world,
-                                     int threads, FilePager* file_pager)
+                                     int threads, FilePager* file_pager, bool reads_through_frames)
     : file_pager_(file_pager) {
   if (file_pager_ != nullptr) {
     file_pager_->reset();
+    file_pager_->use_frames(plan.page_frames && reads_through_frames);
     file_pager_->set_prefetch_client(kLookAheadClient);
     if (!plan.page_trace.empty()) {
       page_trace_ = std::make_unique<PageTrace>(plan.page_trace);
@@ -43,6 +44,7 @@ void MemoryObservation::report(std::vector<StageStats>& stages) const {
       if (file_pager_) {
         stage.disk.emplace();
         stage.disk->mapping = file_pager_->mapping();
+        stage.disk->frames = file_pager_->frame_count();
         stage.disk->page_bytes = file_pager_->page_bytes();
         stage.disk->budget_bytes = file_pager_->budget_bytes();
         stage.disk->counters = file_pager_->counters(client);

@@ -24,6 +24,7 @@ struct MemoryPlan {
   bool copy_world = false;             // memory.backing = copy: a world file copied onto huge pages
   std::size_t page_bytes = std::size_t{4} << 20;
   PageMapping page_mapping = PageMapping::automatic;  // real paging: how resident pages appear (memory/page_mapping.hpp)
+  bool page_frames = true;  // real paging: walks that can read pages in frames (FilePager::use_frames)
   // Real paging: sorted batches queued for trace whose pages its look-ahead reads first (0: none).
   std::size_t look_ahead_batches = 0;
   // Threads reading ahead, each on its own queued batch: reads in flight beside trace's own.
@@ -38,10 +39,11 @@ struct MemoryPlan {
 
 class MemoryObservation {
  public:
-  // `file_pager`: the real pager of a paged world file, emptied here so each render starts
-  // cold, or null.
+  // `file_pager`: the real pager of a paged world file, or null; emptied here so each render
+  // starts cold, and its pages kept in frames where the plan allows it and the world's walks
+  // read through frames (`reads_through_frames`, Accelerator::reads_through_frames).
   MemoryObservation(const MemoryPlan& plan, std::vector<std::span<const std::byte>> world, int threads,
-                    FilePager* file_pager = nullptr);
+                    FilePager* file_pager = nullptr, bool reads_through_frames = false);
   ~MemoryObservation();  // detaches and writes the page trace
   MemoryObservation(const MemoryObservation&) = delete;
   MemoryObservation& operator=(const MemoryObservation&) = delete;

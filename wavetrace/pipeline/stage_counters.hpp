@@ -23,6 +23,7 @@ struct PagerStats {
 
 struct DiskStats {
   PageMapping mapping = PageMapping::memfd;
+  std::size_t frames = 0;  // pages of the pool held in frames (FilePager::use_frames); 0: none
   std::size_t page_bytes = 0;
   std::size_t budget_bytes = 0;
   // For trace, its look-ahead's reads included (faults, bytes, read seconds, by part); the

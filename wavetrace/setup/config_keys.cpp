@@ -411,6 +411,12 @@ const std::vector<ConfigKey>& config_schema() {
        "them changing the process's mappings; at most 30,000 pages resident); auto: userfaultfd where the kernel "
        "allows it, else memfd",
        read_page_mapping},
+      {"memory.page_frames", T::boolean, true, 0, 0, {},
+       "real paging: walks that can (hmq:width=8's, chunked or not) read resident pages in frames of fixed address, "
+       "each page read straight into one and left there until its frame is reused, with no page mapped or unmapped "
+       "(pages of 32 KiB or more; other reads go through memory.page_mapping's range, a 64th of the budget); "
+       "false: every read through that range",
+       boolean<&P::memory, &MemoryPlan::page_frames>},
       {"memory.look_ahead", T::integer, std::int64_t{0}, 0, 64, {},
        "real paging (memory.backing = file): how many of the sorted batches queued for trace a thread of its own "
        "traces ahead (every 4th ray, hits thrown away) so that their pages are read before trace needs them; 0: none "

@@ -105,7 +105,8 @@ RenderOutput render_image(const RenderPlan& plan, const World& world, const Came
       if (world.proxy != nullptr && plan.needs_proxy()) {
         for (const auto& span : world.proxy->accelerator().memory_spans()) spans.push_back(span);
       }
-      observation.emplace(plan.memory, std::move(spans), workers, plan.memory.file_backing ? world.pager : nullptr);
+      observation.emplace(plan.memory, std::move(spans), workers, plan.memory.file_backing ? world.pager : nullptr,
+                          world.accelerator.reads_through_frames());
     } else {
       output.memory_unobserved = fmt::format("accelerator '{}' cannot report its memory reads: no pager or cache counters",
                                              world.accelerator.name());

@@ -123,8 +123,7 @@ template <KernelIsa kIsa, typename Probe, typename VisitLeaf, typename LeafAddre
   Bounds3 frame = root_frame;
   while (true) {
     if (!(current & kWideLeafReference)) {
-      const QuantizedWideNode& node = nodes[current];
-      probe.read(&node, sizeof node);
+      const QuantizedWideNode& node = *probe.resident(nodes + current, sizeof(QuantizedWideNode));
       __m256 bound[6], near;
       decode_children(node, frame, bound);
       const unsigned entered_mask =
@@ -215,8 +214,7 @@ template <KernelIsa kIsa, typename Probe, typename VisitLeaf>
   std::uint32_t top = 0;
   while (true) {
     if (!(current.reference & kWideLeafReference)) {
-      const QuantizedWideNode& node = nodes[current.reference];
-      probe.read(&node, sizeof node);
+      const QuantizedWideNode& node = *probe.resident(nodes + current.reference, sizeof(QuantizedWideNode));
       __m256 bound[6];
       decode_children(node, current.frame, bound);
       const unsigned occupied = occupied_slots(node);

@@ -285,6 +285,8 @@ class ChunkedAccelerator final : public Accelerator, public ChunkSet {
                  [](const Accelerator& sub, const RayBatch& r, HitBatch& h, RayRange g) { sub.intersect_coherent(r, h, g); });
   }
   bool probed() const override { return chunks_.front().accelerator->probed(); }
+  // Its top tree is read in place (a few pages, which the mapped pool keeps), its chunks as they read.
+  bool reads_through_frames() const override { return chunks_.front().accelerator->reads_through_frames(); }
   // Probed rounds report the reads of the chunks answered here; a router's chunks are read
   // (and counted) by their owners.
   void intersect_closest_probed(const RayBatch& rays, HitBatch& hits, RayRange range,

@@ -51,6 +51,7 @@
 //   A vertex is the global grid point of its three lines, in floats: origin + line * cell.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
 
@@ -62,6 +63,12 @@ inline constexpr std::uint32_t kMaxBlockSlots = 64;
 inline constexpr std::uint32_t kInnerBit = 1u << 30;
 inline constexpr std::uint32_t kBlockHeaderBytes = 4;
 inline constexpr std::uint32_t kLeafHeaderBytes = 9;
+// No leaf record, with the slack its decode reads past it, is longer: the header's fields
+// bound it. 9 header bytes; three offset streams of at most 63 vertices of 32 bits (756
+// bytes); indices of at most 42 slots (14 one-triangle strips) of 7 bits (37); ids of 14
+// triangles of 31 bits (55); corners of 14 of 3 bits (6); 3 bytes read past the last: 866.
+// A paged walk reads a record from a frame whose tail holds this much of the next page.
+inline constexpr std::size_t kMaxLeafRecordBytes = 1024;
 
 struct Box {
   glm::vec3 lower, upper;

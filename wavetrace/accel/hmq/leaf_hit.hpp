@@ -76,11 +76,13 @@ template <typename Probe>
 [[gnu::always_inline]] inline void prepare_leaf(const std::byte* record, const GlobalGrid& grid, const Box& box,
                                                 LeafTriangles& leaf, Probe& probe) {
   DecodedLeaf& decoded = leaf.decoded;
-  // Its first page announced before the decode reads it, its size reported after, by the
-  // decode that finds it (a record ending on the next page faults that page in).
-  if constexpr (Probe::kRecords) probe.announce(record);
-  decode_leaf(record, grid, snap_outward(grid, box), decoded);
-  if constexpr (Probe::kRecords) probe.read(record, std::size_t(decoded.end() - record));
+  // Its first page announced before the decode reads it (paged in frames, where the probe
+  // says), its size reported after, by the decode that finds it (a record ending on the next
+  // page faults that page in, but in a frame, whose tail holds it).
+  const std::byte* bytes = record;
+  if constexpr (Probe::kRecords) bytes = probe.resident_record(record, kMaxLeafRecordBytes);
+  decode_leaf(bytes, grid, snap_outward(grid, box), decoded);
+  if constexpr (Probe::kRecords) probe.record_read(record, std::size_t(decoded.end() - bytes));
 #if WAVETRACE_AVX2
   const StripLayoutEntry& layout = *decoded.layout;
   const __m256i index_mask = _mm256_set1_epi32(63);  // lanes past the last triangle pick in bounds

@@ -273,6 +273,7 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
   }
 
   std::string name() const override { return "hmq8"; }
+  bool reads_through_frames() const override { return true; }
 
   // Camera rays eight at a time (two 2x2 quads): nodes decoded once a packet, leaves decoded
   // and gathered once a packet, each ray tested against them alone (the same hits as single
@@ -356,6 +357,7 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
         return kAnyHit && best.found;
       }, [&](std::uint32_t units) { return leaves + std::size_t(units) * kUnit; });
       write_leaf_hit<!kAnyHit>(best, hits, i);
+      probe.end_ray();  // best's streams were read from the frames the probe let go here
     });
   }
 
