@@ -1,7 +1,7 @@
 // The real pager: the file's range reserved once, pages copied into it on demand (by
 // userfaultfd, or as memfd slots mapped over it), a SIGBUS and SIGSEGV handler for reads no
-// probe announced. Reads happen outside the pool's lock: threads reading different pages keep
-// that many reads in flight.
+// probe announced, and frames that walks read in place of the range. Reads happen outside
+// the pool's lock: threads reading different pages keep that many reads in flight.
 #include "wavetrace/memory/file_pager.hpp"
 #include "wavetrace/memory/page_trace.hpp"
 #include "wavetrace/memory/cache_aligned_allocator.hpp"  // kHugePageBytes, huge_pages_advised

@@ -26,7 +26,8 @@ struct NullProbe {
   void announce(const void*) {}
   template <typename T>
   const T* resident(const T* address, std::size_t) { return address; }
-  const std::byte* resident_record(const std::byte* address, std::size_t) { return address; }
+  template <std::size_t kMaxBytes>
+  const std::byte* resident_record(const std::byte* address) { return address; }
   void record_read(const void*, std::size_t) {}
   void end_ray() {}
 };
@@ -126,9 +127,11 @@ class RecordingProbe {
     observe_read(address, bytes);
     return reinterpret_cast<const T*>(in_frame(reinterpret_cast<const std::byte*>(address)));
   }
-  // A read that starts at `address` and whose size only the read tells, at most `max_bytes`
-  // (at most FilePager::kFrameTailBytes): where to read it. record_read() follows, with the size.
-  const std::byte* resident_record(const std::byte* address, [[maybe_unused]] std::size_t max_bytes) {
+  // A read that starts at `address` and whose size only the read tells, at most kMaxBytes:
+  // where to read it. record_read() follows, with the size.
+  template <std::size_t kMaxBytes>
+  const std::byte* resident_record(const std::byte* address) {
+    static_assert(kMaxBytes <= FilePager::kFrameTailBytes, "a frame's tail holds the part of a record past its page");
     if (!framed_) {
       announce(address);
       return address;
@@ -187,7 +190,6 @@ class RecordingProbe {
     current_offset_ = pinned.offset;
     return address + current_offset_;
   }
-
 
   // The real pager loads `page` (holding `address`) or marks it recently used.
   void touch_file_page(const void* address, std::uintptr_t page) {

@@ -80,7 +80,7 @@ template <typename Probe>
   // says), its size reported after, by the decode that finds it (a record ending on the next
   // page faults that page in, but in a frame, whose tail holds it).
   const std::byte* bytes = record;
-  if constexpr (Probe::kRecords) bytes = probe.resident_record(record, kMaxLeafRecordBytes);
+  if constexpr (Probe::kRecords) bytes = probe.template resident_record<kMaxLeafRecordBytes>(record);
   decode_leaf(bytes, grid, snap_outward(grid, box), decoded);
   if constexpr (Probe::kRecords) probe.record_read(record, std::size_t(decoded.end() - bytes));
 #if WAVETRACE_AVX2
