@@ -397,8 +397,8 @@ const std::vector<ConfigKey>& config_schema() {
        "(512MiB, 2GB); not accel.memory_budget, which bounds the whole process for auto",
        read_memory_budget},
       {"memory.page_bytes", T::integer, std::int64_t{4} << 20, 4096, std::int64_t{1} << 30, {},
-       "page size of the pool in bytes, a power of two (the paper: 4 MiB; real paging of room:8M on this project's "
-       "machines is fastest at 64 KiB: docs/measurements.md)",
+       "page size of the pool in bytes, a power of two (the paper: 4 MiB; real paging of room:64M on this project's "
+       "machines is fastest at 256 KiB with memory.page_frames, 64 KiB without: docs/measurements.md)",
        integer<&P::memory, &MemoryPlan::page_bytes>},
       {"memory.backing", T::text, std::string("memory"), 0, 0, {"memory", "copy", "file"},
        "where a world file's pages live: memory (mapped, the OS pages it), copy (read whole into memory on 2 MiB "
