@@ -420,6 +420,31 @@ TEST_P(FilePagerTest, FramesShowTheFileToManyReadersAtOnce) {
   std::filesystem::remove(path);
 }
 
+// A read into a frame that finds the file cut short: an exception naming the file, and the
+// frame free again for the pages that are still there.
+TEST_P(FilePagerTest, AFileCutShortWhileReadIntoFramesIsAClearErrorNamingIt) {
+  constexpr std::size_t kBlocks = 32 * kBlocksPerFramePage;
+  const std::string path = numbered_file("pager_frames_truncated.bin", kBlocks);
+  FilePager pager(path, kBlocks * kPage, kFramePage, kFrameBudget, 1, GetParam());
+  ASSERT_TRUE(pager.use_frames(true));
+  std::filesystem::resize_file(path, 4 * kFramePage);
+  std::uint32_t frame = 0;
+  try {
+    pager.pin(pager.base() + 20 * kFramePage, frame);
+    ADD_FAILURE() << "a read past the file's new end succeeded";
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find(path + ": reading page 20"), std::string::npos) << error.what();
+    EXPECT_NE(std::string(error.what()).find("the file ends early"), std::string::npos) << error.what();
+  }
+  for (std::size_t page = 0; page < 3; ++page) {  // every frame but the failed read's is still free
+    const std::byte* shown = pager.pin(pager.base() + page * kFramePage, frame);
+    ASSERT_NE(shown, nullptr);
+    EXPECT_EQ(reinterpret_cast<const std::uint32_t*>(shown)[5], page * kBlocksPerFramePage * 1000 + 5);
+    pager.unpin(frame);
+  }
+  std::filesystem::remove(path);
+}
+
 TEST_P(FilePagerDeathTest, AFileCutShortWhilePagedIsAClearErrorNamingIt) {
   GTEST_FLAG_SET(death_test_style, "threadsafe");
   const std::string path = numbered_file("pager_truncated.bin");
