@@ -211,12 +211,10 @@ FilePager::FilePager(const std::string& path, std::uint64_t file_bytes, std::siz
   }
   page_count_ = pages;
   slot_of_ = std::make_unique<std::atomic<std::uint32_t>[]>(pages);
-  headed_at_ = std::make_unique<std::atomic<std::uint64_t>[]>(pages);
   prefetched_ = std::make_unique<std::atomic<std::uint8_t>[]>(pages);
   for (std::size_t p = 0; p < pages; ++p) slot_of_[p].store(kNone, std::memory_order_relaxed);
   self_pidfd_ = static_cast<int>(::syscall(SYS_pidfd_open, ::getpid(), 0));
-  previous_.assign(pages, kNone);
-  next_.assign(pages, kNone);
+  mapped_order_.reset(pages);
   size_mapped_pool_locked(budget_pages_);
   clients_.resize(clients + 1);
   part_faults_.assign(clients_.size() * part_names_.size(), 0);
@@ -258,28 +256,35 @@ std::size_t FilePager::client_index() const {
   return current_client < clients_.size() - 1 ? current_client : clients_.size() - 1;
 }
 
-void FilePager::unlink_locked(std::uint32_t page) {
-  const std::uint32_t before = previous_[page], after = next_[page];
-  (before == kNone ? head_ : next_[before]) = after;
-  (after == kNone ? tail_ : previous_[after]) = before;
-  previous_[page] = next_[page] = kNone;
+void FilePager::LruOrder::reset(std::size_t entries) {
+  previous.assign(entries, kNone);
+  next.assign(entries, kNone);
+  head = tail = kNone;
+  headed_at = std::make_unique<std::atomic<std::uint64_t>[]>(entries);
 }
 
-void FilePager::push_front_locked(std::uint32_t page) {
-  headed_at_[page].store(lru_clock_.fetch_add(1, std::memory_order_relaxed) + 1, std::memory_order_relaxed);
-  previous_[page] = kNone;
-  next_[page] = head_;
-  if (head_ != kNone) previous_[head_] = page;
-  head_ = page;
-  if (tail_ == kNone) tail_ = page;
+void FilePager::LruOrder::unlink(std::uint32_t entry) {
+  const std::uint32_t before = previous[entry], after = next[entry];
+  (before == kNone ? head : next[before]) = after;
+  (after == kNone ? tail : previous[after]) = before;
+  previous[entry] = next[entry] = kNone;
+}
+
+void FilePager::LruOrder::push_front(std::uint32_t entry) {
+  headed_at[entry].store(clock.fetch_add(1, std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+  previous[entry] = kNone;
+  next[entry] = head;
+  if (head != kNone) previous[head] = entry;
+  head = entry;
+  if (tail == kNone) tail = entry;
 }
 
 void FilePager::evict_tail_locked(std::size_t count) {
   std::array<std::uint32_t, kMaxEvictionGroup> victims;
   std::size_t taken = 0;
-  for (; taken < std::min(count, kMaxEvictionGroup) && tail_ != kNone; ++taken) {
-    victims[taken] = tail_;
-    unlink_locked(tail_);
+  for (; taken < std::min(count, kMaxEvictionGroup) && !mapped_order_.empty(); ++taken) {
+    victims[taken] = mapped_order_.tail;
+    mapped_order_.unlink(mapped_order_.tail);
   }
   if (taken == 0) return;
   // Unmapping a page that a thread may have in its TLB costs a shootdown (an interrupt to
@@ -391,10 +396,7 @@ std::string FilePager::load(std::uint32_t page, std::uint64_t address_offset, st
     const std::uint32_t state = slot_of_[page].load(std::memory_order_relaxed);
     if (state != kNone) count_prefetch_hit(page);
     if (state != kNone && state != kLoading) {
-      if (head_ != page) {
-        unlink_locked(page);
-        push_front_locked(page);
-      }
+      mapped_order_.move_to_front(page);
       if (waiting_since) {
         clients_[client_index()].wait_seconds +=
             std::chrono::duration<double>(std::chrono::steady_clock::now() - *waiting_since).count();
@@ -403,7 +405,7 @@ std::string FilePager::load(std::uint32_t page, std::uint64_t address_offset, st
     }
     if (!waiting_since) waiting_since = std::chrono::steady_clock::now();
     // Another thread reads this page, or every slot is taken by reads under way: wait.
-    if (state == kLoading || (free_slots_.empty() && tail_ == kNone)) {
+    if (state == kLoading || (free_slots_.empty() && mapped_order_.empty())) {
       loaded_.wait(lock);
       continue;
     }
@@ -435,7 +437,7 @@ std::string FilePager::load(std::uint32_t page, std::uint64_t address_offset, st
   } else {
     slot_of_[page].store(slot, std::memory_order_relaxed);
     if (client_index() == prefetch_client_) prefetched_[page].store(1, std::memory_order_relaxed);
-    push_front_locked(page);
+    mapped_order_.push_front(page);
     count_read_locked(page, address_offset, seconds, by_fault);
   }
   loaded_.notify_all();
@@ -458,8 +460,7 @@ void FilePager::touch(const void* address) {
   // Resident and near the LRU head: nothing to do, and no lock taken. Should the page be
   // evicted right after this check, the read it announces faults and loads it again.
   const std::uint32_t slot = slot_of_[page].load(std::memory_order_relaxed);
-  if (slot < kLoading &&
-      lru_clock_.load(std::memory_order_relaxed) - headed_at_[page].load(std::memory_order_relaxed) < fresh_ticks_) {
+  if (slot < kLoading && mapped_order_.fresh(page, fresh_ticks_)) {
     count_prefetch_hit(page);
     return;
   }
@@ -469,7 +470,7 @@ void FilePager::touch(const void* address) {
 
 bool FilePager::use_frames(bool wanted) {
   std::lock_guard lock(mutex_);
-  if (tail_ != kNone || frame_tail_ != kNone || reads_in_flight_ > 0) {
+  if (!mapped_order_.empty() || !frame_order_.empty() || reads_in_flight_ > 0) {
     throw std::logic_error(fmt::format("{}: frames switched while pages are resident", path_));
   }
   release_frames();
@@ -504,11 +505,8 @@ bool FilePager::use_frames(bool wanted) {
     for (std::size_t p = 0; p < page_count_; ++p) frame_of_[p].store(kNone, std::memory_order_relaxed);
   }
   pins_ = std::make_unique<std::atomic<std::uint32_t>[]>(frames);
-  frame_headed_at_ = std::make_unique<std::atomic<std::uint64_t>[]>(frames);
   page_in_frame_.assign(frames, kNone);
-  frame_previous_.assign(frames, kNone);
-  frame_next_.assign(frames, kNone);
-  frame_head_ = frame_tail_ = kNone;
+  frame_order_.reset(frames);
   free_frames_.clear();
   for (std::size_t f = frames; f-- > 0;) free_frames_.push_back(static_cast<std::uint32_t>(f));
   frame_fresh_ticks_ = std::max<std::uint64_t>(frames / 4, 1);
@@ -521,35 +519,19 @@ void FilePager::release_frames() {
   frames_ = nullptr;
   frames_bytes_ = frame_stride_ = frame_count_ = 0;
   free_frames_.clear();
-  frame_head_ = frame_tail_ = kNone;
-}
-
-void FilePager::unlink_frame_locked(std::uint32_t frame) {
-  const std::uint32_t before = frame_previous_[frame], after = frame_next_[frame];
-  (before == kNone ? frame_head_ : frame_next_[before]) = after;
-  (after == kNone ? frame_tail_ : frame_previous_[after]) = before;
-  frame_previous_[frame] = frame_next_[frame] = kNone;
-}
-
-void FilePager::push_frame_front_locked(std::uint32_t frame) {
-  frame_headed_at_[frame].store(frame_clock_.fetch_add(1, std::memory_order_relaxed) + 1, std::memory_order_relaxed);
-  frame_previous_[frame] = kNone;
-  frame_next_[frame] = frame_head_;
-  if (frame_head_ != kNone) frame_previous_[frame_head_] = frame;
-  frame_head_ = frame;
-  if (frame_tail_ == kNone) frame_tail_ = frame;
+  frame_order_.reset(0);
 }
 
 bool FilePager::evict_frame_locked() {
   // A pinned frame is passed over and put at the head, as read now: once round the list
   // finds every frame pinned.
-  for (std::size_t tries = 0; tries < frame_count_ && frame_tail_ != kNone; ++tries) {
-    const std::uint32_t frame = frame_tail_, page = page_in_frame_[frame];
-    unlink_frame_locked(frame);
+  for (std::size_t tries = 0; tries < frame_count_ && !frame_order_.empty(); ++tries) {
+    const std::uint32_t frame = frame_order_.tail, page = page_in_frame_[frame];
+    frame_order_.unlink(frame);
     frame_of_[page].store(kNone, std::memory_order_seq_cst);
     if (pins_[frame].load(std::memory_order_seq_cst) != 0) {
       frame_of_[page].store(frame, std::memory_order_seq_cst);
-      push_frame_front_locked(frame);
+      frame_order_.push_front(frame);
       continue;
     }
     page_in_frame_[frame] = kNone;
@@ -566,10 +548,7 @@ std::uint32_t FilePager::load_frame(std::uint32_t page, std::uint64_t address_of
     const std::uint32_t state = frame_of_[page].load(std::memory_order_relaxed);
     if (state != kNone) count_prefetch_hit(page);
     if (state != kNone && state != kLoading) {
-      if (frame_head_ != state) {
-        unlink_frame_locked(state);
-        push_frame_front_locked(state);
-      }
+      frame_order_.move_to_front(state);
       if (waiting_since) {
         clients_[client_index()].wait_seconds +=
             std::chrono::duration<double>(std::chrono::steady_clock::now() - *waiting_since).count();
@@ -608,7 +587,7 @@ std::uint32_t FilePager::load_frame(std::uint32_t page, std::uint64_t address_of
   page_in_frame_[frame] = page;
   frame_of_[page].store(frame, std::memory_order_release);
   if (client_index() == prefetch_client_) prefetched_[page].store(1, std::memory_order_relaxed);
-  push_frame_front_locked(frame);
+  frame_order_.push_front(frame);
   count_read_locked(page, address_offset, seconds, /*by_fault=*/false);
   loaded_.notify_all();
   return frame;
@@ -626,17 +605,13 @@ const std::byte* FilePager::pin(const void* address, std::uint32_t& frame) {
     if (frame_of_[page].load(std::memory_order_seq_cst) == seen) {
       frame = seen;
       // Near the head of the LRU order: left where it is, no lock taken (as touch does).
-      if (frame_clock_.load(std::memory_order_relaxed) - frame_headed_at_[seen].load(std::memory_order_relaxed) <
-          frame_fresh_ticks_) {
+      if (frame_order_.fresh(seen, frame_fresh_ticks_)) {
         count_prefetch_hit(page);
         return frame_bytes(seen);
       }
       std::lock_guard lock(mutex_);  // pinned, it cannot leave its frame: only its place in the order moves
       count_prefetch_hit(page);
-      if (frame_head_ != seen) {
-        unlink_frame_locked(seen);
-        push_frame_front_locked(seen);
-      }
+      frame_order_.move_to_front(seen);
       return frame_bytes(seen);
     }
     pins_[seen].fetch_sub(1, std::memory_order_relaxed);
@@ -667,10 +642,10 @@ bool FilePager::handle_fault(const void* address) noexcept {
 
 void FilePager::reset() {
   std::lock_guard lock(mutex_);
-  while (tail_ != kNone) evict_tail_locked(kMaxEvictionGroup);
-  while (frame_tail_ != kNone) {
-    const std::uint32_t frame = frame_tail_;
-    unlink_frame_locked(frame);
+  while (!mapped_order_.empty()) evict_tail_locked(kMaxEvictionGroup);
+  while (!frame_order_.empty()) {
+    const std::uint32_t frame = frame_order_.tail;
+    frame_order_.unlink(frame);
     frame_of_[page_in_frame_[frame]].store(kNone, std::memory_order_relaxed);
     prefetched_[page_in_frame_[frame]].store(0, std::memory_order_relaxed);
     page_in_frame_[frame] = kNone;

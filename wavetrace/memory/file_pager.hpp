@@ -192,8 +192,6 @@ class FilePager {
   std::uint32_t load_frame(std::uint32_t page, std::uint64_t address_offset, std::unique_lock<std::mutex>& lock);
   // Frees the least recently used frame no reader has pinned; false when every one is.
   bool evict_frame_locked();
-  void unlink_frame_locked(std::uint32_t frame);
-  void push_frame_front_locked(std::uint32_t frame);
   std::byte* frame_bytes(std::uint32_t frame) const { return frames_ + std::size_t(frame) * frame_stride_; }
   void release_frames();
   // A full pool evicts an eighth of itself, up to 8 pages, at a time: a shootdown per group,
@@ -208,8 +206,28 @@ class FilePager {
       prefetch_hits_.fetch_add(1, std::memory_order_relaxed);
     }
   }
-  void unlink_locked(std::uint32_t page);
-  void push_front_locked(std::uint32_t page);
+  // An LRU order over the entries 0..n-1 (the mapped pool's pages, or the frames): a doubly
+  // linked list, most recent at head, changed under mutex_; each entry stamped with the
+  // order's clock (one tick a push) when it went to the head, read without the lock.
+  struct LruOrder {
+    std::vector<std::uint32_t> previous, next;
+    std::uint32_t head = kNone, tail = kNone;
+    std::atomic<std::uint64_t> clock{0};
+    std::unique_ptr<std::atomic<std::uint64_t>[]> headed_at;
+    void reset(std::size_t entries);  // empty, for `entries` entries
+    bool empty() const { return tail == kNone; }
+    void unlink(std::uint32_t entry);
+    void push_front(std::uint32_t entry);
+    void move_to_front(std::uint32_t entry) {
+      if (head == entry) return;
+      unlink(entry);
+      push_front(entry);
+    }
+    // Went to the head fewer than `ticks` pushes ago.
+    bool fresh(std::uint32_t entry, std::uint64_t ticks) const {
+      return clock.load(std::memory_order_relaxed) - headed_at[entry].load(std::memory_order_relaxed) < ticks;
+    }
+  };
   std::size_t client_index() const;
   void release();  // unregisters, unmaps and closes: what the destructor does
 
@@ -233,16 +251,13 @@ class FilePager {
   // by touch's fast path.
   std::unique_ptr<std::atomic<std::uint32_t>[]> slot_of_;
   std::size_t page_count_ = 0;
-  // The LRU list's clock: one tick per page put at its head. A resident page put there fewer
-  // than `fresh_ticks_` (a quarter of the pool) ticks ago is still in the list's first
-  // quarter, far from eviction, so a touch of it takes no lock and leaves it where it is:
-  // the order is LRU's but for such touches, which may leave a page up to a quarter of the
-  // pool further back than exact LRU would (2-3% more faults on room:8M, 3-5% less time).
-  std::atomic<std::uint64_t> lru_clock_{0};
-  std::unique_ptr<std::atomic<std::uint64_t>[]> headed_at_;
+  // The mapped pool's LRU order, over pages. A resident page put at its head fewer than
+  // `fresh_ticks_` (a quarter of the pool) pushes ago is still in its first quarter, far from
+  // eviction, so a touch of it takes no lock and leaves it where it is: the order is LRU's
+  // but for such touches, which may leave a page up to a quarter of the pool further back
+  // than exact LRU would (2-3% more faults on room:8M, 3-5% less time). Frames do the same.
+  LruOrder mapped_order_;
   std::uint64_t fresh_ticks_ = 1;
-  std::vector<std::uint32_t> previous_, next_; // the LRU list, most recent at head_
-  std::uint32_t head_ = kNone, tail_ = kNone;
   std::vector<std::uint32_t> free_slots_;
   std::size_t eviction_group_ = 1;  // pages evicted at once when the pool is full
   int self_pidfd_ = -1;  // this process, for process_madvise; -1 once the kernel refused it
@@ -266,10 +281,8 @@ class FilePager {
   // one of the two sees the other).
   std::unique_ptr<std::atomic<std::uint32_t>[]> frame_of_;
   std::unique_ptr<std::atomic<std::uint32_t>[]> pins_;          // per frame: readers holding it
-  std::atomic<std::uint64_t> frame_clock_{0};  // the frames' LRU clock, as lru_clock_
-  std::unique_ptr<std::atomic<std::uint64_t>[]> frame_headed_at_;  // per frame, on frame_clock_
-  std::vector<std::uint32_t> page_in_frame_, frame_previous_, frame_next_;  // per frame; the frames' LRU list
-  std::uint32_t frame_head_ = kNone, frame_tail_ = kNone;
+  std::vector<std::uint32_t> page_in_frame_;  // per frame
+  LruOrder frame_order_;                      // over frames
   std::vector<std::uint32_t> free_frames_;
   std::uint64_t frame_fresh_ticks_ = 1;
 };
