@@ -13,6 +13,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <memory>
 #include <mutex>
@@ -185,6 +186,8 @@ class FilePager {
   void evict_tail_locked(std::size_t count);
   // Sizes the mapped pool to `slots` pages (empty, under the lock).
   void size_mapped_pool_locked(std::size_t slots);
+  // Adds the time since `since` to the calling thread's client's waits.
+  void count_wait_locked(std::chrono::steady_clock::time_point since);
   // Counts one page read for the calling thread's client.
   void count_read_locked(std::uint32_t page, std::uint64_t address_offset, double seconds, bool by_fault);
   // Framed: the frame holding `page`, read into one first if need be, moved to the head of
