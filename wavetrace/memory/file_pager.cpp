@@ -170,18 +170,11 @@ FilePager::FilePager(const std::string& path, std::uint64_t file_bytes, std::siz
   // block of addresses: probes find a read's page from its address alone (address >>
   // log2(page_bytes)), and a probe that numbered pages off the pager's would let reads across
   // the pager's boundaries go unannounced (18% of room:64M's reads came in by fault so).
-  void* range = ::mmap(nullptr, reserved_bytes_ + page_bytes, PROT_NONE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
-  if (range == MAP_FAILED) {
+  base_ = map_aligned(reserved_bytes_, page_bytes, PROT_NONE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE);
+  if (base_ == nullptr) {
     ::close(direct_fd_);
     throw std::runtime_error(fmt::format("{}: cannot reserve {} bytes of address space", path, reserved_bytes_));
   }
-  const auto start = reinterpret_cast<std::uintptr_t>(range);
-  const std::uintptr_t aligned = (start + page_bytes - 1) & ~std::uintptr_t(page_bytes - 1);
-  if (aligned > start) ::munmap(range, aligned - start);
-  if (const std::size_t tail = page_bytes - (aligned - start); tail > 0) {
-    ::munmap(reinterpret_cast<std::byte*>(aligned) + reserved_bytes_, tail);
-  }
-  base_ = reinterpret_cast<std::byte*>(aligned);
   if (mapping != PageMapping::memfd) {
     std::string reason;
     fault_fd_ = register_missing_pages(base_, reserved_bytes_, reason);
@@ -228,6 +221,19 @@ FilePager::FilePager(const std::string& path, std::uint64_t file_bytes, std::siz
 }
 
 FilePager::~FilePager() { release(); }
+
+std::byte* FilePager::map_aligned(std::size_t bytes, std::size_t alignment, int protection, int flags) {
+  void* region = ::mmap(nullptr, bytes + alignment, protection, flags, -1, 0);
+  if (region == MAP_FAILED) return nullptr;
+  // The part before the boundary and the part past `bytes` go back.
+  const auto start = reinterpret_cast<std::uintptr_t>(region);
+  const std::uintptr_t aligned = (start + alignment - 1) & ~std::uintptr_t(alignment - 1);
+  if (aligned > start) ::munmap(region, aligned - start);
+  if (const std::size_t tail = alignment - (aligned - start); tail > 0) {
+    ::munmap(reinterpret_cast<std::byte*>(aligned) + bytes, tail);
+  }
+  return reinterpret_cast<std::byte*>(aligned);
+}
 
 void FilePager::size_mapped_pool_locked(std::size_t slots) {
   slots_ = slots;

@@ -186,6 +186,10 @@ class FilePager {
   void evict_tail_locked(std::size_t count);
   // Sizes the mapped pool to `slots` pages (empty, under the lock).
   void size_mapped_pool_locked(std::size_t slots);
+  // `bytes` of fresh anonymous memory starting on an `alignment` boundary (a power of two),
+  // mapped with `protection` and `flags` (MAP_PRIVATE | MAP_ANONYMOUS and more); null when
+  // the kernel refuses, errno saying why.
+  static std::byte* map_aligned(std::size_t bytes, std::size_t alignment, int protection, int flags);
   // Adds the time since `since` to the calling thread's client's waits.
   void count_wait_locked(std::chrono::steady_clock::time_point since);
   // Counts one page read for the calling thread's client.

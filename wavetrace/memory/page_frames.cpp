@@ -33,18 +33,11 @@ bool FilePager::use_frames(bool wanted) {
   // On 2 MiB pages where the system allows: fewer TLB misses for the walks that read there,
   // and every 4 KiB of the frames made present now, once, not at each one's first read.
   const std::size_t bytes = (frames * stride + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;
-  void* region = ::mmap(nullptr, bytes + kHugePageBytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-  if (region == MAP_FAILED) {
+  frames_ = map_aligned(bytes, kHugePageBytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS);
+  if (frames_ == nullptr) {
     throw std::runtime_error(fmt::format("{}: cannot allocate {} frames of {} bytes: {}", path_, frames, stride,
                                          std::strerror(errno)));
   }
-  const auto start = reinterpret_cast<std::uintptr_t>(region);
-  const std::uintptr_t aligned = (start + kHugePageBytes - 1) & ~std::uintptr_t(kHugePageBytes - 1);
-  if (aligned > start) ::munmap(region, aligned - start);
-  if (const std::size_t tail = kHugePageBytes - (aligned - start); tail > 0) {
-    ::munmap(reinterpret_cast<std::byte*>(aligned) + bytes, tail);
-  }
-  frames_ = reinterpret_cast<std::byte*>(aligned);
   frames_bytes_ = bytes;
   if (huge_pages_advised()) ::madvise(frames_, bytes, MADV_HUGEPAGE);  // advice only
   ::madvise(frames_, bytes, MADV_POPULATE_WRITE);  // where the kernel has it; else each 4 KiB at its first read
