@@ -418,7 +418,8 @@ TEST(ZSort, DiskRunsMergeIntoTheOrderOfOneInCoreSort) {
 }
 
 // A ray's key is its curve's index of the cell its point falls in (origin for `origin`,
-// approximate hit for `hph`, 20 bits per axis), with bit 63 set for shadow rays.
+// approximate hit for `hph`, 20 bits per axis); a shadow ray's is bit 63 and its index counted
+// from the curve's far end, so that shadow rays sweep the world back the way bounce rays came.
 TEST(ReorderKeys, AreTheCurveIndexOfTheQuantizedPoint) {
   const Bounds3 box = cube_around_origin();
   const std::vector<std::array<std::uint32_t, 3>> cells = {{3, 1000, 77}, {524287, 0, 1048575}, {1048575, 1, 65536}};
@@ -442,8 +443,9 @@ TEST(ReorderKeys, AreTheCurveIndexOfTheQuantizedPoint) {
       for (std::size_t i = 0; i < cells.size(); ++i) {
         const std::uint64_t index =
             curve == CurveKind::morton ? morton_key<3, 20>(cells[i]) : hilbert_key<3, 20>(cells[i]);
-        const std::uint64_t shadow = rays.kind[i] == RayKind::shadow ? std::uint64_t{1} << 63 : 0;
-        EXPECT_EQ(rays.sort_key[i], index | shadow) << to_string(heuristic) << " " << to_string(curve) << " " << i;
+        const std::uint64_t expected =
+            rays.kind[i] == RayKind::shadow ? (std::uint64_t{1} << 63) | ((std::uint64_t{1} << 60) - 1 - index) : index;
+        EXPECT_EQ(rays.sort_key[i], expected) << to_string(heuristic) << " " << to_string(curve) << " " << i;
       }
     }
   }

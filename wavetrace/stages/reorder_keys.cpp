@@ -84,8 +84,13 @@ void keys_for(RayBatch& rays, const Bounds3& bounds) {
       return std::array<std::uint32_t, 6>{h[0], h[1], h[2], origin[0], origin[1], origin[2]};
     }
   };
+  // Shadow rays walk the curve backward. A flush holding both kinds is then two sweeps over
+  // the world, forward and back, and each sweep starts where the one before it ended: among the
+  // pages a pool under LRU still holds, not among those the last sweep evicted first.
+  constexpr std::uint64_t kLastCurveIndex = (std::uint64_t{1} << (D * kBits)) - 1;
+  static_assert(D * kBits < 63, "bit 63 is the shadow bit");
   const auto set_key = [&](std::size_t i, std::uint64_t key) {
-    rays.sort_key[i] = key | (rays.kind[i] == RayKind::shadow ? std::uint64_t{1} << 63 : 0);
+    rays.sort_key[i] = rays.kind[i] == RayKind::shadow ? (std::uint64_t{1} << 63) | (kLastCurveIndex - key) : key;
   };
   if constexpr (kCurve == CurveKind::morton) {
     for (std::size_t i = 0; i < rays.count; ++i) set_key(i, morton_key<D, kBits>(cell_of(i)));

@@ -4,7 +4,8 @@
 //   origin_dir   5D, 12 bits              hph_origin   6D, 10 bits
 //                                         hph_dir      5D, 12 bits
 // A direction is two dimensions: its octahedral map onto the unit square. Bit 63 puts
-// shadow rays after closest-hit rays, so trace gets long runs of one query kind.
+// shadow rays after closest-hit rays, so trace gets long runs of one query kind; below it a
+// shadow ray's index is counted from the curve's far end (the sweep back: reorder_keys.cpp).
 #pragma once
 
 #include <cstdint>
