@@ -25,9 +25,10 @@ std::optional<std::string> leaf_record_problem(std::span<const std::byte> bytes,
   if (record + kLeafHeaderBytes > bytes.size()) return "has a leaf record past its array";
   const std::byte* data = bytes.data() + record;
   const LeafHeader header = read_leaf_header(data);
-  if (header.entry >= StripTable::instance().size()) return fmt::format("has a leaf of strip table entry {}", header.entry);
-  const StripLayoutEntry& layout = StripTable::instance().entry(header.entry);
-  if (record + leaf_record_bytes(data) > bytes.size()) return "has a leaf record running past its array";
+  const StripTable& strips = StripTable::instance();
+  if (header.entry >= strips.size()) return fmt::format("has a leaf of strip table entry {}", header.entry);
+  const StripLayoutEntry& layout = strips.entry(header.entry);
+  if (record + leaf_record_bytes(header, layout) > bytes.size()) return "has a leaf record running past its array";
   const std::byte* stream = data + kLeafHeaderBytes;
   for (int axis = 0; axis < 3; ++axis) stream += stream_bytes(header.axis_bits[axis] + 1, header.vertex_count);
   std::uint32_t values[64];

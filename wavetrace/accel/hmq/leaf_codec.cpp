@@ -241,12 +241,7 @@ void encode_leaf(const QuantizedMesh& quantized, std::span<const std::uint32_t> 
 
 std::size_t leaf_record_bytes(const std::byte* record) {
   const LeafHeader header = read_leaf_header(record);
-  const StripLayoutEntry& layout = StripTable::instance().entry(header.entry);
-  std::size_t bytes = kLeafHeaderBytes;
-  for (int axis = 0; axis < 3; ++axis) bytes += stream_bytes(header.axis_bits[axis] + 1, header.vertex_count);
-  if (header.indexed) bytes += stream_bytes(header.index_bits, layout.slots);
-  bytes += stream_bytes(header.id_bits, layout.triangles) + stream_bytes(3, layout.triangles);
-  return bytes;
+  return leaf_record_bytes(header, StripTable::instance().entry(header.entry));
 }
 
 }  // namespace wavetrace::hmq

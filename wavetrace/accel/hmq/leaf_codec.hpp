@@ -152,6 +152,14 @@ inline void decode_leaf(const std::byte* record, const GlobalGrid& grid, const G
   leaf.corners = data + stream_bytes(leaf.header.id_bits, triangles);
 }
 
+// Bytes a record of this header and strip layout occupies: its streams in record order.
+inline std::size_t leaf_record_bytes(const LeafHeader& header, const StripLayoutEntry& layout) {
+  std::size_t bytes = kLeafHeaderBytes;
+  for (int axis = 0; axis < 3; ++axis) bytes += stream_bytes(header.axis_bits[axis] + 1, header.vertex_count);
+  if (header.indexed) bytes += stream_bytes(header.index_bits, layout.slots);
+  return bytes + stream_bytes(header.id_bits, layout.triangles) + stream_bytes(3, layout.triangles);
+}
+
 // Bytes the record at `record` occupies (for tests and statistics).
 std::size_t leaf_record_bytes(const std::byte* record);
 
