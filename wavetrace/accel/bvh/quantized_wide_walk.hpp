@@ -155,6 +155,25 @@ template <KernelIsa kIsa, typename Probe, typename VisitLeaf, typename LeafAddre
             _mm_prefetch(line + 64, _MM_HINT_T0);
           }
         }
+        if (std::popcount(entered_mask) == 2) {  // two: one comparison orders them, the farther is stacked
+          alignas(32) std::uint32_t reference[8];
+          alignas(32) float distance[8];
+          alignas(32) float lanes[6][8];
+          _mm256_store_si256(reinterpret_cast<__m256i*>(reference), references);
+          _mm256_store_ps(distance, near);
+          for (int b = 0; b < 6; ++b) _mm256_store_ps(lanes[b], bound[b]);
+          int nearer = std::countr_zero(entered_mask);
+          int farther = std::countr_zero(entered_mask & (entered_mask - 1));
+          if (distance[farther] < distance[nearer]) std::swap(nearer, farther);
+          stack.reference[top] = reference[farther];
+          stack.distance[top] = distance[farther];
+          for (int b = 0; b < 6; ++b) stack.bound[b][top] = lanes[b][farther];
+          ++top;
+          current = reference[nearer];
+          frame.lower = {lanes[0][nearer], lanes[1][nearer], lanes[2][nearer]};
+          frame.upper = {lanes[3][nearer], lanes[4][nearer], lanes[5][nearer]};
+          continue;
+        }
         const __m256i order = lane_sort::nearest_last_for<kIsa>(near, entered_mask);
         _mm256_storeu_si256(reinterpret_cast<__m256i*>(stack.reference + top),
                             _mm256_permutevar8x32_epi32(references, order));

@@ -320,6 +320,15 @@ class WideBvhAccelerator final : public ProbedAccelerator<WideBvhAccelerator> {
             continue;
           }
           prefetch_children(node, mask, nodes, blocks_.data());
+          if (std::popcount(mask) == 2) {  // two: one comparison orders them, the farther is stacked
+            int near = std::countr_zero(mask);
+            int far = std::countr_zero(mask & (mask - 1));
+            if (distance[far] < distance[near]) std::swap(near, far);
+            stack.child[top] = node.child[far], stack.count[top] = node.count[far], stack.distance[top] = distance[far];
+            ++top;
+            child = node.child[near], count = node.count[near];
+            continue;
+          }
           push_nearest_last<kIsa>(node, mask, distance, stack, top);
         } else {
           query.test_blocks<kAnyHit>(blocks_.data() + child, count, probe);
