@@ -15,6 +15,7 @@
 
 #include "wavetrace/accel/hit_surface.hpp"
 #include "wavetrace/accel/ray_loop.hpp"
+#include "wavetrace/memory/kernel_isa_choice.hpp"  // to_string(KernelIsa)
 #endif
 
 namespace wavetrace {
