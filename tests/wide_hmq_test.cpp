@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <span>
 #include <string>
 
@@ -13,6 +14,8 @@
 #include "wavetrace/accel/bvh/quantized_wide_node.hpp"
 #include "wavetrace/accel/registry.hpp"
 #include "wavetrace/accel/section_archive.hpp"
+#include "wavetrace/memory/memory_probe.hpp"
+#include "wavetrace/memory/read_tally.hpp"
 #include "wavetrace/memory/section_file.hpp"
 #include "wavetrace/memory/section_writer.hpp"
 #include "accel_agreement.hpp"
@@ -92,6 +95,42 @@ TEST(WideHmq, PacketsAnswerExactlyAsSingleRays) {
       }
     }
     EXPECT_GT(hits, 1000u) << source;
+  }
+}
+
+// The walks keep the leaves they decoded last for the next ray (DecodedLeafCache), but a probed
+// walk, which the pagers and the read counts follow, must still read every record it tests:
+// the same ray 64 times reads 64 times what it reads once, and hits as it does unprobed.
+TEST(WideHmq, ProbedWalksReadEveryLeafTheyTestWhatEverTheyDecodedBefore) {
+  const Scene scene = make_builtin_scene("builtin:sphere:20k");
+  for (const std::uint32_t width : {2u, 8u}) {
+    const auto accel = make_hmq_accelerator(scene.mesh, hmq_options(width, 8, 16));
+    const auto count_reads = [&](std::size_t copies) {
+      RayBatch rays(copies);
+      HitBatch probed(copies), plain(copies);
+      rays.count = copies;
+      for (std::size_t i = 0; i < copies; ++i) {
+        rays.set_geometry(i, {0.1f, 0.2f, 3.0f}, {0.0f, 0.0f, -1.0f}, 0.0f, std::numeric_limits<float>::infinity());
+        rays.flags[i] = ray_flags::alive;
+        rays.kind[i] = RayKind::camera;
+      }
+      ReadTally tally(accel->memory_spans(), 1);
+      RecordingProbe probe(MemoryObservers{nullptr, nullptr, nullptr, &tally}, 0, 0);
+      const RayRange all{0, std::uint32_t(copies)};
+      accel->intersect_closest_probed(rays, probed, all, probe);
+      accel->intersect_closest(rays, plain, all);
+      for (std::size_t i = 0; i < copies; ++i) {
+        EXPECT_TRUE(plain.is_hit(i));
+        EXPECT_EQ(probed.t[i], plain.t[i]);
+        EXPECT_EQ(probed.primitive[i], plain.primitive[i]);
+      }
+      std::uint64_t reads = 0;
+      for (const std::uint64_t array_reads : tally.totals()) reads += array_reads;
+      return reads;
+    };
+    const std::uint64_t once = count_reads(1);
+    EXPECT_GT(once, 0u) << width;
+    EXPECT_EQ(count_reads(64), 64 * once) << width;
   }
 }
 

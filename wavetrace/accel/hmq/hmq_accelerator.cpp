@@ -332,11 +332,12 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
 
   template <bool kAnyHit, KernelIsa kIsa, typename Probe>
   void traverse(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
+    DecodedLeafCache decoded;
     for_each_ray(rays, hits, range, [&](const SingleRay& ray, std::uint32_t i) {
       float tmax = ray.tmax;
       LeafHit best;
       walk_bvh(top_.data(), ray.box, ray.tmin, tmax, probe, [&](const BvhNode& leaf) {
-        traverse_blocks<kAnyHit>(leaf, ray.box, ray.sheared, ray.tmin, tmax, best, probe);
+        traverse_blocks<kAnyHit>(leaf, ray.box, ray.sheared, ray.tmin, tmax, best, probe, decoded);
         return kAnyHit && best.found;
       });
       write_leaf_hit<!kAnyHit>(best, hits, i);
@@ -347,7 +348,7 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
   // the nearer child visited next and the farther one stacked, as in walk_bvh.
   template <bool kAnyHit, typename Probe>
   void traverse_blocks(const BvhNode& top_leaf, const BoxRay& box_ray, const WatertightRay& sheared, float tmin,
-                       float& tmax, LeafHit& best, Probe& probe) const {
+                       float& tmax, LeafHit& best, Probe& probe, DecodedLeafCache& decoded) const {
     struct Node {
       const std::byte* block;
       std::uint32_t word;  // its slot
@@ -387,7 +388,8 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
     while (true) {
       if (have) {
         if (!is_inner(current.word)) {
-          test_leaf<kAnyHit>(current.block, node_index(current.word), current.box, sheared, tmin, tmax, best, probe);
+          test_leaf<kAnyHit>(current.block, node_index(current.word), current.box, sheared, tmin, tmax, best, probe,
+                             decoded);
           if (kAnyHit && best.found) return;
           have = false;
         } else {
@@ -422,14 +424,14 @@ class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
 
   template <bool kAnyHit, typename Probe>
   void test_leaf(const std::byte* block, std::uint32_t leaf, const Box& box, const WatertightRay& sheared, float tmin,
-                 float& tmax, LeafHit& best, Probe& probe) const {
+                 float& tmax, LeafHit& best, Probe& probe, DecodedLeafCache& decoded) const {
     const std::uint32_t node_slots = static_cast<std::uint8_t>(block[0]);
     const std::uint32_t forward_slots = static_cast<std::uint8_t>(block[1]);
     std::uint16_t offset;
     const std::byte* offset_at = block + kBlockHeaderBytes + 4 * (node_slots + forward_slots) + 2 * leaf;
     probe.read(offset_at, 2);
     std::memcpy(&offset, offset_at, 2);
-    test_leaf_record<kAnyHit>(block + offset, grid_, box, sheared, tmin, tmax, best, probe);
+    test_leaf_record<kAnyHit>(block + offset, grid_, box, sheared, tmin, tmax, best, probe, decoded);
   }
 
   GlobalGrid grid_;

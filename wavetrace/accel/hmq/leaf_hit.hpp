@@ -159,14 +159,38 @@ template <bool kAnyHit>
 #endif
 }
 
-// The leaf record at `record`, whose decoded box is `box`, against one ray.
+// The leaves one walker decoded last, by record address, direct-mapped: coherent rays (a
+// camera's neighbouring pixels, rays sorted by hit point) meet the same leaves one after
+// another, and the decode is most of a leaf's cost. In-core walks only (NullProbe): a probed
+// walk must read, and report, every record it tests, and a paged record's frame may be
+// reused while its decoded copy is held.
+class DecodedLeafCache {
+ public:
+  static constexpr std::size_t kEntries = 8;
+
+  template <typename Probe>
+  [[gnu::always_inline]] const LeafTriangles& leaf(const std::byte* record, const GlobalGrid& grid, const Box& box,
+                                                   Probe& probe) {
+    const std::size_t slot = (reinterpret_cast<std::uintptr_t>(record) >> 4) % kEntries;
+    if (record_[slot] != record || Probe::kRecords) {
+      prepare_leaf(record, grid, box, leaves_[slot], probe);
+      record_[slot] = Probe::kRecords ? nullptr : record;
+    }
+    return leaves_[slot];
+  }
+
+ private:
+  const std::byte* record_[kEntries] = {};
+  LeafTriangles leaves_[kEntries];
+};
+
+// The leaf record at `record`, whose decoded box is `box`, against one ray (decoded through
+// `cache`).
 template <bool kAnyHit, typename Probe>
 [[gnu::always_inline]] inline void test_leaf_record(const std::byte* record, const GlobalGrid& grid, const Box& box,
                                                     const WatertightRay& sheared, float tmin, float& tmax,
-                                                    LeafHit& best, Probe& probe) {
-  LeafTriangles leaf;
-  prepare_leaf(record, grid, box, leaf, probe);
-  test_leaf_triangles<kAnyHit>(leaf, sheared, tmin, tmax, best);
+                                                    LeafHit& best, Probe& probe, DecodedLeafCache& cache) {
+  test_leaf_triangles<kAnyHit>(cache.leaf(record, grid, box, probe), sheared, tmin, tmax, best);
 }
 
 // With kSurface (closest hits, whose corners test_leaf_record kept) also the point and normal.

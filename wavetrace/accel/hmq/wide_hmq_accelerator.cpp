@@ -347,13 +347,14 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
   template <bool kAnyHit, KernelIsa kIsa, typename Probe>
   void traverse(const RayBatch& rays, HitBatch& hits, RayRange range, Probe& probe) const {
     QuantizedWideStack stack;
+    DecodedLeafCache decoded;
     const std::byte* leaves = leaf_records();
     for_each_ray(rays, hits, range, [&](const SingleRay& ray, std::uint32_t i) {
       float tmax = ray.tmax;
       LeafHit best;
       walk_quantized_wide<kIsa>(nodes_.data(), root_, ray, tmax, probe, stack, [&](std::uint32_t units, const Bounds3& box) {
         test_leaf_record<kAnyHit>(leaves + std::size_t(units) * kUnit, grid_, Box{box.lower, box.upper}, ray.sheared,
-                                  ray.tmin, tmax, best, probe);
+                                  ray.tmin, tmax, best, probe, decoded);
         return kAnyHit && best.found;
       }, [&](std::uint32_t units) { return leaves + std::size_t(units) * kUnit; });
       write_leaf_hit<!kAnyHit>(best, hits, i);
