@@ -5,6 +5,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "wavetrace/kernels/morton.hpp"
 #include "wavetrace/scene/load_scene.hpp"
 #include "wavetrace/scene/builtin_scenes.hpp"
 #include "wavetrace/scene/mesh_report.hpp"
@@ -161,6 +162,26 @@ TEST(Subdivision, LoopQuadruplesAndKeepsClosed) {
   EXPECT_EQ(twice.non_manifold_faces_dropped, 0u);
   EXPECT_TRUE(analyze_mesh(twice.mesh).closed());
   EXPECT_GT(signed_volume(twice.mesh), 2.0);
+}
+
+// A subdivided surface is numbered along the Z-order curve of its triangles' centroids (10 bits
+// an axis over the mesh's bounds), so that neighbours have near numbers: each step of OpenMesh's
+// Loop appends three of a face's four children at the end of the mesh.
+TEST(Subdivision, NumbersTheTrianglesAlongTheZCurve) {
+  const SubdivisionResult twice = loop_subdivide(make_builtin_scene("builtin:sphere:320").mesh, 2);
+  const TriangleMesh& mesh = twice.mesh;
+  Bounds3 bounds;
+  for (const glm::vec3& p : mesh.positions) bounds.extend(p);
+  const glm::vec3 scale = 1024.0f / (bounds.upper - bounds.lower);
+  std::uint64_t previous = 0;
+  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+    const glm::uvec3& tri = mesh.triangles[t];
+    const glm::vec3 centroid = (mesh.positions[tri.x] + mesh.positions[tri.y] + mesh.positions[tri.z]) / 3.0f;
+    const glm::uvec3 cell = glm::uvec3(glm::clamp((centroid - bounds.lower) * scale, glm::vec3(0.0f), glm::vec3(1023.0f)));
+    const std::uint64_t key = morton3d_encode(cell.x, cell.y, cell.z);
+    ASSERT_GE(key, previous) << "triangle " << t;
+    previous = key;
+  }
 }
 
 TEST(Subdivision, SceneRequestSubdividesRealMeshes) {

@@ -1,20 +1,54 @@
 // Loop subdivision through OpenMesh's uniform LoopT subdivider.
 #include "wavetrace/scene/subdivide.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <numeric>
 #include <set>
+#include <vector>
 
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 #include <OpenMesh/Tools/Subdivider/Uniform/LoopT.hh>
 #include <fmt/format.h>
 
+#include "wavetrace/kernels/morton.hpp"
 #include "wavetrace/memory/process_memory.hpp"
 
 namespace wavetrace {
 namespace {
+
+// Puts a subdivided surface's triangles in the Z-order of their centroids. OpenMesh's Loop
+// step keeps each parent face as one child and appends the other three at the end, so after
+// two steps a face's neighbours are numbered anywhere in the mesh; the order of a generated
+// mesh is ours to choose, and one where neighbours are numbered alike is what compact
+// structures that store triangle numbers per leaf need (HMQ's leaf ids: bunny00 subdivided
+// twice, 3.1 bytes a triangle of ids and corners in OpenMesh's order).
+void order_triangles_along_z_curve(TriangleMesh& mesh) {
+  Bounds3 bounds;
+  for (const glm::vec3& p : mesh.positions) bounds.extend(p);
+  if (bounds.empty()) return;
+  constexpr float kCells = 1024.0f;  // 10 bits an axis
+  const glm::vec3 extent = glm::max(bounds.upper - bounds.lower, glm::vec3(std::numeric_limits<float>::min()));
+  const glm::vec3 scale = kCells / extent;
+  std::vector<std::uint64_t> key(mesh.triangle_count());
+  for (std::size_t t = 0; t < key.size(); ++t) {
+    const glm::uvec3& tri = mesh.triangles[t];
+    const glm::vec3 centroid = (mesh.positions[tri.x] + mesh.positions[tri.y] + mesh.positions[tri.z]) / 3.0f;
+    const glm::uvec3 cell = glm::uvec3(glm::clamp((centroid - bounds.lower) * scale, glm::vec3(0.0f), glm::vec3(kCells - 1)));
+    key[t] = morton3d_encode(cell.x, cell.y, cell.z);
+  }
+  std::vector<std::uint32_t> order(key.size());
+  std::iota(order.begin(), order.end(), 0u);
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {  // ties in the old order
+    return key[a] != key[b] ? key[a] < key[b] : a < b;
+  });
+  std::vector<glm::uvec3> triangles(order.size());
+  for (std::size_t i = 0; i < order.size(); ++i) triangles[i] = mesh.triangles[order[i]];
+  mesh.triangles = std::move(triangles);
+}
 
 // One surface, its materials ignored.
 SubdivisionResult subdivide_surface(const TriangleMesh& mesh, int levels) {
@@ -57,6 +91,7 @@ SubdivisionResult subdivide_surface(const TriangleMesh& mesh, int levels) {
     for (const auto vertex : kernel.fv_range(face)) triangle[corner++] = static_cast<std::uint32_t>(vertex.idx());
     result.mesh.triangles.push_back(triangle);
   }
+  order_triangles_along_z_curve(result.mesh);
   return result;
 }
 

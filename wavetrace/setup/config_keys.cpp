@@ -191,7 +191,7 @@ const std::vector<ConfigKey>& config_schema() {
       {"scene.source", T::text, std::string("builtin:default"), 0, 0, {},
        "mesh file (.off .ply .obj .stl), scene file (.toml) or builtin:NAME[:TRIANGLES]",
        text<&P::scene, &SceneRequest::source>},
-      {"scene.subdivide", T::integer, std::int64_t{0}, 0, 6, {}, "levels of Loop subdivision after loading",
+      {"scene.subdivide", T::integer, std::int64_t{0}, 0, 6, {}, "levels of Loop subdivision after loading (the new triangles numbered along the Z-curve of their centroids)",
        integer<&P::scene, &SceneRequest::subdivide>},
 
       {"camera.position", T::vector3, std::nullopt, 0, 0, {}, "eye point (default: the scene's or framed)",
