@@ -357,7 +357,8 @@ const std::vector<ConfigKey>& config_schema() {
        [](const RenderPlan& plan) -> Recorded {
          return plan.accelerator.hmq.epsilon > 0.0 ? Recorded(plan.accelerator.hmq.epsilon) : std::nullopt;
        }},
-      {"accel.hmq.leaf_size", T::integer, std::int64_t{8}, 1, 14, {}, "most triangles per leaf (the paper: 4, 8, 12)",
+      {"accel.hmq.leaf_size", T::integer, std::int64_t{0}, 0, 14, {},
+       "most triangles per leaf (the paper: 4, 8, 12); 0: the width's own, 8 for the binary layout and 14 for width 8",
        integer<&P::accelerator, &A::hmq, &HmqOptions::leaf_size>},
       {"accel.hmq.top_fraction", T::real, 0.05, 0.0, 1.0, {},
        "share of the BVH's nodes kept uncompressed at the top (width 2 only)",

@@ -22,8 +22,9 @@ void check_options(const HmqOptions& options) {
           fmt::format("bits = {} and epsilon = {} are both set; the grid comes from one of them", options.bits,
                       options.epsilon));
   require(options.bits >= 1 && options.bits <= 24, fmt::format("bits = {}: must be 1 .. 24", options.bits));
-  require(options.leaf_size >= 1 && options.leaf_size <= kMaxLeafTriangles,
-          fmt::format("leaf_size = {}: must be 1 .. {} (the strip table's limit)", options.leaf_size, kMaxLeafTriangles));
+  require(options.leaf_size <= kMaxLeafTriangles,
+          fmt::format("leaf_size = {}: must be 1 .. {} (the strip table's limit; 0: the width's own)", options.leaf_size,
+                      kMaxLeafTriangles));
   require(options.top_fraction >= 0.0 && options.top_fraction <= 1.0,
           fmt::format("top_fraction = {}: must be 0 .. 1", options.top_fraction));
   require(options.width == 2 || options.width == 8,
@@ -50,13 +51,13 @@ SnappedTree build_snapped_tree(const TriangleMesh& mesh, const HmqOptions& optio
   });
   clock.lap(snapped.phases, "snap");
   SahOptions sah;
-  sah.max_leaf_size = options.leaf_size;
+  sah.max_leaf_size = options.leaf_triangles();
   sah.bins = options.bins;
   // A leaf record has a fixed cost (header, id base, byte-aligned streams) that makes small
   // leaves expensive in bytes; a traversal step priced at half a full leaf keeps leaves
   // near full, as in the paper's Table 2 (about 3.3, 6.2 and 9.2 triangles per leaf for
   // leaf sizes 4, 8, 12 on Lucy).
-  sah.traversal_cost = 0.5f * float(options.leaf_size);
+  sah.traversal_cost = 0.5f * float(options.leaf_triangles());
   snapped.tree = build_sah_tree(std::move(references), sah);
   clock.lap(snapped.phases, "sah");
   snapped.peak_bytes = snapped.tree.peak_bytes;
