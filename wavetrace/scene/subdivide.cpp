@@ -33,12 +33,16 @@ void order_triangles_along_z_curve(TriangleMesh& mesh) {
   constexpr float kCells = 1024.0f;  // 10 bits an axis
   const glm::vec3 extent = glm::max(bounds.upper - bounds.lower, glm::vec3(std::numeric_limits<float>::min()));
   const glm::vec3 scale = kCells / extent;
+  // A coordinate that is not finite (none passes the loaders' checks) falls in cell 0.
+  const auto cell = [&](const glm::vec3& centroid, int axis) -> std::uint64_t {
+    const float at = (centroid[axis] - bounds.lower[axis]) * scale[axis];
+    return at > 0.0f ? std::uint64_t(std::min(at, kCells - 1.0f)) : 0u;
+  };
   std::vector<std::uint64_t> key(mesh.triangle_count());
   for (std::size_t t = 0; t < key.size(); ++t) {
     const glm::uvec3& tri = mesh.triangles[t];
     const glm::vec3 centroid = (mesh.positions[tri.x] + mesh.positions[tri.y] + mesh.positions[tri.z]) / 3.0f;
-    const glm::uvec3 cell = glm::uvec3(glm::clamp((centroid - bounds.lower) * scale, glm::vec3(0.0f), glm::vec3(kCells - 1)));
-    key[t] = morton3d_encode(cell.x, cell.y, cell.z);
+    key[t] = morton3d_encode(cell(centroid, 0), cell(centroid, 1), cell(centroid, 2));
   }
   std::vector<std::uint32_t> order(key.size());
   std::iota(order.begin(), order.end(), 0u);
