@@ -174,13 +174,25 @@ std::vector<ReorderHeuristic> parse_heuristic_list(const std::string& list) {
   return heuristics;
 }
 
+std::vector<ReorderBenchRow> parse_reorder_rows(const std::string& list) {
+  std::vector<ReorderBenchRow> rows;
+  for (const std::string& name : split_commas(list)) {
+    try {
+      rows.push_back(parse_reorder_bench_row(name));
+    } catch (const std::invalid_argument& error) {
+      throw ConfigError(fmt::format("--heuristics: {} (or paths: one path at a time, no reordering)", error.what()));
+    }
+  }
+  return rows;
+}
+
 int run_reorder(const ReorderArguments& args) {
   const Config config = render_bench_config({"render.max_depth=5"}, args.assignments, args.scene, args.spp, args.threads,
                                             args.size, [&](Config& flags) {
                                               apply_accelerator_spec(flags, args.accel);
                                               flags.set("reorder.curve=" + args.curve);
                                             });
-  const ReorderBenchReport report = run_reorder_bench(config, parse_heuristic_list(args.heuristics), args.repeat);
+  const ReorderBenchReport report = run_reorder_bench(config, parse_reorder_rows(args.heuristics), args.repeat);
   fmt::print("{}", to_table(report));
   if (!args.json.empty()) write_text(args.json, to_json(report).dump(2) + "\n");
   return 0;
@@ -367,7 +379,8 @@ void add_bench_command(CLI::App& app, int& exit_code) {
   add_scene_option(*reorder, reorder_args->scene, SceneKinds::with_worlds, false);
   add_accel_option(*reorder, reorder_args->accel);
   reorder->add_option("--heuristics", reorder_args->heuristics,
-                      "comma-separated: none, origin, origin_dir, hph, hph_origin, hph_dir (the first is the baseline)");
+                      "comma-separated: none, origin, origin_dir, hph, hph_origin, hph_dir, or paths (no reordering, "
+                      "one path at a time: the megakernel); the first is the baseline");
   reorder->add_option("--curve", reorder_args->curve, "morton or hilbert");
   add_spp_option(*reorder, reorder_args->spp);
   add_size_option(*reorder, reorder_args->size);

@@ -5,7 +5,9 @@
 # Usage: bench/out_of_core_suite.sh WORLD.wtw OUT_DIR
 # Settings (environment): SIZE (640x480), SPP (16), DEPTH (3), PAGES (page sizes in bytes, the
 #   sweep of item 2: "131072"), BUDGETS ("24 10"),
-#   HEURISTICS (none,origin,origin_dir,hph,hph_origin,hph_dir), BUFFERS ("memory disk"),
+#   HEURISTICS (none,paths,origin,origin_dir,hph,hph_origin,hph_dir; paths: no reordering, one
+#   path at a time, the megakernel), BUFFERS ("memory disk"), PIXEL_ORDER (zcurve: the paper
+#   generates camera rays along the Z-curve "for all the tests"; it is none's order),
 #   LOW_HEURISTICS (the heuristics at budgets after the first; default HEURISTICS),
 #   THREADS (2; paged renders keep more reads in flight with more threads than cores: 8 on
 #   2 cores rendered room:64M 1.3x faster, docs/measurements.md), CURVE (morton).
@@ -16,9 +18,9 @@ world=${1:?usage: bench/out_of_core_suite.sh WORLD.wtw OUT_DIR}
 out=${2:-out/out_of_core}
 mkdir -p "$out"
 wavetrace=${WAVETRACE:-build/wavetrace}
-heuristics=${HEURISTICS:-none,origin,origin_dir,hph,hph_origin,hph_dir}
+heuristics=${HEURISTICS:-none,paths,origin,origin_dir,hph,hph_origin,hph_dir}
 common=(--scene "$world" --size "${SIZE:-640x480}" --spp "${SPP:-16}" --threads "${THREADS:-2}"
-        --curve "${CURVE:-morton}" --set "render.max_depth=${DEPTH:-3}")
+        --curve "${CURVE:-morton}" --set "render.max_depth=${DEPTH:-3}" --set "render.pixel_order=${PIXEL_ORDER:-zcurve}")
 drop_caches() { sync; echo 3 > /proc/sys/vm/drop_caches 2>/dev/null || true; }
 
 { lscpu | grep "Model name" | tr -s " "; grep -o 'avx512[a-z_0-9]*' /proc/cpuinfo | sort -u | tr '\n' ' '; echo; } > "$out/cpu.txt"

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Table III with real I/O as Markdown, from bench/out_of_core_suite.sh's JSON: every paged run
 beside the same heuristic's render of the world mapped whole (the fraction of in-core speed),
-then where the trace's reads went (faults by part of the world file).
+its reads and time against none's and against paths' (one path at a time, the paper's renderer
+without reordering), then where the trace's reads went (faults by part of the world file).
 Usage: bench/out_of_core_table.py OUT_DIR"""
 import glob
 import json
@@ -25,22 +26,26 @@ print(f"{in_core['scene']['source']}: {in_core['scene']['triangles']} triangles,
       f"{in_core['accel']}, {in_core['threads']} threads; {cpu}")
 print()
 print("| budget | buffer | page KiB | heuristic | rays traced | rays/page | real reads | MB read | read s | wait s | "
-      "pages/1k rays | render s | Mrays/s | of in-core | reads vs none | time vs none | identical |")
-print("| --- | --- | ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |")
+      "pages/1k rays | render s | Mrays/s | of in-core | reads vs none | time vs none | reads vs paths | time vs paths | "
+      "identical |")
+print("| --- | --- | ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: "
+      "| --- |")
 parts = []
 for _, _, page, buffer, budget, path in sorted(runs):
     report = json.load(open(path))
     pages = max(report["page_count"], 1)
-    none = next((r for r in report["results"] if r["heuristic"] == "none"), None)
+    baseline = {name: next((r for r in report["results"] if r["heuristic"] == name), None) for name in ("none", "paths")}
     for r in report["results"]:
         rate = r["rays_traced"] / r["render_seconds"]
-        versus = lambda key: f"{none[key] / r[key]:.2f}x" if none and r[key] else "-"
+        versus = lambda name, key: f"{baseline[name][key] / r[key]:.2f}x" if baseline[name] and r[key] else "-"
         pages_1k = r.get("disk_pages_per_1000_rays")
+        pages_1k = f"{pages_1k:.1f}" if pages_1k is not None else "-"  # paths: not counted one ray at a time
         print(f"| {budget}% | {buffer} | {page >> 10:,} | {r['heuristic']} | {r['rays_traced']:,} | {r['rays_traced'] / pages:,.0f} | "
               f"{r['disk_faults']:,} | {r['disk_bytes_read'] / 1e6:,.0f} | {r['disk_read_seconds']:.1f} | "
-              f"{r['disk_wait_seconds']:.1f} | {pages_1k:.1f} | {r['render_seconds']:.1f} | {rate / 1e6:.3f} | "
-              f"{100 * rate / in_core_rate[r['heuristic']]:.1f}% | {versus('disk_faults')} | "
-              f"{versus('render_seconds')} | {'yes' if r['image_identical'] else 'NO'} |")
+              f"{r['disk_wait_seconds']:.1f} | {pages_1k} | {r['render_seconds']:.1f} | {rate / 1e6:.3f} | "
+              f"{100 * rate / in_core_rate[r['heuristic']]:.1f}% | {versus('none', 'disk_faults')} | "
+              f"{versus('none', 'render_seconds')} | {versus('paths', 'disk_faults')} | {versus('paths', 'render_seconds')} | "
+              f"{'yes' if r['image_identical'] else 'NO'} |")
         parts.append((budget, buffer, page, r["heuristic"], r.get("disk_faults_by_part", {}), r["disk_faults"]))
 print()
 print("In core (mapped whole): " + ", ".join(

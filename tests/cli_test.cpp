@@ -316,9 +316,9 @@ TEST(Cli, BenchReorderAndBenchPhotonsRunPhotonMapping) {
 TEST(Cli, BenchSetAssignmentsAreNotOverriddenByFlagDefaults) {
   const nlohmann::json json = testing::run_bench_json(
       "reorder_set.json", "reorder --scene builtin:room:5000 --accel bvh --size 16x12 --threads 1 --heuristics none "
-      "--set reorder.curve=hilbert --set render.spp=2 --set render.width=20");
+      "--set reorder.curve=hilbert --set render.spp=2 --set render.width=20 --set render.pixel_order=zcurve");
   EXPECT_EQ(json["curve"], "hilbert");
-  EXPECT_EQ(json["image"], "20x12, 2 spp, depth 5");
+  EXPECT_EQ(json["image"], "20x12, 2 spp, depth 5, camera rays in Z-curve order");
 }
 
 TEST(Cli, BenchPipelineComparesTheMegakernelWithEachHeuristic) {

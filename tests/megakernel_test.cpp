@@ -1,5 +1,6 @@
 // The megakernel, the wavefront's control experiment: the same image bit for bit with every
-// accelerator, the same rays traced, and settings only the wavefront honours refused.
+// accelerator, the same rays traced, its reads observed, and settings only the wavefront
+// honours refused.
 #include <gtest/gtest.h>
 
 #include "render_support.hpp"
@@ -69,6 +70,28 @@ TEST(Megakernel, MatchesTheWavefrontWithReordering) {
   EXPECT_TRUE(megakernel.image == hph.image);
 }
 
+// Observed ([memory]), each ray's walk reads through the trace stage's probe: the pager counts
+// the megakernel's reads as a "trace" stage beside it, and the image does not change.
+TEST(Megakernel, ItsWalksReadsAreCountedAsTraces) {
+  const std::vector<std::string> settings = {"pipeline.mode=megakernel", "accel.type=hmq", "accel.hmq.width=8",
+                                             "render.threads=2"};
+  const RenderOutput plain = render(room(), settings);
+  std::vector<std::string> observed = settings;
+  observed.insert(observed.end(), {"memory.budget=20%", "memory.page_bytes=4096"});
+  const RenderOutput paged = render(room(), observed);
+  EXPECT_TRUE(paged.image == plain.image);
+  ASSERT_EQ(plain.run.stages.size(), 1u);
+  ASSERT_EQ(paged.run.stages.size(), 2u);
+  const StageStats& walks = paged.run.stages[1];
+  EXPECT_EQ(walks.name, "trace");
+  EXPECT_EQ(walks.rays_in, paged.run.stages[0].rays_in);
+  EXPECT_GT(walks.seconds, 0.0);
+  EXPECT_LE(walks.seconds, paged.run.stages[0].seconds);
+  ASSERT_TRUE(walks.pager.has_value());
+  EXPECT_GT(walks.pager->counters.faults, 0u);
+  EXPECT_GT(walks.pager->counters.accesses, walks.pager->counters.faults);
+}
+
 TEST(Megakernel, RefusesWhatOnlyTheWavefrontHonours) {
   const auto refusal = [](const std::vector<std::string>& settings) -> std::string {
     try {
@@ -85,8 +108,9 @@ TEST(Megakernel, RefusesWhatOnlyTheWavefrontHonours) {
   EXPECT_NE(refusal({"pipeline.mode=megakernel", "pipeline.stages=[\"generate\", \"trace\", \"shade\"]"})
                 .find("pipeline.stages"),
             std::string::npos);
-  EXPECT_NE(refusal({"pipeline.mode=megakernel", "memory.budget=50%"}).find("pipeline.mode = wavefront"),
+  EXPECT_NE(refusal({"pipeline.mode=megakernel", "memory.budget=50%", "memory.look_ahead=4"}).find("memory.look_ahead"),
             std::string::npos);
+  EXPECT_EQ(refusal({"pipeline.mode=megakernel", "memory.budget=50%"}), "accepted");
   EXPECT_NE(refusal({"pipeline.mode=sideways"}).find("sideways"), std::string::npos);
   EXPECT_EQ(refusal({"pipeline.mode=megakernel"}), "accepted");
 }

@@ -523,6 +523,31 @@ TEST(Reordering, BenchmarkRoundsReportOneRenderPerHeuristic) {
   EXPECT_THROW(run_reorder_bench(config, {ReorderHeuristic::none}, 0), ConfigError);
 }
 
+// `paths`, the paper's renderer without its reordering module (one path at a time, the
+// megakernel), is a row like a heuristic's: the same image and rays, its reads counted.
+TEST(Reordering, BenchmarkRendersOnePathAtATimeAsARow) {
+  Config config;
+  for (const char* setting : {"scene.source=builtin:room:20k", "accel.type=bvh", "render.width=32", "render.height=24",
+                              "render.spp=1", "render.threads=2", "render.max_depth=3", "proxy.accel=bvh",
+                              "memory.budget=20%", "memory.page_bytes=4096"}) {
+    config.set(setting);
+  }
+  const ReorderBenchReport report = run_reorder_bench(
+      config, {ReorderBenchRow(ReorderHeuristic::none), ReorderBenchRow::paths_row(), parse_reorder_bench_row("hph")});
+  ASSERT_EQ(report.results.size(), 3u);
+  const ReorderBenchResult& none = report.results[0];
+  const ReorderBenchResult& paths = report.results[1];
+  EXPECT_EQ(paths.heuristic, "paths");
+  EXPECT_EQ(report.results[2].heuristic, "hph");
+  EXPECT_TRUE(paths.image_identical);
+  EXPECT_EQ(paths.rays_traced, none.rays_traced);
+  EXPECT_GT(paths.trace_seconds, 0.0);
+  ASSERT_TRUE(paths.page_faults.has_value());
+  EXPECT_GT(*paths.page_faults, 0u);
+  EXPECT_EQ(parse_reorder_bench_row("paths").name(), "paths");
+  EXPECT_THROW(parse_reorder_bench_row("pathz"), std::invalid_argument);
+}
+
 struct Rendered {
   RenderOutput output;
   std::uint64_t approx_in = 0, approx_out = 0, traced = 0;

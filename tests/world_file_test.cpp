@@ -169,6 +169,33 @@ TEST(WorldFile, RealPagingChangesNoPixelAndCountsItsReadsOnTwoAndEightThreads) {
   fs::remove(path);
 }
 
+// The megakernel pages a world file as the wavefront does: one path at a time, the same image.
+TEST(WorldFile, OnePathAtATimePagesTheFileToo) {
+  const std::string path = temp_path("paged_paths.wtw");
+  const std::vector<std::string> build = {"accel.type=hmq", "accel.hmq.width=8", "build.chunk_triangles=4096"};
+  const std::vector<float> fresh = build_and_save(build, path);
+  std::vector<std::string> paged = build;
+  for (const char* s : {"memory.backing=file", "memory.budget=5%", "memory.page_bytes=4096", "render.threads=2",
+                        "pipeline.mode=megakernel"}) {
+    paged.emplace_back(s);
+  }
+  const RenderPlan plan = plan_render(small_render(paged));
+  const std::unique_ptr<LoadedWorld> world = load_world(path, world_paging(plan), 2);
+  const LoadedWorld& loaded = *world;
+  ASSERT_NE(loaded.file->pager(), nullptr);
+  const RenderOutput output = render_image(plan, World{loaded.scene, *loaded.accelerator, *loaded.lights, nullptr,
+                                                       loaded.file->pager()},
+                                           resolve_camera(plan.camera, loaded.scene));
+  EXPECT_TRUE(output.image == fresh);
+  ASSERT_EQ(output.run.stages.size(), 2u);
+  const StageStats& walks = output.run.stages[1];
+  EXPECT_EQ(walks.name, "trace");
+  ASSERT_TRUE(walks.disk.has_value());
+  EXPECT_GT(walks.disk->counters.faults, 0u);
+  EXPECT_EQ(walks.disk->counters.bytes_read, walks.disk->counters.faults * 4096);
+  fs::remove(path);
+}
+
 // A paged walk announces what it reads, so that pages come in by the probe's touch, not by a
 // fault in the read: only a leaf record that ends on the next page is read there before the
 // probe hears of its end. With pages larger than the OS's, this needs the pager's pages

@@ -22,13 +22,14 @@ const StageStats* find_stage(const PipelineRun& run, std::string_view name) {
 
 // One render's figures: its stages' seconds and rays (the photon pass's too), and what
 // [memory] counted of trace and approx_hit.
-ReorderBenchResult result_of(ReorderHeuristic heuristic, const RenderOutput& output) {
+ReorderBenchResult result_of(const ReorderBenchRow& row, const RenderOutput& output) {
   ReorderBenchResult result;
-  result.heuristic = to_string(heuristic);
+  result.heuristic = row.name();
   result.render_seconds = output.seconds();
   result.closest_mrays_per_s = output.closest_mrays_per_s;
   result.shadow_mrays_per_s = output.any_mrays_per_s;
   const double thread_seconds = output.seconds() * output.run.threads;
+  if (const StageStats* paths = find_stage(output.run, "megakernel")) result.rays_traced = paths->rays_in;
   if (const StageStats* trace = find_stage(output.run, "trace")) {
     result.trace_seconds = trace->seconds;
     result.trace_mrays_per_s = trace->mrays_per_s();
@@ -88,18 +89,29 @@ ReorderBenchResult result_of(ReorderHeuristic heuristic, const RenderOutput& out
   return result;
 }
 
+// A row's settings: its heuristic's, and for `paths` the megakernel.
+Config row_variant(const Config& config, const ReorderBenchRow& row) {
+  Config variant = heuristic_variant(config, row.heuristic);
+  if (row.paths) variant.set_value("pipeline.mode", std::string("megakernel"));
+  return variant;
+}
+
 }  // namespace
 
-ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<ReorderHeuristic>& heuristics, int rounds) {
+ReorderBenchRow parse_reorder_bench_row(const std::string& name) {
+  return name == "paths" ? ReorderBenchRow::paths_row() : ReorderBenchRow(parse_reorder_heuristic(name));
+}
+
+ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<ReorderBenchRow>& heuristics, int rounds) {
   if (heuristics.empty()) throw ConfigError("--heuristics names no heuristic");
   if (rounds < 1) throw ConfigError("--repeat must be at least 1");
-  const RenderPlan base = plan_render(heuristic_variant(config, heuristics.front()));
+  const RenderPlan base = plan_render(row_variant(config, heuristics.front()));
   if (base.rules.max_depth < 3) {
     throw ConfigError(fmt::format("render.max_depth = {}: the reorder benchmark path traces to depth 3 or more",
                                   base.rules.max_depth));
   }
   bool hit_points = false;
-  for (ReorderHeuristic heuristic : heuristics) hit_points = hit_points || uses_hit_points(heuristic);
+  for (const ReorderBenchRow& row : heuristics) hit_points = hit_points || uses_hit_points(row.heuristic);
   const RenderWorld opened(base, hit_points);
   const Scene& scene = opened.scene();
   const Accelerator* accelerator = &opened.accelerator();
@@ -115,8 +127,10 @@ ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<Reo
   if (saved) report.world_bytes = saved->file->file_bytes();
   report.accel = accelerator->name();
   report.curve = to_string(base.reorder.curve);
-  report.image = fmt::format("{}x{}, {} spp, depth {}", base.image.width, base.image.height,
-                             base.image.samples_per_pixel, base.rules.max_depth);
+  // The camera rays' order is the baseline's: the paper generates them along the Z-curve.
+  report.image = fmt::format("{}x{}, {} spp, depth {}, camera rays in {} order", base.image.width, base.image.height,
+                             base.image.samples_per_pixel, base.rules.max_depth,
+                             base.pixel_order == PixelOrder::zcurve ? "Z-curve" : "scanline");
   if (base.integrator == Integrator::photon) {
     report.image += fmt::format(", photon mapping ({} photons, k = {}, {} gathering rays)", base.photon.count,
                                 base.photon.k, base.photon.gather_rays);
@@ -151,14 +165,13 @@ ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<Reo
   std::vector<std::vector<ReorderBenchResult>> rounds_of(heuristics.size());
   for (int round = 0; round < rounds; ++round) {
     for (std::size_t h = 0; h < heuristics.size(); ++h) {
-      const ReorderHeuristic heuristic = heuristics[h];
-      const RenderPlan plan = plan_render(heuristic_variant(config, heuristic));
+      const RenderPlan plan = plan_render(row_variant(config, heuristics[h]));
       const ProcessCpuTime cpu_before = read_process_cpu_time();
       const RenderOutput output = render_image(plan, world, camera);
       const ProcessCpuTime cpu = read_process_cpu_time() - cpu_before;
       report.threads = output.run.threads;
 
-      ReorderBenchResult result = result_of(heuristic, output);
+      ReorderBenchResult result = result_of(heuristics[h], output);
       result.cpu_user_seconds = cpu.user_seconds;
       result.cpu_system_seconds = cpu.system_seconds;
       if (first_image.empty()) first_image = output.image;

@@ -17,6 +17,25 @@
 
 namespace wavetrace {
 
+// What one row renders: a reorder heuristic's wavefront render, or `paths`: no reordering and
+// no wavefront, each path traced to its end before the next (pipeline.mode = megakernel), the
+// paper's renderer without its reordering module ("process rays as they are generated").
+struct ReorderBenchRow {
+  ReorderBenchRow(ReorderHeuristic heuristic = ReorderHeuristic::none) : heuristic(heuristic) {}  // NOLINT: a heuristic is a row
+  static ReorderBenchRow paths_row() {
+    ReorderBenchRow row;
+    row.paths = true;
+    return row;
+  }
+  std::string name() const { return paths ? "paths" : to_string(heuristic); }
+
+  ReorderHeuristic heuristic;
+  bool paths = false;
+};
+
+// A row by its name: a heuristic's (reorder_keys.hpp) or "paths"; throws std::invalid_argument.
+ReorderBenchRow parse_reorder_bench_row(const std::string& name);
+
 struct ReorderBenchResult {
   std::string heuristic;
   double render_seconds = 0.0;  // the whole render: with photon mapping, both passes
@@ -67,11 +86,10 @@ struct ReorderBenchReport {
   std::vector<ReorderBenchResult> results;
 };
 
-// `config` holds every other setting (scene, accel, render, proxy, memory); each heuristic
-// gets reorder.heuristic and the chain it needs; `rounds` times over, the heuristics in
-// turn. Throws ConfigError for a depth under 3 or no round.
-ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<ReorderHeuristic>& heuristics,
-                                     int rounds = 1);
+// `config` holds every other setting (scene, accel, render, proxy, memory); each row gets
+// reorder.heuristic and the chain it needs (`paths` the megakernel); `rounds` times over, the
+// rows in turn. Throws ConfigError for a depth under 3 or no round.
+ReorderBenchReport run_reorder_bench(const Config& config, const std::vector<ReorderBenchRow>& rows, int rounds = 1);
 
 nlohmann::json to_json(const ReorderBenchReport& report);
 std::string to_table(const ReorderBenchReport& report);

@@ -2,13 +2,17 @@
 #include "wavetrace/pipeline/megakernel.hpp"
 
 #include <atomic>
+#include <optional>
 #include <utility>
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
+#include "wavetrace/memory/memory_probe.hpp"
 #include "wavetrace/pipeline/tracing_arena.hpp"
+#include "wavetrace/stages/observed_stage.hpp"
 
 namespace wavetrace {
 namespace {
@@ -20,6 +24,7 @@ struct PathScratch {
   Batch current{1}, next{1}, shadow{1};
   std::uint64_t rays_traced = 0;
   std::uint64_t nanoseconds = 0;
+  std::uint64_t trace_nanoseconds = 0;  // observed runs only
 };
 
 }  // namespace
@@ -38,6 +43,7 @@ PipelineRun run_megakernel(const GenerateStage& generate, const TraceStage& trac
   tbb::enumerable_thread_specific<PathScratch> scratch;
   std::atomic<std::uint64_t> camera_rays_done{0}, rays_traced{0};  // for progress reports
   const Clock::time_point start = Clock::now();
+  const ProcessCpuTime cpu_at_start = read_process_cpu_time();
   std::optional<ProgressReporter> reporter;
   reporter.emplace(
       on_progress,
@@ -54,6 +60,24 @@ PipelineRun run_megakernel(const GenerateStage& generate, const TraceStage& trac
       PathScratch& s = scratch.local();
       const std::uint64_t traced_before = s.rays_traced;
       std::uint64_t paths = 0;
+      // Observed ([memory]), each ray's walk goes through the trace stage's probe, which pages
+      // a world read from a file, and is timed apart as the wavefront's trace stage is.
+      std::optional<RecordingProbe> probe;
+      if (const MemoryObservers* observers = trace.observers()) {
+        probe.emplace(*observers, std::size_t(ObservedStage::trace),
+                      std::size_t(tbb::this_task_arena::current_thread_index()));
+      }
+      const auto trace_one = [&](Batch& batch) {
+        ++s.rays_traced;
+        if (!probe) {
+          trace.trace_run(batch, one);
+          return;
+        }
+        const Clock::time_point since = Clock::now();
+        trace.trace_run(batch, one, &*probe);
+        s.trace_nanoseconds += static_cast<std::uint64_t>(
+            std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - since).count());
+      };
       for (std::uint32_t tile = tiles.begin(); tile != tiles.end(); ++tile) {
         const std::uint32_t x0 = tile % tiles_x * side, y0 = tile / tiles_x * side;
         for (std::uint32_t y = y0; y < std::min(y0 + side, image.height); ++y) {
@@ -64,15 +88,13 @@ PipelineRun run_megakernel(const GenerateStage& generate, const TraceStage& trac
               generate.write_camera_ray(current->rays, 0, y * image.width + x, sample);
               current->rays.count = 1;
               for (;;) {
-                trace.trace_run(*current, one);
-                ++s.rays_traced;
+                trace_one(*current);
                 if (shade.shade(*current, one) == 0 || spawn == nullptr) break;
                 next->rays.count = 0;
                 s.shadow.rays.count = 0;
                 spawn->spawn(*current, one, next->rays, &s.shadow.rays);
                 if (s.shadow.rays.count > 0) {
-                  trace.trace_run(s.shadow, one);
-                  ++s.rays_traced;
+                  trace_one(s.shadow);
                   shade.shade(s.shadow, one);
                 }
                 if (next->rays.count == 0) break;
@@ -92,6 +114,7 @@ PipelineRun run_megakernel(const GenerateStage& generate, const TraceStage& trac
 
   PipelineRun run;
   run.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  run.cpu = read_process_cpu_time() - cpu_at_start;
   reporter.reset();
   run.threads = arena.threads();
   StageStats stats;
@@ -102,6 +125,14 @@ PipelineRun run_megakernel(const GenerateStage& generate, const TraceStage& trac
   }
   stats.rays_out = 0;
   run.stages.push_back(stats);
+  if (trace.observers() != nullptr) {
+    // The walks alone, under the wavefront's name for them, where [memory] reports its counts.
+    StageStats walks;
+    walks.name = trace.name();
+    walks.rays_in = walks.rays_out = stats.rays_in;
+    for (const PathScratch& s : scratch) walks.seconds += double(s.trace_nanoseconds) * 1e-9;
+    run.stages.push_back(walks);
+  }
   return run;
 }
 

@@ -76,8 +76,12 @@ void check_megakernel_plan(const RenderPlan& plan) {
                                   "spawn (set pipeline.stages = auto)",
                                   fmt::join(plan.stages, ", ")));
   }
-  if (plan.memory.enabled()) {
-    throw ConfigError("[memory] observation (pager, cache) counts the wavefront's stages: set pipeline.mode = wavefront");
+  // [memory] observes the megakernel's trace calls (the paper's renderer without reordering:
+  // each path's rays one after another); the look-ahead reads the wavefront's queued batches.
+  if (plan.memory.look_ahead_batches > 0) {
+    throw ConfigError(fmt::format("memory.look_ahead = {} reads the batches queued for trace: pipeline.mode = "
+                                  "megakernel has none (set memory.look_ahead = 0 or pipeline.mode = wavefront)",
+                                  plan.memory.look_ahead_batches));
   }
 }
 

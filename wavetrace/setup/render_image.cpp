@@ -113,13 +113,15 @@ RenderOutput render_image(const RenderPlan& plan, const World& world, const Came
     }
   }
   if (plan.pipeline.mode == PipelineMode::megakernel) {
-    // The control experiment runs without the trace stage's per-run clocks and counters
-    // (and plan_render refused [memory] observation for it).
-    const TraceStage trace(world.accelerator, world.scene.material_runs);
+    // The control experiment runs without the trace stage's per-run clocks and counters,
+    // but for [memory]'s: observed, its walks page a world file as the wavefront's do.
+    const TraceStage trace(world.accelerator, world.scene.material_runs,
+                           TraceInstruments{.observers = observation ? &observation->observers() : nullptr});
     const ShadeStage shade(world, film, plan.rules);
     const SpawnStage spawn(world, plan.rules);
     output.run = run_megakernel(generate, trace, shade, &spawn, {plan.pipeline.threads, plan.pipeline.tile_side},
                                 on_progress);
+    if (observation) observation->report(output.run.stages);
   } else {
     std::unique_ptr<PhotonMaps> maps;
     BatchPool batches(plan.pipeline.batch_size);  // both passes' batches: the camera pass reuses the photons'

@@ -64,6 +64,8 @@ class TraceStage final : public Stage {
   // Traces `range` of `batch`, whose rays are all of one kind; the megakernel calls it
   // for one ray at a time. `probe` sees every read (null: unobserved).
   void trace_run(Batch& batch, RayRange range, RecordingProbe* probe = nullptr) const;
+  // What sees the reads of trace_run's walks, when they are observed ([memory]); else null.
+  const MemoryObservers* observers() const { return instruments_.observers; }
 
   // Observed runs are traced this many rays at a time, the window in which the pager
   // counts the distinct pages consecutive rays touch (`disk.pages_per_1000_rays`).
