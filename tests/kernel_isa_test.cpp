@@ -14,6 +14,7 @@
 
 #include "accel_options.hpp"
 #include "test_support.hpp"
+#include "wavetrace/accel/hmq/leaf_hit.hpp"
 #include "wavetrace/accel/registry.hpp"
 #include "wavetrace/bench/ray_sets.hpp"
 #include "wavetrace/kernels/lane_sort.hpp"
@@ -60,6 +61,50 @@ TEST(KernelIsa, LaneSortOrdersChildrenAsTheBaselineDoes) {
     _mm256_store_si256(reinterpret_cast<__m256i*>(actual), lane_sort::nearest_last_avx512(_mm256_load_ps(near), entered));
     for (int lane = 0; lane < 8; ++lane) ASSERT_EQ(expected[lane], actual[lane]) << "trial " << trial << " lane " << lane;
   }
+#else
+  GTEST_SKIP() << "this build (-march=" WAVETRACE_ARCH ") has one set of walks";
+#endif
+}
+
+// The AVX-512 walks gather a leaf's corners sixteen lanes at once, by a permute of one register
+// (up to 16 vertices or slots), of two (up to 32) or a gather: each lane k < triangles holds
+// triangle k's corners, for every strip layout, plain and indexed, at each vertex count.
+TEST(KernelIsa, SixteenLanesGatherEveryTrianglesCorners) {
+#if WAVETRACE_AVX512_DISPATCH
+  if (!cpu_runs_avx512()) GTEST_SKIP() << "this CPU has no AVX-512";
+  std::mt19937 random(11);
+  const hmq::StripTable& table = hmq::StripTable::instance();
+  std::size_t checked = 0;
+  for (std::uint32_t entry = 0; entry < table.size(); ++entry) {
+    const hmq::StripLayoutEntry& layout = table.entry(entry);
+    for (const bool indexed : {false, true}) {
+      for (const std::uint32_t vertices : {3u, 8u, 16u, 17u, 32u, 33u, 63u}) {
+        if (!indexed && vertices != layout.slots) continue;  // plain strips: slot i is vertex i
+        if (indexed && vertices > layout.slots) continue;
+        hmq::DecodedLeaf decoded{};
+        decoded.header.indexed = indexed;
+        decoded.header.vertex_count = vertices;
+        decoded.layout = &layout;
+        for (int axis = 0; axis < 3; ++axis) {
+          for (std::uint32_t v = 0; v < 64; ++v) decoded.position[axis][v] = float(axis * 1000 + v);
+        }
+        for (std::uint32_t slot = 0; slot < 64; ++slot) decoded.slot_vertex[slot] = random() % vertices;
+        TriangleLanes<16> lanes{};
+        hmq::gather_corners_sixteen(decoded, lanes);
+        for (std::uint32_t k = 0; k < layout.triangles; ++k) {
+          for (std::uint32_t c = 0; c < 3; ++c) {
+            const glm::vec3 corner = decoded.slot_position(layout.first_slot[k] + c);
+            for (int axis = 0; axis < 3; ++axis) {
+              ASSERT_EQ(lanes.corner[c][axis][k], corner[axis])
+                  << "entry " << entry << (indexed ? " indexed" : "") << " vertices " << vertices << " triangle " << k;
+            }
+          }
+        }
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, table.size());
 #else
   GTEST_SKIP() << "this build (-march=" WAVETRACE_ARCH ") has one set of walks";
 #endif

@@ -1,5 +1,5 @@
 // The watertight test (triangle_intersect.hpp) for several triangles at once, one per SIMD
-// lane (4 with SSE, 8 with AVX2), with the scalar test's float operations in the scalar
+// lane (4 with SSE, 8 with AVX2, 16 in the AVX-512 walks), with the scalar test's float operations in the scalar
 // test's order, so every lane's edge weights, determinant and distance are bit-identical to
 // intersect_watertight's. Lanes with an edge weight of exactly zero (where the scalar test
 // redoes the edges in double) are reported apart for the caller to redo with the scalar test.
@@ -40,6 +40,10 @@ struct WatertightLanes {
 
 namespace lanes {
 
+// Comparisons are named (equal, less, greater: false where either side is NaN, as C's
+// operators are) so that each width gives them its own mask type: a vector of -1 and 0 for
+// SSE and AVX2, a mask register for AVX-512, where GCC 12 turns a vector-extension compare
+// of 16 floats into sixteen scalar ones.
 template <int kLanes> struct Vector;
 template <> struct Vector<4> {
   using Float = __m128;
@@ -47,6 +51,9 @@ template <> struct Vector<4> {
   static Float splat(float x) { return _mm_set1_ps(x); }
   static Float load(const float* p) { return _mm_load_ps(p); }
   static void store(float* p, Float x) { _mm_store_ps(p, x); }
+  static auto equal(Float a, Float b) { return a == b; }
+  static auto less(Float a, Float b) { return a < b; }
+  static auto greater(Float a, Float b) { return a > b; }
   template <typename Mask> static unsigned bits(Mask m) { return static_cast<unsigned>(_mm_movemask_ps(Float(m))); }
 };
 template <> struct Vector<8> {
@@ -55,15 +62,38 @@ template <> struct Vector<8> {
   static Float splat(float x) { return _mm256_set1_ps(x); }
   static Float load(const float* p) { return _mm256_load_ps(p); }
   static void store(float* p, Float x) { _mm256_store_ps(p, x); }
+  static auto equal(Float a, Float b) { return a == b; }
+  static auto less(Float a, Float b) { return a < b; }
+  static auto greater(Float a, Float b) { return a > b; }
   template <typename Mask> static unsigned bits(Mask m) { return static_cast<unsigned>(_mm256_movemask_ps(Float(m))); }
 };
+#if WAVETRACE_AVX512_DISPATCH
+// Only the AVX-512 walks instantiate it: members of that target, which only a function of that
+// target may inline (kernel_isa.hpp).
+template <> struct Vector<16> {
+  using Float = __m512;
+  using Int = std::int32_t __attribute__((vector_size(64)));
+  [[WAVETRACE_AVX512_TARGET]] static Float splat(float x) { return _mm512_set1_ps(x); }
+  [[WAVETRACE_AVX512_TARGET]] static Float load(const float* p) { return _mm512_load_ps(p); }
+  [[WAVETRACE_AVX512_TARGET]] static void store(float* p, Float x) { _mm512_store_ps(p, x); }
+  [[WAVETRACE_AVX512_TARGET]] static __mmask16 equal(Float a, Float b) { return _mm512_cmp_ps_mask(a, b, _CMP_EQ_OQ); }
+  [[WAVETRACE_AVX512_TARGET]] static __mmask16 less(Float a, Float b) { return _mm512_cmp_ps_mask(a, b, _CMP_LT_OQ); }
+  [[WAVETRACE_AVX512_TARGET]] static __mmask16 greater(Float a, Float b) { return _mm512_cmp_ps_mask(a, b, _CMP_GT_OQ); }
+  static unsigned bits(unsigned m) { return m & 0xffffu; }
+};
+#endif
 
 }  // namespace lanes
 
-template <int kLanes>
-[[gnu::always_inline]] inline void intersect_watertight_lanes(const WatertightRay& ray, const TriangleLanes<kLanes>& lanes,
+// GCC warns that the 16-lane instance calls functions that return __m512 from a function not
+// of the AVX-512 target; it runs only inlined into one (kernel_isa.hpp), so no call is made.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
+// Tests the kLanes triangles of `lanes` from lane `first` on (a multiple of kLanes).
+template <int kLanes, int kRowLanes>
+[[gnu::always_inline]] inline void intersect_watertight_lanes(const WatertightRay& ray, const TriangleLanes<kRowLanes>& lanes,
                                                               unsigned used, float tmin, float tmax,
-                                                              WatertightLanes<kLanes>& out) {
+                                                              WatertightLanes<kLanes>& out, int first = 0) {
   using V = lanes::Vector<kLanes>;
   using Float = typename V::Float;
   const int axes[3] = {ray.kx, ray.ky, ray.kz};
@@ -73,7 +103,7 @@ template <int kLanes>
   for (int k = 0; k < 3; ++k) origin[k] = V::splat(ray_origin[axes[k]]);
   Float relative[3][3];  // corner, permuted axis (x, y, z of the sheared frame before shearing)
   for (int c = 0; c < 3; ++c) {
-    for (int k = 0; k < 3; ++k) relative[c][k] = V::load(lanes.corner[c][axes[k]]) - origin[k];
+    for (int k = 0; k < 3; ++k) relative[c][k] = V::load(lanes.corner[c][axes[k]] + first) - origin[k];
   }
   const Float shear_x = V::splat(ray.shear_x), shear_y = V::splat(ray.shear_y);
   Float px[3], py[3];
@@ -86,9 +116,9 @@ template <int kLanes>
   const Float v = px[0] * py[2] - py[0] * px[2];
   const Float w = px[1] * py[0] - py[1] * px[0];
   const Float zero = V::splat(0.0f);
-  const auto on_edge = (u == zero) | (v == zero) | (w == zero);
-  const auto any_negative = (u < zero) | (v < zero) | (w < zero);
-  const auto any_positive = (u > zero) | (v > zero) | (w > zero);
+  const auto on_edge = V::equal(u, zero) | V::equal(v, zero) | V::equal(w, zero);
+  const auto any_negative = V::less(u, zero) | V::less(v, zero) | V::less(w, zero);
+  const auto any_positive = V::greater(u, zero) | V::greater(v, zero) | V::greater(w, zero);
   const Float determinant = (u + v) + w;
   const Float shear_z = V::splat(ray.shear_z);
   const Float scaled_t = (u * (shear_z * relative[0][2]) + v * (shear_z * relative[1][2])) + w * (shear_z * relative[2][2]);
@@ -99,9 +129,10 @@ template <int kLanes>
   const Float abs_determinant = Float(Int(determinant) ^ sign_bit);
   const Float signed_t = Float(Int(scaled_t) ^ sign_bit);
   // The scalar test rejects on `<` or `>`; a NaN compares false there and passes, so here too.
-  const auto outside_interval = (signed_t < V::splat(tmin) * abs_determinant) |
-                                (signed_t > (V::splat(tmax) * abs_determinant) * V::splat(kDistancePrecheckSlack));
-  const auto rejected = (any_negative & any_positive) | outside_interval | (determinant == zero);
+  const auto outside_interval =
+      V::less(signed_t, V::splat(tmin) * abs_determinant) |
+      V::greater(signed_t, (V::splat(tmax) * abs_determinant) * V::splat(kDistancePrecheckSlack));
+  const auto rejected = (any_negative & any_positive) | outside_interval | V::equal(determinant, zero);
   const Float inverse = V::splat(1.0f) / determinant;
   V::store(out.t, scaled_t * inverse);
   V::store(out.u, v * inverse);
@@ -109,6 +140,7 @@ template <int kLanes>
   out.on_edge = V::bits(on_edge) & used;
   out.candidates = ~V::bits(rejected) & used & ~out.on_edge;
 }
+#pragma GCC diagnostic pop
 
 #endif  // WAVETRACE_AVX2
 

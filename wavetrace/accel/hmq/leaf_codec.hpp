@@ -12,6 +12,7 @@
 #include "wavetrace/accel/hmq/hmq_format.hpp"
 #include "wavetrace/accel/hmq/packed_stream.hpp"
 #include "wavetrace/accel/hmq/strip_table.hpp"
+#include "wavetrace/kernels/kernel_isa.hpp"
 #include "wavetrace/scene/triangle_mesh.hpp"
 
 #if WAVETRACE_AVX2
@@ -66,8 +67,8 @@ void encode_leaf(const QuantizedMesh& quantized, std::span<const std::uint32_t> 
 struct DecodedLeaf {
   LeafHeader header;
   const StripLayoutEntry* layout;
-  alignas(32) float position[3][64];  // per axis, per vertex
-  alignas(32) std::uint32_t slot_vertex[64];  // indexed strips: the vertex of each slot; else unused
+  alignas(64) float position[3][64];  // per axis, per vertex; rows aligned for 16-lane loads
+  alignas(64) std::uint32_t slot_vertex[64];  // indexed strips: the vertex of each slot; else unused
   const std::byte* ids;      // the id stream
   const std::byte* corners;  // the corner stream
 
@@ -90,10 +91,46 @@ struct DecodedLeaf {
   }
 };
 
+#if WAVETRACE_AVX512_DISPATCH
+// Whether a walk of this kernel set decodes and tests a leaf sixteen lanes at a time.
+template <KernelIsa kIsa>
+inline constexpr bool kSixteenLanes = kIsa == KernelIsa::avx512;
+
+// One axis of decode_leaf's positions, sixteen vertices at a time (the same operations).
+[[WAVETRACE_AVX512_TARGET]] inline void decode_axis_sixteen(const std::byte* data, std::uint32_t bits,
+                                                            std::uint32_t vertices, int lower, int upper,
+                                                            float origin, float cell, float* position) {
+  using SixteenI32 = std::int32_t __attribute__((vector_size(64)));
+  using SixteenF32 = float __attribute__((vector_size(64)));
+  for (std::uint32_t first = 0; first < vertices; first += 16) {
+    const SixteenU32 value = read_stream_sixteen(data, bits, first, vertices);
+    const SixteenU32 offset = value >> 1u;
+    // In unsigned arithmetic, as the scalar decode: the adds and subtracts wrap modulo 2^32.
+    const SixteenU32 line = (value & 1u) != 0u ? std::uint32_t(upper) - offset : std::uint32_t(lower) + offset;
+    const SixteenF32 position_lanes = origin + __builtin_convertvector(SixteenI32(line), SixteenF32) * cell;
+    std::memcpy(position + first, &position_lanes, sizeof(position_lanes));
+  }
+}
+
+// The slots' vertex indices of an indexed record, sixteen at a time.
+[[WAVETRACE_AVX512_TARGET]] inline void decode_indices_sixteen(const std::byte* data, std::uint32_t bits,
+                                                               std::uint32_t slots, std::uint32_t* slot_vertex) {
+  for (std::uint32_t first = 0; first < slots; first += 16) {
+    const SixteenU32 vertex = read_stream_sixteen(data, bits, first, slots);
+    std::memcpy(slot_vertex + first, &vertex, sizeof(vertex));
+  }
+}
+#else
+template <KernelIsa>
+inline constexpr bool kSixteenLanes = false;
+#endif
+
 // Vertex v's grid line on an axis is the leaf box's plane its offset counts from (the
 // min-max trick), and its position the grid point of that line: origin + line * cell, the
 // float operations of GlobalGrid::point. With AVX2, eight vertices at a time straight from
-// the record (read_stream_lanes), the columns' lanes past the last vertex left unspecified.
+// the record (read_stream_lanes), sixteen in the AVX-512 walks, the columns' lanes past the
+// last vertex left unspecified.
+template <KernelIsa kIsa = KernelIsa::baseline>
 inline void decode_leaf(const std::byte* record, const GlobalGrid& grid, const GridBox& box, DecodedLeaf& leaf) {
   leaf.header = read_leaf_header(record);
   leaf.layout = &StripTable::instance().entry(leaf.header.entry);
@@ -104,6 +141,15 @@ inline void decode_leaf(const std::byte* record, const GlobalGrid& grid, const G
     const int lower = box.lower[axis], upper = box.upper[axis];
     const float origin = grid.origin[axis], cell = grid.cell[axis];
     float* position = leaf.position[axis];
+#if WAVETRACE_AVX512_DISPATCH
+    if constexpr (kSixteenLanes<kIsa>) {
+      if (bits <= kLaneStreamBits) {
+        decode_axis_sixteen(data, bits, vertices, lower, upper, origin, cell, position);
+        data += stream_bytes(bits, vertices);
+        continue;
+      }
+    }
+#endif
 #if WAVETRACE_AVX2
     if (bits <= kLaneStreamBits) {
       for (std::uint32_t first = 0; first < vertices; first += 8) {
@@ -133,19 +179,26 @@ inline void decode_leaf(const std::byte* record, const GlobalGrid& grid, const G
   }
   const std::uint32_t slots = leaf.layout->slots;
   if (leaf.header.indexed) {
-#if WAVETRACE_AVX2
-    if (leaf.header.index_bits != 0) {
-      for (std::uint32_t first = 0; first < slots; first += 8) {
-        _mm256_store_si256(reinterpret_cast<__m256i*>(leaf.slot_vertex + first),
-                           read_stream_lanes(data, leaf.header.index_bits, first, slots));
-      }
-    } else {
-      read_stream(data, 0, slots, leaf.slot_vertex);
-    }
-#else
-    read_stream(data, leaf.header.index_bits, slots, leaf.slot_vertex);
+    const std::uint32_t bits = leaf.header.index_bits;
+#if WAVETRACE_AVX512_DISPATCH
+    if (kSixteenLanes<kIsa> && bits != 0) {
+      decode_indices_sixteen(data, bits, slots, leaf.slot_vertex);
+    } else
 #endif
-    data += stream_bytes(leaf.header.index_bits, slots);
+    {
+#if WAVETRACE_AVX2
+      if (bits != 0) {
+        for (std::uint32_t first = 0; first < slots; first += 8) {
+          _mm256_store_si256(reinterpret_cast<__m256i*>(leaf.slot_vertex + first), read_stream_lanes(data, bits, first, slots));
+        }
+      } else {
+        read_stream(data, 0, slots, leaf.slot_vertex);
+      }
+#else
+      read_stream(data, bits, slots, leaf.slot_vertex);
+#endif
+    }
+    data += stream_bytes(bits, slots);
   }
   const std::uint32_t triangles = leaf.layout->triangles;
   leaf.ids = data;

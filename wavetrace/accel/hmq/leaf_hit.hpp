@@ -15,6 +15,7 @@
 #include "wavetrace/accel/hmq/global_grid.hpp"
 #include "wavetrace/accel/hmq/hmq_format.hpp"
 #include "wavetrace/accel/hmq/leaf_codec.hpp"
+#include "wavetrace/kernels/kernel_isa.hpp"
 #include "wavetrace/kernels/nearest_hit.hpp"
 #include "wavetrace/kernels/triangle_intersect.hpp"
 #include "wavetrace/kernels/watertight_lanes.hpp"
@@ -40,12 +41,13 @@ struct LeafHit {
   }
 };
 
-// A leaf decoded once, with its triangles' corners gathered into lanes (eight triangles a
-// pass), ready to be tested by one ray or by each ray of a packet.
+// A leaf decoded once, with its triangles' corners gathered into lanes (triangle k in lane k),
+// ready to be tested by one ray or by each ray of a packet: eight triangles a pass in AVX2, all
+// fourteen in one pass of the AVX-512 walks.
 struct LeafTriangles {
   DecodedLeaf decoded;
 #if WAVETRACE_AVX2
-  TriangleLanes<8> lanes[2];  // triangles 0-7 and 8-13
+  TriangleLanes<16> lanes;
 #endif
   glm::vec3 corner(std::uint32_t k, std::uint32_t c) const {
     return decoded.slot_position(decoded.layout->first_slot[k] + c);
@@ -72,7 +74,37 @@ struct LeafTriangles {
 inline int lane_parts(std::uint32_t entries) { return entries <= 8 ? 1 : entries <= 16 ? 2 : entries <= 32 ? 4 : 0; }
 #endif
 
-template <typename Probe>
+#if WAVETRACE_AVX512_DISPATCH
+// pick_lanes in sixteen lanes: one permute over up to 16 entries, one of two registers over
+// up to 32, a gather past that. (The masked forms here and in the widening below start from
+// zero, where the plain ones start from _mm512_undefined, which GCC 12 reports as maybe
+// uninitialized once inlined.)
+[[WAVETRACE_AVX512_TARGET]] inline __m512 pick_sixteen_lanes(const float* column, __m512i index, std::uint32_t entries) {
+  if (entries <= 16) return _mm512_maskz_permutexvar_ps(0xffff, index, _mm512_load_ps(column));
+  if (entries <= 32) return _mm512_permutex2var_ps(_mm512_load_ps(column), index, _mm512_load_ps(column + 16));
+  return _mm512_mask_i32gather_ps(_mm512_setzero_ps(), 0xffff, index, column, 4);
+}
+
+// The AVX-512 walks' gather of every triangle's corners into lanes, sixteen at once.
+[[WAVETRACE_AVX512_TARGET]] inline void gather_corners_sixteen(const DecodedLeaf& decoded, TriangleLanes<16>& lanes) {
+  const StripLayoutEntry& layout = *decoded.layout;
+  const __m512i index_mask = _mm512_set1_epi32(63);  // lanes past the last triangle pick in bounds
+  const __m512i first_slot =
+      _mm512_maskz_cvtepu8_epi32(0xffff, _mm_loadu_si128(reinterpret_cast<const __m128i*>(layout.first_slot.data())));
+  const float* slot_vertex = reinterpret_cast<const float*>(decoded.slot_vertex);  // permuted as bits
+  for (int c = 0; c < 3; ++c) {
+    __m512i vertex = _mm512_and_si512(_mm512_add_epi32(first_slot, _mm512_set1_epi32(c)), index_mask);
+    if (decoded.header.indexed) {
+      vertex = _mm512_and_si512(_mm512_castps_si512(pick_sixteen_lanes(slot_vertex, vertex, layout.slots)), index_mask);
+    }
+    for (int axis = 0; axis < 3; ++axis) {
+      _mm512_store_ps(lanes.corner[c][axis], pick_sixteen_lanes(decoded.position[axis], vertex, decoded.header.vertex_count));
+    }
+  }
+}
+#endif
+
+template <KernelIsa kIsa = KernelIsa::baseline, typename Probe>
 [[gnu::always_inline]] inline void prepare_leaf(const std::byte* record, const GlobalGrid& grid, const Box& box,
                                                 LeafTriangles& leaf, Probe& probe) {
   DecodedLeaf& decoded = leaf.decoded;
@@ -81,8 +113,11 @@ template <typename Probe>
   // page faults that page in, but in a frame, whose tail holds it).
   const std::byte* bytes = record;
   if constexpr (Probe::kRecords) bytes = probe.template resident_record<kMaxLeafRecordBytes>(record);
-  decode_leaf(bytes, grid, snap_outward(grid, box), decoded);
+  decode_leaf<kIsa>(bytes, grid, snap_outward(grid, box), decoded);
   if constexpr (Probe::kRecords) probe.record_read(record, std::size_t(decoded.end() - bytes));
+#if WAVETRACE_AVX512_DISPATCH
+  if constexpr (kSixteenLanes<kIsa>) return gather_corners_sixteen(decoded, leaf.lanes);
+#endif
 #if WAVETRACE_AVX2
   const StripLayoutEntry& layout = *decoded.layout;
   const __m256i index_mask = _mm256_set1_epi32(63);  // lanes past the last triangle pick in bounds
@@ -92,14 +127,13 @@ template <typename Probe>
     __m128i first_bytes = _mm_setzero_si128();
     std::memcpy(&first_bytes, layout.first_slot.data() + base, 8);
     const __m256i first_slot = _mm256_cvtepu8_epi32(first_bytes);
-    TriangleLanes<8>& lanes = leaf.lanes[base / 8];
     for (int c = 0; c < 3; ++c) {
       __m256i vertex = _mm256_and_si256(_mm256_add_epi32(first_slot, _mm256_set1_epi32(c)), index_mask);
       if (decoded.header.indexed) {
         vertex = _mm256_and_si256(_mm256_castps_si256(pick_lanes(slot_vertex, vertex, slot_parts)), index_mask);
       }
       for (int axis = 0; axis < 3; ++axis) {
-        _mm256_store_ps(lanes.corner[c][axis], pick_lanes(decoded.position[axis], vertex, vertex_parts));
+        _mm256_store_ps(leaf.lanes.corner[c][axis] + base, pick_lanes(decoded.position[axis], vertex, vertex_parts));
       }
     }
   }
@@ -109,7 +143,7 @@ template <typename Probe>
 // Tests a prepared leaf's triangles against one ray; a hit that replaces `best` by the
 // nearest-hit rule (nearest_hit.hpp) shrinks `tmax` to it (with kAnyHit, the first hit ends
 // the test).
-template <bool kAnyHit>
+template <bool kAnyHit, KernelIsa kIsa = KernelIsa::baseline>
 [[gnu::always_inline]] inline void test_leaf_triangles(const LeafTriangles& leaf, const WatertightRay& sheared,
                                                        float tmin, float& tmax, LeafHit& best) {
   const DecodedLeaf& decoded = leaf.decoded;
@@ -128,10 +162,11 @@ template <bool kAnyHit>
 #if WAVETRACE_AVX2
   // Candidates of each pass are taken in triangle order against the shrinking tmax, exactly
   // as the scalar loop takes them (same hits, same t).
-  for (std::uint32_t base = 0; base < triangles; base += 8) {
-    const std::uint32_t count = std::min<std::uint32_t>(8, triangles - base);
-    WatertightLanes<8> result;
-    intersect_watertight_lanes(sheared, leaf.lanes[base / 8], (1u << count) - 1, tmin, tmax, result);
+  constexpr std::uint32_t kPass = kSixteenLanes<kIsa> ? 16 : 8;
+  for (std::uint32_t base = 0; base < triangles; base += kPass) {
+    const std::uint32_t count = std::min<std::uint32_t>(kPass, triangles - base);
+    WatertightLanes<kPass> result;
+    intersect_watertight_lanes(sheared, leaf.lanes, (1u << count) - 1, tmin, tmax, result, int(base));
     for (unsigned pending = result.candidates | result.on_edge; pending != 0; pending &= pending - 1) {
       const int lane = std::countr_zero(pending);
       const std::uint32_t k = base + lane;
@@ -168,12 +203,12 @@ class DecodedLeafCache {
  public:
   static constexpr std::size_t kEntries = 8;
 
-  template <typename Probe>
+  template <KernelIsa kIsa, typename Probe>
   [[gnu::always_inline]] const LeafTriangles& leaf(const std::byte* record, const GlobalGrid& grid, const Box& box,
                                                    Probe& probe) {
     const std::size_t slot = (reinterpret_cast<std::uintptr_t>(record) >> 4) % kEntries;
     if (record_[slot] != record || Probe::kRecords) {
-      prepare_leaf(record, grid, box, leaves_[slot], probe);
+      prepare_leaf<kIsa>(record, grid, box, leaves_[slot], probe);
       record_[slot] = Probe::kRecords ? nullptr : record;
     }
     return leaves_[slot];
@@ -186,11 +221,11 @@ class DecodedLeafCache {
 
 // The leaf record at `record`, whose decoded box is `box`, against one ray (decoded through
 // `cache`).
-template <bool kAnyHit, typename Probe>
+template <bool kAnyHit, KernelIsa kIsa = KernelIsa::baseline, typename Probe>
 [[gnu::always_inline]] inline void test_leaf_record(const std::byte* record, const GlobalGrid& grid, const Box& box,
                                                     const WatertightRay& sheared, float tmin, float& tmax,
                                                     LeafHit& best, Probe& probe, DecodedLeafCache& cache) {
-  test_leaf_triangles<kAnyHit>(cache.leaf(record, grid, box, probe), sheared, tmin, tmax, best);
+  test_leaf_triangles<kAnyHit, kIsa>(cache.template leaf<kIsa>(record, grid, box, probe), sheared, tmin, tmax, best);
 }
 
 // With kSurface (closest hits, whose corners test_leaf_record kept) also the point and normal.

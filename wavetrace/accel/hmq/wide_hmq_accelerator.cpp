@@ -300,11 +300,11 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
           walk_quantized_wide_packet<kIsa>(nodes_.data(), root_, packet, live, tmax, probe, stack,
                                      [&](std::uint32_t units, const Bounds3& box, unsigned members) {
                                        LeafTriangles leaf;
-                                       prepare_leaf(leaves + std::size_t(units) * kUnit, grid_, Box{box.lower, box.upper},
-                                                    leaf, probe);
+                                       prepare_leaf<kIsa>(leaves + std::size_t(units) * kUnit, grid_,
+                                                          Box{box.lower, box.upper}, leaf, probe);
                                        for (; members != 0; members &= members - 1) {
                                          const int r = std::countr_zero(members);
-                                         test_leaf_triangles<false>(leaf, packet[r].sheared, packet[r].tmin, tmax[r], best[r]);
+                                         test_leaf_triangles<false, kIsa>(leaf, packet[r].sheared, packet[r].tmin, tmax[r], best[r]);
                                        }
                                      });
         }
@@ -353,7 +353,7 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
       float tmax = ray.tmax;
       LeafHit best;
       walk_quantized_wide<kIsa>(nodes_.data(), root_, ray, tmax, probe, stack, [&](std::uint32_t units, const Bounds3& box) {
-        test_leaf_record<kAnyHit>(leaves + std::size_t(units) * kUnit, grid_, Box{box.lower, box.upper}, ray.sheared,
+        test_leaf_record<kAnyHit, kIsa>(leaves + std::size_t(units) * kUnit, grid_, Box{box.lower, box.upper}, ray.sheared,
                                   ray.tmin, tmax, best, probe, decoded);
         return kAnyHit && best.found;
       }, [&](std::uint32_t units) { return leaves + std::size_t(units) * kUnit; });
