@@ -39,7 +39,7 @@ for _, _, page, buffer, budget, path in sorted(runs):
         rate = r["rays_traced"] / r["render_seconds"]
         versus = lambda name, key: f"{baseline[name][key] / r[key]:.2f}x" if baseline[name] and r[key] else "-"
         pages_1k = r.get("disk_pages_per_1000_rays")
-        pages_1k = f"{pages_1k:.1f}" if pages_1k is not None else "-"  # paths: not counted one ray at a time
+        pages_1k = f"{pages_1k:.1f}" if pages_1k is not None else "-"
         print(f"| {budget}% | {buffer} | {page >> 10:,} | {r['heuristic']} | {r['rays_traced']:,} | {r['rays_traced'] / pages:,.0f} | "
               f"{r['disk_faults']:,} | {r['disk_bytes_read'] / 1e6:,.0f} | {r['disk_read_seconds']:.1f} | "
               f"{r['disk_wait_seconds']:.1f} | {pages_1k} | {r['render_seconds']:.1f} | {rate / 1e6:.3f} | "

@@ -193,6 +193,9 @@ TEST(WorldFile, OnePathAtATimePagesTheFileToo) {
   ASSERT_TRUE(walks.disk.has_value());
   EXPECT_GT(walks.disk->counters.faults, 0u);
   EXPECT_EQ(walks.disk->counters.bytes_read, walks.disk->counters.faults * 4096);
+  // Windows of a worker's 1,000 consecutive rays count the distinct pages they touched.
+  EXPECT_GT(walks.disk->ray_windows.windows, 0u);
+  EXPECT_GT(walks.disk->pages_per_window(), 1.0);
   fs::remove(path);
 }
 

@@ -62,10 +62,14 @@ PipelineRun run_megakernel(const GenerateStage& generate, const TraceStage& trac
       std::uint64_t paths = 0;
       // Observed ([memory]), each ray's walk goes through the trace stage's probe, which pages
       // a world read from a file, and is timed apart as the wavefront's trace stage is.
+      // Windows of a worker's consecutive rays, whatever their kind, count the distinct pages
+      // they touch as the wavefront's runs do (a window's tail at the end is dropped).
       std::optional<RecordingProbe> probe;
+      std::uint32_t window_rays = 0;
       if (const MemoryObservers* observers = trace.observers()) {
         probe.emplace(*observers, std::size_t(ObservedStage::trace),
                       std::size_t(tbb::this_task_arena::current_thread_index()));
+        probe->count_ray_windows();
       }
       const auto trace_one = [&](Batch& batch) {
         ++s.rays_traced;
@@ -74,7 +78,11 @@ PipelineRun run_megakernel(const GenerateStage& generate, const TraceStage& trac
           return;
         }
         const Clock::time_point since = Clock::now();
-        trace.trace_run(batch, one, &*probe);
+        trace.trace_one_ray(batch, &*probe);
+        if (++window_rays == TraceStage::kRayWindow) {
+          probe->end_ray_window(true);
+          window_rays = 0;
+        }
         s.trace_nanoseconds += static_cast<std::uint64_t>(
             std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - since).count());
       };

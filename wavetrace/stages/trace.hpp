@@ -61,9 +61,12 @@ class TraceStage final : public Stage {
   void look_ahead(Batch& copy) const override;
   static constexpr std::uint32_t kLookAheadStride = 4;
 
-  // Traces `range` of `batch`, whose rays are all of one kind; the megakernel calls it
-  // for one ray at a time. `probe` sees every read (null: unobserved).
+  // Traces `range` of `batch`, whose rays are all of one kind. `probe` sees every read (null:
+  // unobserved), and observed runs count their windows of consecutive rays.
   void trace_run(Batch& batch, RayRange range, RecordingProbe* probe = nullptr) const;
+  // The megakernel's call: the batch's one ray, its reads seen by `probe` (null: unobserved),
+  // whose windows of consecutive rays the caller closes.
+  void trace_one_ray(Batch& batch, RecordingProbe* probe) const { trace_window(batch, {0, 1}, probe); }
   // What sees the reads of trace_run's walks, when they are observed ([memory]); else null.
   const MemoryObservers* observers() const { return instruments_.observers; }
 
