@@ -156,7 +156,7 @@ TEST(Materials, ImagesWithMirrorsAndGlassAreIdenticalAcrossThreadsBatchesAndMode
   EXPECT_GT(mean(reference), 0.01);
   for (const std::vector<std::string>& variant : std::vector<std::vector<std::string>>{
            {"render.threads=2", "render.batch_size=64"},
-           {"render.threads=2", "reorder.heuristic=origin_dir", "render.pixel_order=zcurve"},
+           {"render.threads=2", "reorder.heuristic=origin_dir", "render.pixel_order=scanline"},
            {"render.threads=2", "pipeline.mode=megakernel"}}) {
     std::vector<std::string> settings = variant;
     settings.push_back("render.max_depth=6");

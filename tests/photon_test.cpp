@@ -147,7 +147,7 @@ TEST(PhotonRender, ImageIsIdenticalForThreadsBatchSizesOrdersAndHeuristics) {
   EXPECT_GT(reference.photons->caustic_photons, 0u);
   for (const std::vector<std::string>& variant : std::vector<std::vector<std::string>>{
            {"render.threads=2", "render.batch_size=64"},
-           {"render.threads=2", "render.pixel_order=zcurve", "reorder.heuristic=origin_dir"},
+           {"render.threads=2", "render.pixel_order=scanline", "reorder.heuristic=origin_dir"},
            {"render.threads=2", "reorder.heuristic=hph"}}) {
     const RenderOutput other = render(caustic_scene(), with(variant));
     EXPECT_TRUE(other.image == reference.image) << "differs with " << variant[0] << " " << variant[1];

@@ -50,7 +50,7 @@ TEST(Render, ImageIsIdenticalForThreadsBatchSizesPixelOrdersFilmsAndModes) {
   const std::vector<std::vector<std::string>> variants = {
       {"render.threads=2", "render.batch_size=4096"},
       {"render.threads=2", "render.batch_size=64"},
-      {"render.threads=1", "render.batch_size=17", "render.pixel_order=zcurve"},
+      {"render.threads=1", "render.batch_size=17", "render.pixel_order=scanline"},
       {"render.threads=2", "render.batch_size=1000", "render.rays_in_flight=2048"},
       {"render.threads=2", "render.film=per_thread"},
       {"render.threads=2", "render.film=per_thread", "pipeline.mode=megakernel"},

@@ -233,8 +233,9 @@ const std::vector<ConfigKey>& config_schema() {
       {"render.film", T::text, std::string("shared"), 0, 0, {"shared", "per_thread"},
        "shared: one film, atomic adds; per_thread: a film per worker, summed at the end (same image)",
        read_film},
-      {"render.pixel_order", T::text, std::string("scanline"), 0, 0, {"scanline", "zcurve"},
-       "order in which camera rays are generated",
+      {"render.pixel_order", T::text, std::string("zcurve"), 0, 0, {"scanline", "zcurve"},
+       "order in which camera rays are generated: zcurve (the reordering paper's; each batch a compact block of "
+       "pixels) or scanline (each batch a strip of rows); the image is the same",
        choice<parse_pixel_order, &P::pixel_order>},
       {"render.integrator", T::text, std::string("path"), 0, 0, {"path", "photon"},
        "path: path tracing; photon: a photon pass, then camera rays with light samples, the caustic map and final "

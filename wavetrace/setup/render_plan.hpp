@@ -51,7 +51,7 @@ struct RenderPlan {
   SceneRequest scene;
   CameraOverride camera;
   ImageSpec image;
-  PixelOrder pixel_order = PixelOrder::scanline;
+  PixelOrder pixel_order = PixelOrder::zcurve;
   bool film_per_thread = false;  // render.film
   PathRules rules;
   Integrator integrator = Integrator::path;  // render.integrator
