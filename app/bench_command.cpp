@@ -4,6 +4,7 @@
 #include <fstream>
 #include <memory>
 #include <sstream>
+#include <string_view>
 
 #include <fmt/format.h>
 
@@ -161,29 +162,27 @@ Config render_bench_config(const std::vector<std::string>& defaults, const std::
   return config;
 }
 
-// `--heuristics a,b,...` as heuristics, in order.
-std::vector<ReorderHeuristic> parse_heuristic_list(const std::string& list) {
-  std::vector<ReorderHeuristic> heuristics;
+// `--heuristics a,b,...` as what `parse` makes of each name, in order; `also` is appended to
+// the error that names an unknown one.
+template <typename Parse>
+auto parse_heuristic_names(const std::string& list, Parse&& parse, std::string_view also = "") {
+  std::vector<decltype(parse(std::string()))> parsed;
   for (const std::string& name : split_commas(list)) {
     try {
-      heuristics.push_back(parse_reorder_heuristic(name));
+      parsed.push_back(parse(name));
     } catch (const std::invalid_argument& error) {
-      throw ConfigError(fmt::format("--heuristics: {}", error.what()));
+      throw ConfigError(fmt::format("--heuristics: {}{}", error.what(), also));
     }
   }
-  return heuristics;
+  return parsed;
+}
+
+std::vector<ReorderHeuristic> parse_heuristic_list(const std::string& list) {
+  return parse_heuristic_names(list, parse_reorder_heuristic);
 }
 
 std::vector<ReorderBenchRow> parse_reorder_rows(const std::string& list) {
-  std::vector<ReorderBenchRow> rows;
-  for (const std::string& name : split_commas(list)) {
-    try {
-      rows.push_back(parse_reorder_bench_row(name));
-    } catch (const std::invalid_argument& error) {
-      throw ConfigError(fmt::format("--heuristics: {} (or paths: one path at a time, no reordering)", error.what()));
-    }
-  }
-  return rows;
+  return parse_heuristic_names(list, parse_reorder_bench_row, " (or paths: one path at a time, no reordering)");
 }
 
 int run_reorder(const ReorderArguments& args) {
