@@ -19,6 +19,16 @@
 #include <immintrin.h>
 #endif
 
+// Sixteen lanes, for the AVX-512 walks: GCC compiles this file's shared code at 16 lanes where it
+// is inlined into the one function of the AVX-512 target (kernel_isa.hpp). Clang refuses any
+// call that passes a __m512 from a function not of that target, which the shared code is, so a
+// Clang build (the sanitizer build) tests in passes of eight lanes there too (the same hits).
+#if WAVETRACE_AVX512_DISPATCH && !defined(__clang__)
+#define WAVETRACE_WATERTIGHT_SIXTEEN 1
+#else
+#define WAVETRACE_WATERTIGHT_SIXTEEN 0
+#endif
+
 namespace wavetrace {
 
 // Corners in SoA: corner[c][axis][lane]; unused lanes may hold anything finite or not.
@@ -67,7 +77,7 @@ template <> struct Vector<8> {
   static auto greater(Float a, Float b) { return a > b; }
   template <typename Mask> static unsigned bits(Mask m) { return static_cast<unsigned>(_mm256_movemask_ps(Float(m))); }
 };
-#if WAVETRACE_AVX512_DISPATCH
+#if WAVETRACE_WATERTIGHT_SIXTEEN
 // Only the AVX-512 walks instantiate it: members of that target, which only a function of that
 // target may inline (kernel_isa.hpp).
 template <> struct Vector<16> {
@@ -85,10 +95,12 @@ template <> struct Vector<16> {
 
 }  // namespace lanes
 
+#if WAVETRACE_WATERTIGHT_SIXTEEN
 // GCC warns that the 16-lane instance calls functions that return __m512 from a function not
 // of the AVX-512 target; it runs only inlined into one (kernel_isa.hpp), so no call is made.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpsabi"
+#endif
 // Tests the kLanes triangles of `lanes` from lane `first` on (a multiple of kLanes).
 template <int kLanes, int kRowLanes>
 [[gnu::always_inline]] inline void intersect_watertight_lanes(const WatertightRay& ray, const TriangleLanes<kRowLanes>& lanes,
@@ -140,7 +152,9 @@ template <int kLanes, int kRowLanes>
   out.on_edge = V::bits(on_edge) & used;
   out.candidates = ~V::bits(rejected) & used & ~out.on_edge;
 }
+#if WAVETRACE_WATERTIGHT_SIXTEEN
 #pragma GCC diagnostic pop
+#endif
 
 #endif  // WAVETRACE_AVX2
 

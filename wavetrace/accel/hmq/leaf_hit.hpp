@@ -43,7 +43,7 @@ struct LeafHit {
 
 // A leaf decoded once, with its triangles' corners gathered into lanes (triangle k in lane k),
 // ready to be tested by one ray or by each ray of a packet: eight triangles a pass in AVX2, all
-// fourteen in one pass of the AVX-512 walks.
+// fourteen in one pass of the AVX-512 walks (of a GCC build: watertight_lanes.hpp).
 struct LeafTriangles {
   DecodedLeaf decoded;
 #if WAVETRACE_AVX2
@@ -162,7 +162,7 @@ template <bool kAnyHit, KernelIsa kIsa = KernelIsa::baseline>
 #if WAVETRACE_AVX2
   // Candidates of each pass are taken in triangle order against the shrinking tmax, exactly
   // as the scalar loop takes them (same hits, same t).
-  constexpr std::uint32_t kPass = kSixteenLanes<kIsa> ? 16 : 8;
+  constexpr std::uint32_t kPass = kSixteenLanes<kIsa> && WAVETRACE_WATERTIGHT_SIXTEEN ? 16 : 8;
   for (std::uint32_t base = 0; base < triangles; base += kPass) {
     const std::uint32_t count = std::min<std::uint32_t>(kPass, triangles - base);
     WatertightLanes<kPass> result;
