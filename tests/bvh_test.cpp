@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <functional>
 #include <limits>
+#include <random>
 
 #include <gtest/gtest.h>
 #include <glm/vector_relational.hpp>
@@ -107,6 +108,138 @@ TEST(SahBuilder, CutSizeStopsAtTheRangesAFullBuildWouldCutThere) {
     }
   }
   EXPECT_LT(cut.nodes.size(), whole.nodes.size() / 10);
+}
+
+// Wald's binned SAH written the plain way, one primitive and one axis at a time: one set of
+// bins, scalar sweeps, the first cheapest plane in axis then bin order, std::partition. The
+// builder bins in SIMD, deals a range to several sets of bins in turn, sweeps the three axes
+// in lanes and partitions without std::partition: each must leave the tree as this one is.
+struct PlainSahNode {
+  Bounds3 bounds;
+  std::vector<std::uint32_t> leaf;  // the ids, in leaf order; empty for an inner node
+};
+
+void plain_sah(std::vector<SahReference>& refs, std::uint32_t first, std::uint32_t count, const Bounds3& bounds,
+               std::uint32_t depth, const SahOptions& options, std::vector<PlainSahNode>& preorder) {
+  const auto centroid = [](const SahReference& r) { return (r.bounds.lower + r.bounds.upper) * 0.5f; };
+  const auto half_area = [](const Bounds3& b) {
+    if (b.empty()) return 0.0f;
+    const glm::vec3 e = b.extent();
+    return e.x * e.y + e.y * e.z + e.z * e.x;
+  };
+  const auto blocks = [&](std::uint32_t n) { return float((n + options.block_size - 1) / options.block_size); };
+  const auto leaf = [&] {
+    PlainSahNode node{bounds, {}};
+    for (std::uint32_t i = first; i < first + count; ++i) node.leaf.push_back(refs[i].id);
+    preorder.push_back(node);
+  };
+  if (count == 1 || count <= options.cut_size) return leaf();
+  Bounds3 centroids;
+  for (std::uint32_t i = first; i < first + count; ++i) centroids.extend(centroid(refs[i]));
+  const std::uint32_t bins = options.bins;
+  float scale[3];
+  for (int axis = 0; axis < 3; ++axis) {
+    const float extent = centroids.upper[axis] - centroids.lower[axis];
+    scale[axis] = extent > 0.0f ? float(bins) * (1.0f - 1e-6f) / extent : 0.0f;
+  }
+  const auto bin_of = [&](const SahReference& r, int axis) {
+    const int bin = int((centroid(r)[axis] - centroids.lower[axis]) * scale[axis]);
+    return std::uint32_t(std::clamp(bin, 0, int(bins) - 1));
+  };
+  int best_axis = -1;
+  std::uint32_t best_bin = 0;
+  float best_cost = std::numeric_limits<float>::infinity();
+  std::vector<Bounds3> best_boxes;
+  if (depth < 64) {
+    for (int axis = 0; axis < 3; ++axis) {
+      std::vector<Bounds3> box(bins);
+      std::vector<std::uint32_t> in_bin(bins, 0);
+      for (std::uint32_t i = first; i < first + count; ++i) {
+        box[bin_of(refs[i], axis)].extend(refs[i].bounds);
+        ++in_bin[bin_of(refs[i], axis)];
+      }
+      if (!(centroids.upper[axis] > centroids.lower[axis])) continue;
+      for (std::uint32_t plane = 0; plane + 1 < bins; ++plane) {
+        Bounds3 left, right;
+        std::uint32_t left_count = 0, right_count = 0;
+        for (std::uint32_t b = 0; b <= plane; ++b) left.extend(box[b]), left_count += in_bin[b];
+        for (std::uint32_t b = bins - 1; b > plane; --b) right.extend(box[b]), right_count += in_bin[b];
+        if (left_count == 0 || right_count == 0) continue;
+        const float cost = half_area(left) * blocks(left_count) + half_area(right) * blocks(right_count);
+        if (cost < best_cost) best_axis = axis, best_bin = plane, best_cost = cost, best_boxes = box;
+      }
+    }
+  }
+  const float leaf_cost = options.intersection_cost * blocks(count);
+  const float split_cost = options.traversal_cost + options.intersection_cost * best_cost / half_area(bounds);
+  if (count <= options.max_leaf_size && (best_axis < 0 || leaf_cost <= split_cost)) return leaf();
+  preorder.push_back({bounds, {}});
+  std::uint32_t middle = first + count / 2;
+  Bounds3 left_bounds, right_bounds;
+  if (best_axis >= 0) {
+    middle = std::uint32_t(std::partition(refs.begin() + first, refs.begin() + first + count,
+                                          [&](const SahReference& r) { return bin_of(r, best_axis) <= best_bin; }) -
+                           refs.begin());
+    for (std::uint32_t b = 0; b < bins; ++b) (b <= best_bin ? left_bounds : right_bounds).extend(best_boxes[b]);
+  } else {
+    for (std::uint32_t i = first; i < first + count; ++i) (i < middle ? left_bounds : right_bounds).extend(refs[i].bounds);
+  }
+  plain_sah(refs, first, middle - first, left_bounds, depth + 1, options, preorder);
+  plain_sah(refs, middle, first + count - middle, right_bounds, depth + 1, options, preorder);
+}
+
+TEST(SahBuilder, BuildsTheTreeAPlainBinnedSahBuilds) {
+  // Clusters of small boxes (ranges binned in sets of bins, in parallel above 65,536), and
+  // stacks of boxes with one centroid (no plane separates them: the range is halved).
+  std::mt19937 random(2026);
+  const auto uniform = [&] { return std::uniform_real_distribution<float>(0.0f, 1.0f)(random); };
+  std::vector<Bounds3> boxes;
+  for (int cluster = 0; cluster < 40; ++cluster) {
+    const glm::vec3 centre(uniform() * 100.0f + 1.0f, uniform() * 30.0f + 1.0f, uniform() * 60.0f + 1.0f);
+    const float spread = 0.5f + uniform() * 8.0f;
+    for (int i = 0; i < 1800; ++i) {
+      const glm::vec3 at = centre + spread * glm::vec3(uniform(), uniform(), uniform());
+      Bounds3 box;
+      box.extend(at);
+      box.extend(at + 0.3f * glm::vec3(uniform(), uniform(), uniform()));
+      boxes.push_back(box);
+    }
+    for (int i = 0; i < 20; ++i) boxes.push_back(Bounds3{centre, centre + glm::vec3(1.0f)});
+  }
+  struct Case {
+    std::uint32_t max_leaf_size, bins, block_size;
+    float traversal_cost;
+    std::uint32_t cut_size;
+  };
+  for (const Case& c : {Case{14, 16, 1, 7.0f, 0}, Case{4, 32, 4, 1.0f, 0}, Case{3, 8, 3, 1.0f, 0}, Case{8, 64, 1, 1.0f, 200}}) {
+    SahOptions options;
+    options.max_leaf_size = c.max_leaf_size;
+    options.bins = c.bins;
+    options.block_size = c.block_size;
+    options.traversal_cost = c.traversal_cost;
+    options.cut_size = c.cut_size;
+    const BuildTree tree = build_sah_tree(boxes, options);
+    std::vector<PlainSahNode> built;
+    std::function<void(std::uint32_t)> visit = [&](std::uint32_t index) {
+      const BuildNode& node = tree.nodes[index];
+      built.push_back({node.bounds, {}});
+      if (!node.leaf()) return visit(node.left), visit(node.right);
+      built.back().leaf.assign(tree.primitive_order.begin() + node.first, tree.primitive_order.begin() + node.first + node.count);
+    };
+    visit(0);
+    std::vector<SahReference> refs;
+    Bounds3 all;
+    for (std::uint32_t i = 0; i < boxes.size(); ++i) refs.push_back({boxes[i], i, 0}), all.extend(boxes[i]);
+    std::vector<PlainSahNode> expected;
+    plain_sah(refs, 0, std::uint32_t(refs.size()), all, 1, options, expected);
+    ASSERT_EQ(built.size(), expected.size()) << "leaves of " << c.max_leaf_size << ", " << c.bins << " bins";
+    std::size_t differing = 0;
+    for (std::size_t i = 0; i < built.size(); ++i) {
+      differing += built[i].leaf != expected[i].leaf || built[i].bounds.lower != expected[i].bounds.lower ||
+                   built[i].bounds.upper != expected[i].bounds.upper;
+    }
+    EXPECT_EQ(differing, 0u) << "leaves of " << c.max_leaf_size << ", " << c.bins << " bins";
+  }
 }
 
 TEST(SahBuilder, CoincidentCentroidsStillSplitAndBadOptionsAreErrors) {

@@ -2,8 +2,9 @@
 // plane by surface area heuristic splits the range in place. Large ranges bin in parallel
 // and subtrees build as parallel tasks; node slots come from an atomic counter, so the
 // tree's shape does not depend on the thread count (only node numbering does). Boxes are
-// binned four floats at a time, as Wald's SIMD binning does, and the partition finds the
-// children's centroid bounds as it moves them, so a node costs two passes over its range.
+// binned a register a box, as Wald's SIMD binning does, into several sets of bins in turn;
+// the three axes' planes are costed in lanes; the partition finds the children's centroid
+// bounds as it moves them, so a node costs two passes over its range.
 #include "wavetrace/accel/bvh/sah_builder.hpp"
 
 #include <algorithm>
@@ -33,6 +34,9 @@ namespace {
 constexpr std::uint32_t kMaxBins = 64;
 constexpr std::size_t kParallelBinningThreshold = 1 << 16;
 constexpr std::size_t kParallelSubtreeThreshold = 1 << 12;
+// Ranges of at least this many references bin into four sets of bins in turn, or two.
+constexpr std::uint32_t kFourBinSetsFrom = 256;
+constexpr std::uint32_t kTwoBinSetsFrom = 64;
 // Below this depth the SAH chooses freely; deeper, ranges are halved, which bounds the
 // tree's depth by kFreeDepth + log2(primitives) whatever the geometry (traversal stacks
 // are sized from it: kMaxTreeDepth).
@@ -66,19 +70,51 @@ inline BinBox empty_bin_box() {
   return {_mm_set1_ps(std::numeric_limits<float>::infinity()), _mm_set1_ps(-std::numeric_limits<float>::infinity())};
 }
 
+// A bin's box in one AVX register: lower (x, y, z, -) in the low half and the negated upper
+// (-x, -y, -z, -) in the high one, so that one min extends both ends (binning stores one
+// register a reference and axis instead of two). min(-a, -b) picks -a exactly where max(a, b)
+// picks a, and negation is exact, so the boxes are BinBox's to the bit. Lanes 3 and 7 are not
+// read.
+struct BinBounds {
+  __m256 lower_and_negated_upper;
+  void extend(__m256 other) { lower_and_negated_upper = _mm256_min_ps(other, lower_and_negated_upper); }
+  __m128 lower() const { return _mm256_castps256_ps128(lower_and_negated_upper); }
+  __m128 upper() const {
+    return _mm_xor_ps(_mm256_extractf128_ps(lower_and_negated_upper, 1), _mm_set1_ps(-0.0f));
+  }
+  Bounds3 bounds() const { return BinBox{lower(), upper()}.bounds(); }
+};
+
+// A reference's box as BinBounds holds it.
+inline __m256 bin_bounds_of(__m128 lower, __m128 upper) {
+  return _mm256_set_m128(_mm_xor_ps(upper, _mm_set1_ps(-0.0f)), lower);
+}
+
 // Bins of the three axes. Only the first `used` bins per axis are initialized: a node
 // is binned once, and clearing all kMaxBins bins would cost more than binning a small node.
 struct Binning {
-  explicit Binning(std::uint32_t used) : used(used) {
+  Binning() = default;  // no bin initialized: clear() before use
+  explicit Binning(std::uint32_t used) { clear(used); }
+  void clear(std::uint32_t bins) {
+    used = bins;
+    const __m256 empty = _mm256_set1_ps(std::numeric_limits<float>::infinity());
     for (int axis = 0; axis < 3; ++axis) {
       for (std::uint32_t i = 0; i < used; ++i) {
-        boxes[axis][i] = empty_bin_box();
+        boxes[axis][i].lower_and_negated_upper = empty;
         counts[axis][i] = 0;
       }
     }
   }
-  std::uint32_t used;
-  std::array<std::array<BinBox, kMaxBins>, 3> boxes;
+  void merge(const Binning& other) {
+    for (int axis = 0; axis < 3; ++axis) {
+      for (std::uint32_t i = 0; i < used; ++i) {
+        boxes[axis][i].extend(other.boxes[axis][i].lower_and_negated_upper);
+        counts[axis][i] += other.counts[axis][i];
+      }
+    }
+  }
+  std::uint32_t used = 0;
+  std::array<std::array<BinBounds, kMaxBins>, 3> boxes;
   std::array<std::array<std::uint32_t, kMaxBins>, 3> counts;
 };
 
@@ -159,39 +195,70 @@ class Builder {
         });
   }
 
-  void fill_bins(std::uint32_t begin, std::uint32_t end, const Bounds3& centroids, const glm::vec3& scale,
-                 Binning& binning) const {
-    const __m128 lower = load3(centroids.lower), scales = load3(scale);
-    const __m128i last_bin = _mm_set1_epi32(static_cast<int>(options_.bins - 1));
-    for (std::uint32_t i = begin; i != end; ++i) {
-      const SahReference& reference = references_[i];
-      const __m128 box_lower = lower4(reference), box_upper = upper4(reference);
-      const __m128i bins = bins_of(centroid4(box_lower, box_upper), lower, scales, last_bin);
-      const int bin[3] = {_mm_cvtsi128_si32(bins), _mm_extract_epi32(bins, 1), _mm_extract_epi32(bins, 2)};
-      for (int axis = 0; axis < 3; ++axis) {
-        binning.boxes[axis][bin[axis]].extend(box_lower, box_upper);
-        ++binning.counts[axis][bin[axis]];
-      }
+  // What places a centroid in its bins on the three axes (bins_of's operands).
+  struct BinFrame {
+    __m128 lower, scales;
+    __m128i last_bin;
+  };
+
+  BinFrame bin_frame(const Bounds3& centroids, const glm::vec3& scale) const {
+    return {load3(centroids.lower), load3(scale), _mm_set1_epi32(static_cast<int>(options_.bins - 1))};
+  }
+
+  static void bin_reference(const SahReference& reference, const BinFrame& frame, Binning& binning) {
+    const __m128 box_lower = lower4(reference), box_upper = upper4(reference);
+    const __m128i bins = bins_of(centroid4(box_lower, box_upper), frame.lower, frame.scales, frame.last_bin);
+    const int bin[3] = {_mm_cvtsi128_si32(bins), _mm_extract_epi32(bins, 1), _mm_extract_epi32(bins, 2)};
+    const __m256 box = bin_bounds_of(box_lower, box_upper);
+    for (int axis = 0; axis < 3; ++axis) {
+      binning.boxes[axis][bin[axis]].extend(box);
+      ++binning.counts[axis][bin[axis]];
     }
+  }
+
+  // Neighbours in a range mostly fall in the same bins (the splits above sorted the range by
+  // place), so with one set of bins each reference waits for the previous one's store to its
+  // bin to extend it again. A range deals its references to kSets sets in turn, merged at the
+  // end; returns where the dealing stopped (fewer than kSets references are left). The boxes
+  // are the one set's but for the sign of a zero where +0 and -0 meet in a bin, which no
+  // comparison or area tells apart (test SahBuilder.BuildsTheTreeAPlainBinnedSahBuilds).
+  template <std::uint32_t kSets>
+  std::uint32_t fill_bins_in_turn(std::uint32_t begin, std::uint32_t end, const BinFrame& frame,
+                                  Binning& binning) const {
+    std::array<Binning, kSets - 1> others;
+    for (Binning& other : others) other.clear(binning.used);
+    std::uint32_t i = begin;
+    for (; end - i >= kSets; i += kSets) {
+      bin_reference(references_[i], frame, binning);
+      for (std::uint32_t k = 1; k < kSets; ++k) bin_reference(references_[i + k], frame, others[k - 1]);
+    }
+    for (const Binning& other : others) binning.merge(other);
+    return i;
+  }
+
+  void fill_bins(std::uint32_t begin, std::uint32_t end, const BinFrame& frame, Binning& binning) const {
+    std::uint32_t i = begin;
+    if (end - begin >= kFourBinSetsFrom) {
+      i = fill_bins_in_turn<4>(begin, end, frame, binning);
+    } else if (end - begin >= kTwoBinSetsFrom) {
+      i = fill_bins_in_turn<2>(begin, end, frame, binning);
+    }
+    for (; i != end; ++i) bin_reference(references_[i], frame, binning);
   }
 
   // Into `binning`, fresh: a small node's bins are filled in place, never copied (7 KB).
   void bin_range(std::uint32_t first, std::uint32_t count, const Bounds3& centroids, const glm::vec3& scale,
                  Binning& binning) const {
-    if (count < kParallelBinningThreshold) return fill_bins(first, first + count, centroids, scale, binning);
+    const BinFrame frame = bin_frame(centroids, scale);
+    if (count < kParallelBinningThreshold) return fill_bins(first, first + count, frame, binning);
     binning = tbb::parallel_reduce(
         tbb::blocked_range<std::uint32_t>(first, first + count, 1 << 14), binning,
         [&](const tbb::blocked_range<std::uint32_t>& range, Binning b) {
-          fill_bins(range.begin(), range.end(), centroids, scale, b);
+          fill_bins(range.begin(), range.end(), frame, b);
           return b;
         },
-        [&](Binning a, const Binning& b) {
-          for (int axis = 0; axis < 3; ++axis) {
-            for (std::uint32_t i = 0; i < options_.bins; ++i) {
-              a.boxes[axis][i].extend(b.boxes[axis][i].lower, b.boxes[axis][i].upper);
-              a.counts[axis][i] += b.counts[axis][i];
-            }
-          }
+        [](Binning a, const Binning& b) {
+          a.merge(b);
           return a;
         });
   }
@@ -215,13 +282,21 @@ class Builder {
       }
     };
     Lanes lanes[kMaxBins];  // transposed once for both sweeps
+    const __m128 sign = _mm_set1_ps(-0.0f);
     for (std::uint32_t i = 0; i < bins; ++i) {
-      __m128 l0 = binning.boxes[0][i].lower, l1 = binning.boxes[1][i].lower, l2 = binning.boxes[2][i].lower;
-      __m128 u0 = binning.boxes[0][i].upper, u1 = binning.boxes[1][i].upper, u2 = binning.boxes[2][i].upper;
-      __m128 l3 = _mm_setzero_ps(), u3 = _mm_setzero_ps();
-      _MM_TRANSPOSE4_PS(l0, l1, l2, l3);
-      _MM_TRANSPOSE4_PS(u0, u1, u2, u3);
-      lanes[i] = Lanes{l0, l1, l2, u0, u1, u2};
+      // The three axes' boxes as rows, lower and negated upper transposed at once, a half each.
+      const __m256 r0 = binning.boxes[0][i].lower_and_negated_upper, r1 = binning.boxes[1][i].lower_and_negated_upper;
+      const __m256 r2 = binning.boxes[2][i].lower_and_negated_upper, r3 = _mm256_setzero_ps();
+      const __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpackhi_ps(r0, r1);
+      const __m256 t2 = _mm256_unpacklo_ps(r2, r3), t3 = _mm256_unpackhi_ps(r2, r3);
+      const __m256 x = _mm256_shuffle_ps(t0, t2, 0x44), y = _mm256_shuffle_ps(t0, t2, 0xEE);
+      const __m256 z = _mm256_shuffle_ps(t1, t3, 0x44);
+      lanes[i] = Lanes{_mm256_castps256_ps128(x),
+                       _mm256_castps256_ps128(y),
+                       _mm256_castps256_ps128(z),
+                       _mm_xor_ps(_mm256_extractf128_ps(x, 1), sign),
+                       _mm_xor_ps(_mm256_extractf128_ps(y, 1), sign),
+                       _mm_xor_ps(_mm256_extractf128_ps(z, 1), sign)};
     }
     const auto bin_counts = [&](std::uint32_t i) {
       return _mm_setr_epi32(static_cast<int>(binning.counts[0][i]), static_cast<int>(binning.counts[1][i]),
@@ -252,23 +327,44 @@ class Builder {
       _mm_store_si128(reinterpret_cast<__m128i*>(left_count[i]), count);
       _mm_store_si128(reinterpret_cast<__m128i*>(right_counts[i]), right_count[i]);
     }
+    // The first cheapest plane in axis, then bin, order: the least cost over the planes with
+    // primitives on both sides, then the first plane that costs it (no branch a plane).
+    const __m128 open_axes = _mm_cmpgt_ps(load3(centroids.upper), load3(centroids.lower));
+    __m128 least = infinity;
+    for (std::uint32_t i = 0; i + 1 < bins; ++i) {
+      least = _mm_min_ps(least, plane_cost(cost[i], left_count[i], right_counts[i], open_axes, infinity));
+    }
+    least = _mm_min_ps(least, _mm_shuffle_ps(least, least, _MM_SHUFFLE(2, 3, 0, 1)));
+    least = _mm_min_ps(least, _mm_shuffle_ps(least, least, _MM_SHUFFLE(1, 0, 3, 2)));
     Split best;
-    for (int axis = 0; axis < 3; ++axis) {
-      if (!(centroids.upper[axis] > centroids.lower[axis])) continue;
-      for (std::uint32_t i = 0; i + 1 < bins; ++i) {
-        if (left_count[i][axis] == 0 || right_counts[i][axis] == 0) continue;
-        if (cost[i][axis] < best.cost) {
-          best.axis = axis;
-          best.bin = i;
-          best.cost = cost[i][axis];
-        }
-      }
+    if (!(_mm_cvtss_f32(least) < std::numeric_limits<float>::infinity())) return best;
+    best.cost = _mm_cvtss_f32(least);
+    std::uint32_t first_plane = ~0u;  // axis * kMaxBins + bin of the first plane at the least cost
+    for (std::uint32_t i = 0; i + 1 < bins; ++i) {
+      const int at_least =
+          _mm_movemask_ps(_mm_cmpeq_ps(plane_cost(cost[i], left_count[i], right_counts[i], open_axes, infinity), least)) & 7;
+      if (at_least != 0) first_plane = std::min(first_plane, std::uint32_t(std::countr_zero(unsigned(at_least))) * kMaxBins + i);
     }
-    if (best.axis >= 0) {
-      const auto& row = binning.boxes[best.axis];
-      for (std::uint32_t i = 0; i < bins; ++i) (i <= best.bin ? best.left_bounds : best.right_bounds).extend(row[i].bounds());
-    }
+    best.axis = static_cast<int>(first_plane / kMaxBins);
+    best.bin = first_plane % kMaxBins;
+    const auto& row = binning.boxes[best.axis];
+    BinBounds left = row[0], right = row[best.bin + 1];
+    for (std::uint32_t i = 1; i <= best.bin; ++i) left.extend(row[i].lower_and_negated_upper);
+    for (std::uint32_t i = best.bin + 2; i < bins; ++i) right.extend(row[i].lower_and_negated_upper);
+    best.left_bounds = left.bounds();
+    best.right_bounds = right.bounds();
     return best;
+  }
+
+  // A plane's cost on each axis, infinite where it leaves a side empty or the axis is closed.
+  static __m128 plane_cost(const float* cost, const std::uint32_t* left_count, const std::uint32_t* right_count,
+                           __m128 open_axes, __m128 infinity) {
+    const __m128i zero = _mm_setzero_si128();
+    const __m128i left = _mm_load_si128(reinterpret_cast<const __m128i*>(left_count));
+    const __m128i right = _mm_load_si128(reinterpret_cast<const __m128i*>(right_count));
+    const __m128 empty_side = _mm_castsi128_ps(_mm_or_si128(_mm_cmpeq_epi32(left, zero), _mm_cmpeq_epi32(right, zero)));
+    const __m128 open = _mm_andnot_ps(empty_side, open_axes);
+    return _mm_blendv_ps(infinity, _mm_load_ps(cost), open);
   }
 
   // blocks() of each lane's count (counts stay below 2^31: twice them fits 32 bits).
@@ -300,13 +396,13 @@ class Builder {
                                 Bounds3& right_centroids) {
     const __m128 lower = load3(centroids.lower), scales = load3(scale);
     const __m128i last_bin = _mm_set1_epi32(static_cast<int>(options_.bins - 1));
+    const __m128i split = _mm_set1_epi32(static_cast<int>(split_bin));
     BinBox left = empty_bin_box(), right = empty_bin_box();
     // Tests a reference, and adds its centroid to the side it goes to.
     const auto goes_left = [&](const SahReference& reference) {
       const __m128 c = centroid4(lower4(reference), upper4(reference));
-      alignas(16) std::int32_t bin[4];
-      _mm_store_si128(reinterpret_cast<__m128i*>(bin), bins_of(c, lower, scales, last_bin));
-      const bool is_left = std::uint32_t(bin[axis]) <= split_bin;
+      const __m128i bin = bins_of(c, lower, scales, last_bin);
+      const bool is_left = ((_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpgt_epi32(bin, split))) >> axis) & 1) == 0;
       (is_left ? left : right).extend(c, c);
       return is_left;
     };
