@@ -73,10 +73,7 @@ PipelineRun run_megakernel(const GenerateStage& generate, const TraceStage& trac
       }
       const auto trace_one = [&](Batch& batch) {
         ++s.rays_traced;
-        if (!probe) {
-          trace.trace_run(batch, one);
-          return;
-        }
+        if (!probe) return trace.trace_one_ray(batch, nullptr);
         const Clock::time_point since = Clock::now();
         trace.trace_one_ray(batch, &*probe);
         if (++window_rays == TraceStage::kRayWindow) {
