@@ -433,6 +433,15 @@ class Builder {
   void build_node(std::uint32_t node, std::uint32_t first, std::uint32_t count, const Bounds3& bounds,
                   const Bounds3& centroids, std::uint32_t depth) {
     if (count == 1 || count <= options_.cut_size) return make_leaf(node, first, count, bounds);
+    // A range whose leaf costs no more than a node's visit is a leaf whatever plane the bins
+    // would offer: a split costs the visit plus a share of its children's tests, never less
+    // (where the box has an area). Bounding volume blocks of four and HMQ's leaves below
+    // seven triangles end here without being binned.
+    const float leaf_cost = options_.intersection_cost * blocks(count);
+    if (count <= options_.max_leaf_size && leaf_cost <= options_.traversal_cost && options_.intersection_cost >= 0.0f &&
+        half_area(bounds) > 0.0f) {
+      return make_leaf(node, first, count, bounds);
+    }
     glm::vec3 scale;
     for (int axis = 0; axis < 3; ++axis) {
       const float extent = centroids.upper[axis] - centroids.lower[axis];
@@ -444,7 +453,6 @@ class Builder {
       bin_range(first, count, centroids, scale, binning);
       split = best_split(binning, centroids);
     }
-    const float leaf_cost = options_.intersection_cost * blocks(count);
     const float split_cost = options_.traversal_cost + options_.intersection_cost * split.cost / half_area(bounds);
     if (count <= options_.max_leaf_size && (split.axis < 0 || leaf_cost <= split_cost)) {
       // split.axis < 0 with few primitives: coincident centroids, a leaf is best.
