@@ -435,8 +435,8 @@ class Builder {
     if (count == 1 || count <= options_.cut_size) return make_leaf(node, first, count, bounds);
     // A range whose leaf costs no more than a node's visit is a leaf whatever plane the bins
     // would offer: a split costs the visit plus a share of its children's tests, never less
-    // (where the box has an area). Bounding volume blocks of four and HMQ's leaves below
-    // seven triangles end here without being binned.
+    // (where the box has an area). bvh:width=8's ranges of one block (four) and HMQ's of
+    // seven triangles or fewer end here without being binned.
     const float leaf_cost = options_.intersection_cost * blocks(count);
     if (count <= options_.max_leaf_size && leaf_cost <= options_.traversal_cost && options_.intersection_cost >= 0.0f &&
         half_area(bounds) > 0.0f) {
