@@ -206,18 +206,10 @@ TEST(SahBuilder, BuildsTheTreeAPlainBinnedSahBuilds) {
     }
     for (int i = 0; i < 20; ++i) boxes.push_back(Bounds3{centre, centre + glm::vec3(1.0f)});
   }
-  struct Case {
-    std::uint32_t max_leaf_size, bins, block_size;
-    float traversal_cost;
-    std::uint32_t cut_size;
-  };
-  for (const Case& c : {Case{14, 16, 1, 7.0f, 0}, Case{4, 32, 4, 1.0f, 0}, Case{3, 8, 3, 1.0f, 0}, Case{8, 64, 1, 1.0f, 200}}) {
-    SahOptions options;
-    options.max_leaf_size = c.max_leaf_size;
-    options.bins = c.bins;
-    options.block_size = c.block_size;
-    options.traversal_cost = c.traversal_cost;
-    options.cut_size = c.cut_size;
+  for (const SahOptions& options :
+       {SahOptions{.max_leaf_size = 14, .bins = 16, .traversal_cost = 7.0f},
+        SahOptions{.max_leaf_size = 4, .bins = 32, .block_size = 4}, SahOptions{.max_leaf_size = 3, .bins = 8, .block_size = 3},
+        SahOptions{.max_leaf_size = 8, .bins = 64, .cut_size = 200}}) {
     const BuildTree tree = build_sah_tree(boxes, options);
     std::vector<PlainSahNode> built;
     std::function<void(std::uint32_t)> visit = [&](std::uint32_t index) {
@@ -232,13 +224,13 @@ TEST(SahBuilder, BuildsTheTreeAPlainBinnedSahBuilds) {
     for (std::uint32_t i = 0; i < boxes.size(); ++i) refs.push_back({boxes[i], i, 0}), all.extend(boxes[i]);
     std::vector<PlainSahNode> expected;
     plain_sah(refs, 0, std::uint32_t(refs.size()), all, 1, options, expected);
-    ASSERT_EQ(built.size(), expected.size()) << "leaves of " << c.max_leaf_size << ", " << c.bins << " bins";
+    ASSERT_EQ(built.size(), expected.size()) << "leaves of " << options.max_leaf_size << ", " << options.bins << " bins";
     std::size_t differing = 0;
     for (std::size_t i = 0; i < built.size(); ++i) {
       differing += built[i].leaf != expected[i].leaf || built[i].bounds.lower != expected[i].bounds.lower ||
                    built[i].bounds.upper != expected[i].bounds.upper;
     }
-    EXPECT_EQ(differing, 0u) << "leaves of " << c.max_leaf_size << ", " << c.bins << " bins";
+    EXPECT_EQ(differing, 0u) << "leaves of " << options.max_leaf_size << ", " << options.bins << " bins";
   }
 }
 
