@@ -97,9 +97,12 @@ LeafStrips strips_of_leaf(const TriangleMesh& mesh, std::span<const std::uint32_
   LeafStrips made;  // in the order made
   TriangleList first_slot, first_triangle;
   for (std::size_t remaining = count; remaining > 0;) {
+    // The first unused triangle of the fewest unused neighbours (none has more than three).
     std::size_t start = count;
-    for (std::size_t i = 0; i < count; ++i) {
-      if ((used >> i & 1u) == 0 && (start == count || unused_degree(i) < unused_degree(start))) start = i;
+    for (std::uint32_t unused = leaf_lanes & ~used, least = 4; unused != 0 && least > 0; unused &= unused - 1) {
+      const std::size_t i = std::size_t(std::countr_zero(unused));
+      const std::uint32_t degree = std::uint32_t(unused_degree(i));
+      if (degree < least) start = i, least = degree;
     }
     used |= 1u << start;
     --remaining;

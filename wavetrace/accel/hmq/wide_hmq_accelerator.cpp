@@ -92,11 +92,16 @@ class LeafRecordWriter {
       LargeArray<std::byte>& out = block_bytes_[block];
       PartBytes& parts = block_parts_[block] = {};
       out.clear();
+      const auto triangles_of = [&](std::size_t i) {
+        const BuildNode& leaf = *pending_[i].leaf;
+        return std::span<const std::uint32_t>(snapped_.tree.primitive_order.data() + leaf.first, leaf.count);
+      };
       for (std::size_t i = block * kBlockLeaves, end = std::min(pending_.size(), i + kBlockLeaves); i < end; ++i) {
         const BuildNode& leaf = *pending_[i].leaf;
+        if (i + kCornersAhead < end) prefetch_leaf_corners(snapped_.quantized, triangles_of(i + kCornersAhead));
+        if (i + kGridPointsAhead < end) prefetch_leaf_grid_points(snapped_.quantized, triangles_of(i + kGridPointsAhead));
         const std::size_t at = out.size();
-        encode_leaf(snapped_.quantized, std::span(snapped_.tree.primitive_order.data() + leaf.first, leaf.count),
-                    pending_[i].box, out);
+        encode_leaf(snapped_.quantized, triangles_of(i), pending_[i].box, out);
         const LeafHeader header = read_leaf_header(out.data() + at);
         const std::size_t identity = stream_bytes(header.id_bits, leaf.count) + stream_bytes(3, leaf.count);
         const std::size_t record = out.size() - at;
@@ -134,6 +139,8 @@ class LeafRecordWriter {
 
  private:
   static constexpr std::size_t kBatchLeaves = 8192, kBlockLeaves = 256;
+  // Leaves ahead of the one encoded whose corners, then grid points, are fetched.
+  static constexpr std::size_t kCornersAhead = 4, kGridPointsAhead = 2;
   struct PendingLeaf {
     const BuildNode* leaf;
     GridBox box;
