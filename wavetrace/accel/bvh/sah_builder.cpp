@@ -70,40 +70,24 @@ inline BinBox empty_bin_box() {
   return {_mm_set1_ps(std::numeric_limits<float>::infinity()), _mm_set1_ps(-std::numeric_limits<float>::infinity())};
 }
 
-// A bin in one AVX register, so that binning a reference on an axis is one min, one add and
-// one store (it was two min-max-stores of the box and a count's increment):
-//   lanes 0-2  the box's lower x, y, z
-//   lane 3     the bin's count, a 32-bit integer
-//   lanes 4-6  the box's negated upper x, y, z: one min extends both ends. min(-a, -b) picks
-//              -a exactly where max(a, b) picks a, and negation is exact, so the boxes are
-//              BinBox's to the bit.
-//   lane 7     +inf
-// A reference comes with +inf in lanes 3 and 7, which the min leaves to the bin (a count's
-// bits read as a float are never below +inf, or are NaN, and min then keeps its second
-// operand), and then the count takes an integer add of 1 in lane 3.
-struct Bin {
-  __m256 packed;
-  static __m256 empty() {
-    return _mm256_blend_ps(_mm256_set1_ps(std::numeric_limits<float>::infinity()), _mm256_setzero_ps(), 0x08);
+// A bin's box in one AVX register: lower (x, y, z, -) in the low half and the negated upper
+// (-x, -y, -z, -) in the high one, so that one min extends both ends (binning stores one
+// register a reference and axis instead of two). min(-a, -b) picks -a exactly where max(a, b)
+// picks a, and negation is exact, so the boxes are BinBox's to the bit. Lanes 3 and 7 are not
+// read.
+struct BinBounds {
+  __m256 lower_and_negated_upper;
+  void extend(__m256 other) { lower_and_negated_upper = _mm256_min_ps(other, lower_and_negated_upper); }
+  __m128 lower() const { return _mm256_castps256_ps128(lower_and_negated_upper); }
+  __m128 upper() const {
+    return _mm_xor_ps(_mm256_extractf128_ps(lower_and_negated_upper, 1), _mm_set1_ps(-0.0f));
   }
-  void add(__m256 reference) {
-    packed = _mm256_castsi256_ps(
-        _mm256_add_epi32(_mm256_castps_si256(_mm256_min_ps(reference, packed)), _mm256_setr_epi32(0, 0, 0, 1, 0, 0, 0, 0)));
-  }
-  void merge(const Bin& other) {
-    const __m256 boxes = _mm256_min_ps(other.packed, packed);
-    const __m256i counts = _mm256_add_epi32(_mm256_castps_si256(other.packed), _mm256_castps_si256(packed));
-    packed = _mm256_blend_ps(boxes, _mm256_castsi256_ps(counts), 0x08);
-  }
-  __m128 lower() const { return _mm256_castps256_ps128(packed); }
-  __m128 upper() const { return _mm_xor_ps(_mm256_extractf128_ps(packed, 1), _mm_set1_ps(-0.0f)); }
   Bounds3 bounds() const { return BinBox{lower(), upper()}.bounds(); }
 };
 
-// A reference's box as a Bin takes it.
-inline __m256 bin_reference_of(__m128 lower, __m128 upper) {
-  const __m256 box = _mm256_set_m128(_mm_xor_ps(upper, _mm_set1_ps(-0.0f)), lower);
-  return _mm256_blend_ps(box, _mm256_set1_ps(std::numeric_limits<float>::infinity()), 0x88);
+// A reference's box as BinBounds holds it.
+inline __m256 bin_bounds_of(__m128 lower, __m128 upper) {
+  return _mm256_set_m128(_mm_xor_ps(upper, _mm_set1_ps(-0.0f)), lower);
 }
 
 // Bins of the three axes. Only the first `used` bins per axis are initialized: a node
@@ -111,20 +95,27 @@ inline __m256 bin_reference_of(__m128 lower, __m128 upper) {
 struct Binning {
   Binning() = default;  // no bin initialized: clear() before use
   explicit Binning(std::uint32_t used) { clear(used); }
-  void clear(std::uint32_t bins_used) {
-    used = bins_used;
-    const __m256 empty = Bin::empty();
+  void clear(std::uint32_t bins) {
+    used = bins;
+    const __m256 empty = _mm256_set1_ps(std::numeric_limits<float>::infinity());
     for (int axis = 0; axis < 3; ++axis) {
-      for (std::uint32_t i = 0; i < used; ++i) bins[axis][i].packed = empty;
+      for (std::uint32_t i = 0; i < used; ++i) {
+        boxes[axis][i].lower_and_negated_upper = empty;
+        counts[axis][i] = 0;
+      }
     }
   }
   void merge(const Binning& other) {
     for (int axis = 0; axis < 3; ++axis) {
-      for (std::uint32_t i = 0; i < used; ++i) bins[axis][i].merge(other.bins[axis][i]);
+      for (std::uint32_t i = 0; i < used; ++i) {
+        boxes[axis][i].extend(other.boxes[axis][i].lower_and_negated_upper);
+        counts[axis][i] += other.counts[axis][i];
+      }
     }
   }
   std::uint32_t used = 0;
-  std::array<std::array<Bin, kMaxBins>, 3> bins;
+  std::array<std::array<BinBounds, kMaxBins>, 3> boxes;
+  std::array<std::array<std::uint32_t, kMaxBins>, 3> counts;
 };
 
 struct Split {
@@ -218,8 +209,11 @@ class Builder {
     const __m128 box_lower = lower4(reference), box_upper = upper4(reference);
     const __m128i bins = bins_of(centroid4(box_lower, box_upper), frame.lower, frame.scales, frame.last_bin);
     const int bin[3] = {_mm_cvtsi128_si32(bins), _mm_extract_epi32(bins, 1), _mm_extract_epi32(bins, 2)};
-    const __m256 packed = bin_reference_of(box_lower, box_upper);
-    for (int axis = 0; axis < 3; ++axis) binning.bins[axis][bin[axis]].add(packed);
+    const __m256 box = bin_bounds_of(box_lower, box_upper);
+    for (int axis = 0; axis < 3; ++axis) {
+      binning.boxes[axis][bin[axis]].extend(box);
+      ++binning.counts[axis][bin[axis]];
+    }
   }
 
   // Neighbours in a range mostly fall in the same bins (the splits above sorted the range by
@@ -288,17 +282,15 @@ class Builder {
       }
     };
     Lanes lanes[kMaxBins];  // transposed once for both sweeps
-    __m128i lane_counts[kMaxBins];
     const __m128 sign = _mm_set1_ps(-0.0f);
     for (std::uint32_t i = 0; i < bins; ++i) {
-      // The three axes' bins as rows, lower, counts and negated upper transposed at once.
-      const __m256 r0 = binning.bins[0][i].packed, r1 = binning.bins[1][i].packed;
-      const __m256 r2 = binning.bins[2][i].packed, r3 = _mm256_setzero_ps();
+      // The three axes' boxes as rows, lower and negated upper transposed at once, a half each.
+      const __m256 r0 = binning.boxes[0][i].lower_and_negated_upper, r1 = binning.boxes[1][i].lower_and_negated_upper;
+      const __m256 r2 = binning.boxes[2][i].lower_and_negated_upper, r3 = _mm256_setzero_ps();
       const __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpackhi_ps(r0, r1);
       const __m256 t2 = _mm256_unpacklo_ps(r2, r3), t3 = _mm256_unpackhi_ps(r2, r3);
       const __m256 x = _mm256_shuffle_ps(t0, t2, 0x44), y = _mm256_shuffle_ps(t0, t2, 0xEE);
-      const __m256 z = _mm256_shuffle_ps(t1, t3, 0x44), count = _mm256_shuffle_ps(t1, t3, 0xEE);
-      lane_counts[i] = _mm_castps_si128(_mm256_castps256_ps128(count));
+      const __m256 z = _mm256_shuffle_ps(t1, t3, 0x44);
       lanes[i] = Lanes{_mm256_castps256_ps128(x),
                        _mm256_castps256_ps128(y),
                        _mm256_castps256_ps128(z),
@@ -306,7 +298,10 @@ class Builder {
                        _mm_xor_ps(_mm256_extractf128_ps(y, 1), sign),
                        _mm_xor_ps(_mm256_extractf128_ps(z, 1), sign)};
     }
-    const auto bin_counts = [&](std::uint32_t i) { return lane_counts[i]; };
+    const auto bin_counts = [&](std::uint32_t i) {
+      return _mm_setr_epi32(static_cast<int>(binning.counts[0][i]), static_cast<int>(binning.counts[1][i]),
+                            static_cast<int>(binning.counts[2][i]), 0);
+    };
     const __m128 infinity = _mm_set1_ps(std::numeric_limits<float>::infinity());
     const __m128 minus_infinity = _mm_set1_ps(-std::numeric_limits<float>::infinity());
     const Lanes empty{infinity, infinity, infinity, minus_infinity, minus_infinity, minus_infinity};
@@ -352,10 +347,10 @@ class Builder {
     }
     best.axis = static_cast<int>(first_plane / kMaxBins);
     best.bin = first_plane % kMaxBins;
-    const auto& row = binning.bins[best.axis];
-    Bin left = row[0], right = row[best.bin + 1];  // boxes only: their counts are not read
-    for (std::uint32_t i = 1; i <= best.bin; ++i) left.merge(row[i]);
-    for (std::uint32_t i = best.bin + 2; i < bins; ++i) right.merge(row[i]);
+    const auto& row = binning.boxes[best.axis];
+    BinBounds left = row[0], right = row[best.bin + 1];
+    for (std::uint32_t i = 1; i <= best.bin; ++i) left.extend(row[i].lower_and_negated_upper);
+    for (std::uint32_t i = best.bin + 2; i < bins; ++i) right.extend(row[i].lower_and_negated_upper);
     best.left_bounds = left.bounds();
     best.right_bounds = right.bounds();
     return best;
