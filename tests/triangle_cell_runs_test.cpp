@@ -12,7 +12,9 @@
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
+#include "wavetrace/accel/grid/cell_runs_in_lanes.hpp"
 #include "wavetrace/kernels/triangle_cell_runs.hpp"
+#include "wavetrace/memory/kernel_isa_choice.hpp"
 
 namespace wavetrace {
 namespace {
@@ -158,6 +160,80 @@ TEST(TriangleCellRuns, LayersOutsideTheCallersRangeAreLeftToTheirOwnCalls) {
                                });
   }
   EXPECT_EQ(pieced, whole.cells);
+}
+
+// The grids' eight lanes must give each triangle the scalar function's runs in its order, so
+// that a grid built either way is the same to the byte: triangles of every shape, in slabs of
+// one to three layers, a few at a time and eight.
+TEST(TriangleCellRuns, EightLanesGiveTheScalarRunsInTheirOrder) {
+#if WAVETRACE_AVX512_DISPATCH || WAVETRACE_AVX512F
+  bool runs_avx512 = false;
+  for (const KernelIsa isa : runnable_kernel_isas()) runs_avx512 |= cell_runs_in_lanes(isa);
+  if (!runs_avx512) GTEST_SKIP() << "this CPU has no AVX-512: the grids find their runs one triangle at a time";
+  std::mt19937 random(11);
+  const glm::dvec3 extent = glm::dvec3(kCells) * kFrame.cell_size;
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const auto point_in_grid = [&] {
+    return glm::vec3(kFrame.lower + glm::dvec3(unit(random), unit(random), unit(random)) * extent);
+  };
+  const auto offset = [&](double cells) {
+    return glm::vec3(glm::dvec3(unit(random) - 0.5, unit(random) - 0.5, unit(random) - 0.5) * kFrame.cell_size * cells);
+  };
+  std::vector<TriangleCellVisit> visits;
+  for (int triangle = 0; visits.size() < 6000; ++triangle) {
+    const glm::vec3 a = point_in_grid();
+    std::array<glm::vec3, 3> t;
+    switch (triangle % 7) {
+      case 0: t = {a, a + offset(6.0), a + offset(6.0)}; break;  // a few cells on every axis
+      case 1: {  // a strand: long and thin
+        const glm::vec3 along = offset(10.0);
+        t = {a, a + along, a + along + glm::vec3(0.002f, 0.0f, 0.001f)};
+        break;
+      }
+      case 2: t = {a, a + glm::vec3(0.0f, 0.6f, 0.1f), a + glm::vec3(0.0f, 0.1f, 0.4f)}; break;  // in an x plane
+      case 3: t = {a, a + glm::vec3(0.5f, 0.0f, 0.1f), a + glm::vec3(0.1f, 0.0f, 0.4f)}; break;  // in a y plane
+      case 4: t = {a, a + offset(3.0), a}; break;  // a segment
+      case 5: t = {a, a + offset(2.0), a + offset(2.0)}; break;  // small
+      default: t = {a, a + offset(14.0), a + offset(14.0)}; break;  // some wider than a list's rows
+    }
+    for (glm::vec3& corner : t) corner = glm::clamp(corner, glm::vec3(kFrame.lower), glm::vec3(kFrame.lower + extent));
+    const Runs whole = runs_of(t);
+    const std::uint32_t layers = 1 + std::uint32_t(triangle % 3);
+    for (std::uint32_t first = whole.box_lower.z / layers * layers; first <= whole.box_upper.z; first += layers) {
+      visits.push_back({t[0], t[1], t[2], whole.box_lower, whole.box_upper, first, first + layers - 1});
+    }
+  }
+  std::vector<const TriangleCellVisit*> taken;
+  for (const TriangleCellVisit& visit : visits) {
+    if (fits_cell_run_lanes(visit)) taken.push_back(&visit);
+  }
+  EXPECT_GT(taken.size(), visits.size() / 3);  // the lanes take most kinds of triangle
+  std::size_t compared = 0;
+  for (std::size_t first = 0, group = 0; first < taken.size(); first += group) {
+    group = std::min<std::size_t>(taken.size() - first, 1 + first % 8);  // groups of one to eight
+    CellRunList lists[8];
+    CellRunList* outs[8];
+    for (int lane = 0; lane < 8; ++lane) outs[lane] = &lists[lane];
+    triangle_cell_runs_in_eight_lanes(taken.data() + first, int(group), kFrame, outs);
+    for (std::size_t lane = 0; lane < group; ++lane) {
+      const TriangleCellVisit& v = *taken[first + lane];
+      std::vector<std::array<std::uint32_t, 4>> expected, got;
+      for_each_triangle_cell_run(v.a, v.b, v.c, kFrame, v.box_lower, v.box_upper, v.z_first, v.z_last,
+                                 [&](std::uint32_t y, std::uint32_t z, std::uint32_t x_first, std::uint32_t x_last) {
+                                   expected.push_back({y, z, x_first, x_last});
+                                 });
+      for (std::uint32_t r = 0; r < lists[lane].count; ++r) {
+        const CellRunList::Run& run = lists[lane].runs[r];
+        got.push_back({run.y, run.z, run.x_first, run.x_last});
+      }
+      ASSERT_EQ(got, expected) << "visit " << (taken[first + lane] - visits.data());
+      ++compared;
+    }
+  }
+  EXPECT_EQ(compared, taken.size());
+#else
+  GTEST_SKIP() << "this build carries no AVX-512 kernels: the grids find their runs one triangle at a time";
+#endif
 }
 
 }  // namespace
