@@ -502,5 +502,21 @@ TEST(AccelBench, BadSpecsNameTheProblem) {
   EXPECT_EQ(parse_accelerator_spec("bvh:leaf_size=8:layout=veb", Config{}).options.bvh.max_leaf_size, 8u);
 }
 
+// The binary tree keeps the papers' leaves of four; the 8-wide tree's leaves are up to four
+// blocks of four, unless a size is asked.
+TEST(AccelBench, EachWidthHasItsOwnLeavesUnlessOneIsAsked) {
+  EXPECT_EQ(parse_accelerator_spec("bvh", Config{}).options.bvh.leaf_triangles(), 4u);
+  EXPECT_EQ(parse_accelerator_spec("bvh:width=8", Config{}).options.bvh.leaf_triangles(), 16u);
+  EXPECT_EQ(parse_accelerator_spec("bvh:width=8:leaf_size=4", Config{}).options.bvh.leaf_triangles(), 4u);
+  EXPECT_EQ(parse_accelerator_spec("bvh:leaf_size=2", Config{}).options.bvh.leaf_triangles(), 2u);
+  // Built: leaves of several blocks take fewer nodes, and the same triangles' blocks.
+  const Scene scene = make_builtin_scene("builtin:room:20k");
+  const auto bytes = [&](const std::string& spec) {
+    return make_bvh_accelerator(scene.mesh, parse_accelerator_spec(spec, Config{}).options.bvh)->memory().total();
+  };
+  EXPECT_LT(bytes("bvh:width=8"), bytes("bvh:width=8:leaf_size=4"));
+  EXPECT_EQ(bytes("bvh:width=8"), bytes("bvh:width=8:leaf_size=16"));
+}
+
 }  // namespace
 }  // namespace wavetrace

@@ -287,7 +287,8 @@ const std::vector<ConfigKey>& config_schema() {
        "kernels of our walks: auto (AVX-512 where the CPU has it, or what the environment variable WAVETRACE_ISA "
        "names), or one set forced; an error names a set this CPU cannot run (accel.embree.isa is Embree's)",
        read_kernel_isa},
-      {"accel.bvh.leaf_size", T::integer, std::int64_t{4}, 1, 16, {}, "most triangles per BVH leaf",
+      {"accel.bvh.leaf_size", T::integer, std::int64_t{0}, 0, 16, {},
+       "most triangles per BVH leaf; 0: the width's own, 4 for the binary tree and 16 (four blocks of four) for width 8",
        integer<&P::accelerator, &A::bvh, &BvhOptions::max_leaf_size>},
       {"accel.bvh.layout", T::text, std::string("depth_first"), 0, 0, {"depth_first", "breadth_first", "veb"},
        "BVH node order in memory",

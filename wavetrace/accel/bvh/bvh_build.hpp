@@ -26,7 +26,7 @@ inline BuildTree build_bvh_tree(const IndexedFaceSet& geometry, const BvhOptions
   LargeArray<SahReference> references = geometry.triangle_references();
   clock.lap(phases, "bounds");
   SahOptions sah;
-  sah.max_leaf_size = options.max_leaf_size;
+  sah.max_leaf_size = options.leaf_triangles();
   sah.bins = options.bins;
   // The 8-wide tree's leaves are blocks of four (triangle_block.hpp).
   sah.block_size = options.width == 8 ? TriangleBlock::kLanes : 1;
