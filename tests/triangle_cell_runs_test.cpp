@@ -231,6 +231,27 @@ TEST(TriangleCellRuns, EightLanesGiveTheScalarRunsInTheirOrder) {
     }
   }
   EXPECT_EQ(compared, taken.size());
+
+  // A batch hands on every visit's runs in the order the visits came, lanes or not.
+  std::vector<std::array<std::uint32_t, 5>> expected, got;
+  CellRunBatch batch;
+  batch.use(KernelIsa::avx512);
+  const auto into = [](auto& runs) {
+    return [&runs](std::uint32_t t, std::uint32_t y, std::uint32_t z, std::uint32_t x_first, std::uint32_t x_last) {
+      runs.push_back({t, y, z, x_first, x_last});
+    };
+  };
+  for (std::size_t i = 0; i < visits.size(); ++i) {
+    const TriangleCellVisit& v = visits[i];
+    const auto t = std::uint32_t(i);
+    for_each_triangle_cell_run(v.a, v.b, v.c, kFrame, v.box_lower, v.box_upper, v.z_first, v.z_last,
+                               [&](std::uint32_t y, std::uint32_t z, std::uint32_t x_first, std::uint32_t x_last) {
+                                 into(expected)(t, y, z, x_first, x_last);
+                               });
+    batch.add(t, v, kFrame, into(got));
+  }
+  batch.flush(kFrame, into(got));
+  EXPECT_EQ(got, expected);
 #else
   GTEST_SKIP() << "this build carries no AVX-512 kernels: the grids find their runs one triangle at a time";
 #endif

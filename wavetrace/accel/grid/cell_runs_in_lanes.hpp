@@ -6,7 +6,9 @@
 
 #include "wavetrace/build_config.hpp"  // WAVETRACE_AVX512_DISPATCH, WAVETRACE_AVX512F
 
+#include <cstddef>
 #include <cstdint>
+#include <span>
 
 #include <glm/vec3.hpp>
 
@@ -65,5 +67,60 @@ inline bool fits_cell_run_lanes(const TriangleCellVisit& visit) {
 void triangle_cell_runs_in_eight_lanes(const TriangleCellVisit* const* visits, int count, const CellGridFrame& frame,
                                        CellRunList* const* out);
 #endif
+
+// A batch of a slab's triangle visits: where the kernel set has the lanes, those they take
+// are cut eight at a time, the others one at a time; then every visit's runs are handed on in
+// the order the visits came, so that a grid's lists stay in triangle order.
+class CellRunBatch {
+ public:
+  static constexpr std::size_t kVisits = 32;
+
+  void use(KernelIsa isa) { lanes_ = cell_runs_in_lanes(isa); }
+
+  // Takes a visit of `triangle`; a full batch is handed on: run(triangle, y, z, x_first, x_last).
+  template <typename Run>
+  void add(std::uint32_t triangle, const TriangleCellVisit& visit, const CellGridFrame& frame, Run&& run) {
+    visits_[count_] = visit;
+    in_lanes_[count_] = lanes_ && fits_cell_run_lanes(visit);
+    triangles_[count_] = triangle;
+    if (++count_ == kVisits) flush(frame, run);
+  }
+
+  template <typename Run>
+  void flush(const CellGridFrame& frame, Run&& run) {
+#if WAVETRACE_AVX512_DISPATCH || WAVETRACE_AVX512F
+    const TriangleCellVisit* lane_visits[8];
+    CellRunList* lane_lists[8];
+    int lanes = 0;
+    for (std::size_t i = 0; i < count_; ++i) {
+      if (!in_lanes_[i]) continue;
+      lane_visits[lanes] = &visits_[i], lane_lists[lanes] = &lists_[i];
+      if (++lanes == 8) triangle_cell_runs_in_eight_lanes(lane_visits, lanes, frame, lane_lists), lanes = 0;
+    }
+    if (lanes != 0) triangle_cell_runs_in_eight_lanes(lane_visits, lanes, frame, lane_lists);
+#endif
+    for (std::size_t i = 0; i < count_; ++i) {
+      const std::uint32_t triangle = triangles_[i];
+      const auto of_triangle = [&](std::uint32_t y, std::uint32_t z, std::uint32_t x_first, std::uint32_t x_last) {
+        run(triangle, y, z, x_first, x_last);
+      };
+      if (in_lanes_[i]) {
+        for (const CellRunList::Run& r : std::span(lists_[i].runs, lists_[i].count)) of_triangle(r.y, r.z, r.x_first, r.x_last);
+      } else {
+        const TriangleCellVisit& v = visits_[i];
+        for_each_triangle_cell_run(v.a, v.b, v.c, frame, v.box_lower, v.box_upper, v.z_first, v.z_last, of_triangle);
+      }
+    }
+    count_ = 0;
+  }
+
+ private:
+  bool lanes_ = false;
+  std::size_t count_ = 0;
+  std::uint32_t triangles_[kVisits];
+  bool in_lanes_[kVisits];
+  TriangleCellVisit visits_[kVisits];
+  CellRunList lists_[kVisits];
+};
 
 }  // namespace wavetrace

@@ -10,7 +10,6 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
-#include <span>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -190,24 +189,13 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
   };
   static_assert(sizeof(SlabRowRun) == 12);
 
-  // A batch of a slab's triangle visits, whose runs are found (eight at a time in
-  // AVX-512 lanes) before any is added.
-  struct VisitBatch {
-    static constexpr std::size_t kVisits = 32;
-    std::size_t count = 0;
-    std::uint32_t triangles[kVisits];
-    bool in_lanes[kVisits];
-    TriangleCellVisit visits[kVisits];
-    CellRunList lists[kVisits];
-  };
-
   // One slab's share of the grid: its rows' offsets and slots numbered from the slab's own
   // first slot, where each slot's list starts from the slab's own first entry, and the runs
   // its lists are filled from. Rows of different slabs never share a slot, so each slab's
   // slots and entries are one range of H and of L, in slab order. A part is reused from slab
   // to slab, so the build's scratch is a few slabs' worth, touched once.
   struct SlabPart {
-    VisitBatch batch;
+    CellRunBatch batch;  // with AVX-512, the visits whose runs are cut eight at a time
     std::vector<SlabRowRun> runs;
     std::vector<std::uint64_t> occupied;     // the slab's D bits: bit row·Mx + x of the slab's rows
     std::vector<std::uint64_t> taken;        // the slots its rows took (the paper's bH)
@@ -362,38 +350,9 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
       }
       runs.push_back({t, row, x_first | ((x_last - x_first) << 21)});
     };
-    // With AVX-512 the visits are taken a batch at a time: those the lanes take are cut eight
-    // at once, then every visit's runs are added in triangle order, so each list stays ascending.
-    VisitBatch& batch = part.batch;
+    CellRunBatch& batch = part.batch;
+    batch.use(kernel_isa());
     const bool in_lanes = !bounding_box_lists_ && cell_runs_in_lanes(kernel_isa());
-    const auto add_batch = [&] {
-#if WAVETRACE_AVX512_DISPATCH || WAVETRACE_AVX512F
-      const TriangleCellVisit* lane_visits[8];
-      CellRunList* lane_lists[8];
-      int lanes = 0;
-      for (std::size_t i = 0; i < batch.count; ++i) {
-        if (!batch.in_lanes[i]) continue;
-        lane_visits[lanes] = &batch.visits[i], lane_lists[lanes] = &batch.lists[i];
-        if (++lanes == 8) triangle_cell_runs_in_eight_lanes(lane_visits, lanes, frame, lane_lists), lanes = 0;
-      }
-      if (lanes != 0) triangle_cell_runs_in_eight_lanes(lane_visits, lanes, frame, lane_lists);
-#endif
-      for (std::size_t i = 0; i < batch.count; ++i) {
-        const std::uint32_t t = batch.triangles[i];
-        if (batch.in_lanes[i]) {
-          for (const CellRunList::Run& run : std::span(batch.lists[i].runs, batch.lists[i].count)) {
-            add(t, run.y, run.z, run.x_first, run.x_last);
-          }
-        } else {
-          const TriangleCellVisit& v = batch.visits[i];
-          for_each_triangle_cell_run(v.a, v.b, v.c, frame, v.box_lower, v.box_upper, z_first, z_last,
-                                     [&](std::uint32_t y, std::uint32_t z, std::uint32_t x_first, std::uint32_t x_last) {
-                                       add(t, y, z, x_first, x_last);
-                                     });
-        }
-      }
-      batch.count = 0;
-    };
     for (std::size_t k = slab_starts_[slab]; k < slab_end; ++k) {
       // A slab's triangles are scattered over the mesh: their corners fetched ahead.
       if (k + kPrefetchAhead < slab_end) {
@@ -410,21 +369,18 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
         continue;
       }
       const glm::uvec3& tri = mesh_.triangles[t];
-      if (!in_lanes) {
-        for_each_triangle_cell_run(mesh_.positions[tri.x], mesh_.positions[tri.y], mesh_.positions[tri.z], frame, r.lower,
-                                   r.upper, z_first, z_last,
+      const TriangleCellVisit visit{mesh_.positions[tri.x], mesh_.positions[tri.y], mesh_.positions[tri.z],
+                                    r.lower, r.upper, z_first, z_last};
+      if (in_lanes) {
+        batch.add(t, visit, frame, add);
+      } else {
+        for_each_triangle_cell_run(visit.a, visit.b, visit.c, frame, r.lower, r.upper, z_first, z_last,
                                    [&](std::uint32_t y, std::uint32_t z, std::uint32_t x_first, std::uint32_t x_last) {
                                      add(t, y, z, x_first, x_last);
                                    });
-        continue;
       }
-      TriangleCellVisit& visit = batch.visits[batch.count];
-      visit = {mesh_.positions[tri.x], mesh_.positions[tri.y], mesh_.positions[tri.z], r.lower, r.upper, z_first, z_last};
-      batch.in_lanes[batch.count] = fits_cell_run_lanes(visit);
-      batch.triangles[batch.count] = t;
-      if (++batch.count == VisitBatch::kVisits) add_batch();
     }
-    add_batch();
+    batch.flush(frame, add);
 
     part.stage_seconds[0] += clock.lap();
     std::vector<std::uint64_t>& occupied = part.occupied;
