@@ -56,7 +56,7 @@ const AcceleratorType kTypes[] = {
       .spec = [](double) { return std::string("embree:mode=robust"); }}},
     {"bvh", [](const TriangleMesh& mesh, const AcceleratorOptions& options) { return make_bvh_accelerator(mesh, options.bvh); },
      [](SectionLoader& in, std::string_view) { return load_bvh_accelerator(in); }, {"bvh"}, true, false,
-     // width 8, leaves of up to 16: 67.9-69.4 on the rooms and the scans
+     // width 8, leaves of up to 16: 67.9-69.3 on the rooms and the scans
      [](const AcceleratorOptions& options) { return options.bvh.width == 8 ? 69.0 : 60.0; }, 190.0,
      {.relative_speed = 0.60,  // width 8: 0.54 - 0.69
       .set_up = [](AcceleratorOptions& options, double) { options.bvh.width = 8; },

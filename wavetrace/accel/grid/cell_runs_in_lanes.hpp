@@ -76,6 +76,7 @@ class CellRunBatch {
   static constexpr std::size_t kVisits = 32;
 
   void use(KernelIsa isa) { lanes_ = cell_runs_in_lanes(isa); }
+  bool lanes() const { return lanes_; }
 
   // Takes a visit of `triangle`; a full batch is handed on: run(triangle, y, z, x_first, x_last).
   template <typename Run>

@@ -352,7 +352,6 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
     };
     CellRunBatch& batch = part.batch;
     batch.use(kernel_isa());
-    const bool in_lanes = !bounding_box_lists_ && cell_runs_in_lanes(kernel_isa());
     for (std::size_t k = slab_starts_[slab]; k < slab_end; ++k) {
       // A slab's triangles are scattered over the mesh: their corners fetched ahead.
       if (k + kPrefetchAhead < slab_end) {
@@ -371,7 +370,7 @@ class HashedGridAccelerator final : public ProbedAccelerator<HashedGridAccelerat
       const glm::uvec3& tri = mesh_.triangles[t];
       const TriangleCellVisit visit{mesh_.positions[tri.x], mesh_.positions[tri.y], mesh_.positions[tri.z],
                                     r.lower, r.upper, z_first, z_last};
-      if (in_lanes) {
+      if (batch.lanes()) {
         batch.add(t, visit, frame, add);
       } else {
         for_each_triangle_cell_run(visit.a, visit.b, visit.c, frame, r.lower, r.upper, z_first, z_last,
