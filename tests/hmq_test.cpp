@@ -61,58 +61,57 @@ TEST(HmqStripTable, HasThePapers507EntriesEachAPartitionWithConsistentSlots) {
   EXPECT_THROW(table.find(too_many), std::invalid_argument);
 }
 
-TEST(HmqPackedStream, RoundTripsEveryWidthWithByteAlignedGroups) {
+// Streams laid end to end from any bit: each value read back at every width, from every
+// starting bit within a byte, with the bits a stream takes exactly its values' bits.
+TEST(HmqPackedStream, RoundTripsEveryWidthFromEveryStartingBit) {
   std::mt19937 random(7);
-  for (std::uint32_t bits = 0; bits <= 32; ++bits) {
-    for (const std::uint32_t count : {1u, 5u, 42u}) {
-      std::vector<std::uint32_t> values(count);
-      for (auto& v : values) v = bits == 0 ? 0 : static_cast<std::uint32_t>(random() & ((std::uint64_t{1} << bits) - 1));
-      LargeArray<std::byte> out;
-      append_stream(out, values, bits);
-      EXPECT_EQ(out.size(), stream_bytes(bits, count)) << bits << " bits";
-      out.resize(out.size() + 8);
-      std::vector<std::uint32_t> back(count);
-      read_stream(out.data(), bits, count, back.data());
-      EXPECT_EQ(back, values) << bits << " bits, " << count << " values";
-    }
-  }
-  EXPECT_EQ(stream_shape(6).per_group, 10u);  // 60 bits, then the next group at byte 8
-  EXPECT_EQ(stream_shape(6).group_bytes, 8u);
-  EXPECT_EQ(stream_shape(17).per_group, 3u);  // 51 bits: 7 bytes per group
-  EXPECT_EQ(stream_shape(17).group_bytes, 7u);
-}
-
-// A decoder steps from stream to stream by stream_bytes, which for up to 64 values reads where
-// the last one ends from the offset table: the bytes the encoder appends, at every width and count.
-TEST(HmqPackedStream, StreamBytesAreTheBytesAppendedAtEveryWidthAndCount) {
-  for (std::uint32_t bits = 0; bits <= 32; ++bits) {
-    for (std::uint32_t count = 0; count <= 70; ++count) {
-      const std::vector<std::uint32_t> values(count, bits == 0 ? 0u : 1u);
-      LargeArray<std::byte> out;
-      append_stream(out, values, bits);
-      EXPECT_EQ(stream_bytes(bits, count), out.size()) << bits << " bits, " << count << " values";
+  for (std::uint32_t lead = 0; lead < 8; ++lead) {
+    for (std::uint32_t bits = 0; bits <= 32; ++bits) {
+      for (const std::uint32_t count : {1u, 5u, 42u}) {
+        std::vector<std::uint32_t> values(count);
+        for (auto& v : values) v = static_cast<std::uint32_t>(random() & ((std::uint64_t{1} << bits) - 1));
+        LargeArray<std::byte> out;
+        BitWriter writer(out);
+        writer.append(0x5au & ((1u << lead) - 1), lead);  // a value before the stream, so that it starts at bit `lead`
+        writer.append_stream(values, bits);
+        writer.append(1, 1);  // and one after, which the stream's last value must not reach
+        EXPECT_EQ(writer.written_bits(), lead + stream_bits(bits, count) + 1);
+        writer.finish();
+        EXPECT_EQ(out.size(), (lead + stream_bits(bits, count) + 1 + 7) / 8) << bits << " bits";
+        out.resize(out.size() + 8);
+        std::vector<std::uint32_t> back(count);
+        read_stream(out.data(), lead, bits, count, back.data());
+        EXPECT_EQ(back, values) << bits << " bits, " << count << " values from bit " << lead;
+        EXPECT_EQ(read_value(out.data(), lead + stream_bits(bits, count), 1), 1u) << bits << " bits";
+      }
     }
   }
 }
 
 #if WAVETRACE_AVX2
 // The eight-lane reader every leaf decode uses, value for value against the scalar one, at
-// every width it takes and at counts that end inside, at and past a block of eight.
+// every width it takes, from starting bits within and past the first byte, and at counts that
+// end inside, at and past a block of eight.
 TEST(HmqPackedStream, LaneReaderReadsWhatTheScalarReaderReads) {
   std::mt19937 random(11);
-  for (std::uint32_t bits = 1; bits <= kLaneStreamBits; ++bits) {
-    for (const std::uint32_t count : {1u, 7u, 8u, 9u, 16u, 42u, 64u}) {
-      std::vector<std::uint32_t> values(count);
-      for (auto& v : values) v = static_cast<std::uint32_t>(random() & ((std::uint64_t{1} << bits) - 1));
-      LargeArray<std::byte> out;
-      append_stream(out, values, bits);
-      out.resize(out.size() + 8);
-      for (std::uint32_t first = 0; first < count; first += 8) {
-        alignas(32) std::uint32_t lanes[8];
-        _mm256_store_si256(reinterpret_cast<__m256i*>(lanes), read_stream_lanes(out.data(), bits, first, count));
-        for (std::uint32_t lane = 0; lane < 8; ++lane) {
-          const std::uint32_t expected = first + lane < count ? values[first + lane] : 0u;
-          EXPECT_EQ(lanes[lane], expected) << bits << " bits, value " << first + lane << " of " << count;
+  for (const std::uint32_t lead : {0u, 3u, 7u, 45u}) {
+    for (std::uint32_t bits = 1; bits <= kLaneStreamBits; ++bits) {
+      for (const std::uint32_t count : {1u, 7u, 8u, 9u, 16u, 42u, 64u}) {
+        std::vector<std::uint32_t> values(count);
+        for (auto& v : values) v = static_cast<std::uint32_t>(random() & ((std::uint64_t{1} << bits) - 1));
+        LargeArray<std::byte> out;
+        BitWriter writer(out);
+        for (std::uint32_t b = 0; b < lead; ++b) writer.append(1, 1);  // ones before the stream
+        writer.append_stream(values, bits);
+        writer.finish();
+        out.resize(out.size() + 8);
+        for (std::uint32_t first = 0; first < count; first += 8) {
+          alignas(32) std::uint32_t lanes[8];
+          _mm256_store_si256(reinterpret_cast<__m256i*>(lanes), read_stream_lanes(out.data(), lead, bits, first, count));
+          for (std::uint32_t lane = 0; lane < 8; ++lane) {
+            const std::uint32_t expected = first + lane < count ? values[first + lane] : 0u;
+            EXPECT_EQ(lanes[lane], expected) << bits << " bits, value " << first + lane << " of " << count;
+          }
         }
       }
     }
@@ -244,8 +243,9 @@ TEST(HmqLeaf, RecordDecodesToTheSnappedVerticesIdsAndCorners) {
     const GridBox grid_box = snap_outward(grid, box);
     LargeArray<std::byte> record;
     encode_leaf(quantized, triangles, grid_box, record);
-    EXPECT_EQ(record.size(), leaf_record_bytes(record.data()));
+    const std::size_t record_bytes = record.size();
     record.resize(record.size() + 8);
+    EXPECT_EQ(record_bytes, leaf_record_bytes(record.data()));
     DecodedLeaf leaf;
     decode_leaf(record.data(), grid, grid_box, leaf);
     ASSERT_EQ(leaf.layout->triangles, size);

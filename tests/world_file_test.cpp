@@ -213,7 +213,7 @@ TEST(WorldFile, APagedWalkAnnouncesItsReads) {
     std::vector<std::string> paged = build;
     // One thread: with more, a page may be evicted by another between its announcement and
     // the read, which faults too (in a pool of two pages, often).
-    for (const char* s : {"memory.backing=file", "memory.budget=50%", "render.threads=1", page_bytes}) {
+    for (const char* s : {"memory.backing=file", "memory.budget=60%", "render.threads=1", page_bytes}) {
       paged.emplace_back(s);
     }
     const RenderPlan plan = plan_render(small_render(paged));

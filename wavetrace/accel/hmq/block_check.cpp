@@ -1,6 +1,7 @@
 // The walk of check_blocks: the traversal's own steps, without a ray.
 #include "wavetrace/accel/hmq/block_check.hpp"
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <optional>
@@ -22,32 +23,38 @@ constexpr std::string_view kSection = "hmq.blocks";
 // What is wrong with the leaf record at byte `record` of `bytes`, if anything.
 std::optional<std::string> leaf_record_problem(std::span<const std::byte> bytes, std::uint64_t record,
                                                std::size_t triangles) {
-  if (record + kLeafHeaderBytes > bytes.size()) return "has a leaf record past its array";
-  const std::byte* data = bytes.data() + record;
-  const LeafHeader header = read_leaf_header(data);
+  if (record + (kLeafHeaderBits + 7) / 8 > bytes.size()) return "has a leaf record past its array";
+  // The header's loads read past a short record: from a zero-padded copy, not the array's end.
+  std::byte head[kLeafHeaderReadBytes] = {};
+  std::memcpy(head, bytes.data() + record, std::min<std::size_t>(sizeof head, bytes.size() - record));
+  const LeafHeader header = read_leaf_header(head);
   const StripTable& strips = StripTable::instance();
   if (header.entry >= strips.size()) return fmt::format("has a leaf of strip table entry {}", header.entry);
   const StripLayoutEntry& layout = strips.entry(header.entry);
-  if (record + leaf_record_bytes(header, layout) > bytes.size()) return "has a leaf record running past its array";
-  const std::byte* stream = data + kLeafHeaderBytes;
-  for (int axis = 0; axis < 3; ++axis) stream += stream_bytes(header.axis_bits[axis] + 1, header.vertex_count);
+  // A walk's 8-byte loads of the record's last values reach up to 7 bytes past it, into the
+  // slack every array of records keeps.
+  if (record + leaf_record_bytes(header, layout) + 7 > bytes.size()) return "has a leaf record running past its array";
+  const std::byte* data = bytes.data() + record;
+  std::size_t bit = header.stream_bit;
+  for (int axis = 0; axis < 3; ++axis) bit += stream_bits(header.axis_bits[axis] + 1, header.vertex_count);
   std::uint32_t values[64];
   if (header.indexed) {
-    read_stream(stream, header.index_bits, layout.slots, values);
+    if (header.vertex_count == 0) return "has an indexed leaf of no vertices";
+    read_stream(data, bit, header.index_bits, layout.slots, values);
     for (std::uint32_t s = 0; s < layout.slots; ++s) {
       if (values[s] >= header.vertex_count) return "has a leaf slot naming a vertex it does not hold";
     }
-    stream += stream_bytes(header.index_bits, layout.slots);
+    bit += stream_bits(header.index_bits, layout.slots);
   } else if (header.vertex_count < layout.slots) {
     return fmt::format("has a leaf of {} vertices for {} strip slots", header.vertex_count, layout.slots);
   }
-  read_stream(stream, header.id_bits, layout.triangles, values);
+  read_stream(data, bit, header.id_bits, layout.triangles, values);
   for (std::uint32_t k = 0; k < layout.triangles; ++k) {
     if (std::uint64_t(header.id_base) + values[k] >= triangles) return "has a leaf naming a triangle that does not exist";
   }
-  stream += stream_bytes(header.id_bits, layout.triangles);
+  bit += stream_bits(header.id_bits, layout.triangles);
   // Corner codes 3 c1 + c2 name the mesh triangle's second and third corner: two different ones.
-  read_stream(stream, 3, layout.triangles, values);
+  read_stream(data, bit, 3, layout.triangles, values);
   for (std::uint32_t k = 0; k < layout.triangles; ++k) {
     if (values[k] / 3 == values[k] % 3) return "has a leaf triangle whose corners repeat";
   }

@@ -115,11 +115,10 @@ class BlockEncoder {
       slot.index = static_cast<std::uint32_t>(record_offset.size());
       record_offset.push_back(static_cast<std::uint32_t>(records.size()));
       const std::size_t before = records.size();
-      encode_leaf(quantized_, std::span(tree_.primitive_order.data() + node.first, node.count),
-                  snap_outward(grid_, slot.box), records);
-      const LeafHeader header = read_leaf_header(records.data() + before);
-      const std::size_t triangles = node.count;
-      const std::size_t identity = stream_bytes(header.id_bits, triangles) + stream_bytes(3, triangles);
+      const std::size_t identity =
+          encode_leaf(quantized_, std::span(tree_.primitive_order.data() + node.first, node.count),
+                      snap_outward(grid_, slot.box), records) /
+          8;  // its whole bytes
       parts_.other += identity;
       parts_.geometry += records.size() - before - identity;
     }
@@ -186,7 +185,7 @@ struct HmqSavedState {
   std::uint32_t nodes, leaves;
 };
 static_assert(sizeof(GlobalGrid) == 56 && sizeof(HmqSavedState) == 88);
-constexpr std::uint32_t kHmqSavedVersion = 1;
+constexpr std::uint32_t kHmqSavedVersion = 2;  // 2: leaf records as one bit string
 
 class HmqAccelerator final : public ProbedAccelerator<HmqAccelerator> {
   friend class ProbedAccelerator<HmqAccelerator>;

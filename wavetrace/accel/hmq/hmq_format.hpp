@@ -29,28 +29,31 @@
 // roots (the top leaf's `count` says which) with the top leaf's float box as their parent.
 //
 // Leaf record (its box is its node's decoded box, re-snapped outward to the global grid:
-// lines g_lower = floor, g_upper = ceil; never stored):
-//   bytes 0-4   a 40-bit little-endian header:
-//                 bits  0-8   strip table entry (strip_table.hpp): the triangles and their slots
-//                 bit   9     1: indexed strips (vertices stored once, slots index them);
-//                             0: strips (slot i is vertex i)
-//                 bits 10-15  vertex count v (strips: the entry's slot count)
-//                 bits 16-30  bits per axis of the vertex offsets, 5 bits each: bx, by, bz
-//                 bits 31-33  index bits bi (indexed strips; else 0)
-//                 bits 34-38  triangle id delta bits bt (0 .. 31)
-//                 bit  39     zero
-//   bytes 5-8   uint32 triangle id base
-//   then packed streams (packed_stream.hpp), each starting at the next byte:
+// lines g_lower = floor, g_upper = ceil; never stored): one bit string (packed_stream.hpp),
+// starting at a byte, ceil(bits / 8) bytes long, the last byte's spare bits zero:
+//   bits  0-8    strip table entry (strip_table.hpp): the triangles and their slots
+//   bit   9      1: indexed strips (vertices stored once, slots index them);
+//                0: strips (slot i is vertex i)
+//   bits 10-15   vertex count v (strips: the entry's slot count)
+//   bits 16-30   bits per axis of the vertex offsets, 5 bits each: bx, by, bz
+//   bits 31-35   triangle id delta bits bt (0 .. 31)
+//   bits 36-40   the id base's bits less one, bb - 1 (bb 1 .. 32)
+//   bits 41 ..   the triangle id base, bb bits
+//   then the streams, each from the bit after the one before:
 //     x offsets   v values of 1 + bx bits: offset << 1 | from_upper; grid line = from_upper ?
 //                 g_upper.x - offset : g_lower.x + offset (the min-max trick, §4.1)
 //     y, z        the same with by, bz
-//     indices     (indexed strips) slot count values of bi bits: the vertex of each slot
+//     indices     (indexed strips) slot count values of bi bits, bi the bit width of v - 1:
+//                 the vertex of each slot
 //     ids         t values of bt bits: triangle k is mesh triangle base + id[k]
 //     corners     t values of 3 bits: 3 c1 + c2, the corners (0, 1, 2 of the strip triangle)
 //                 of the mesh triangle's second and third vertex, for barycentrics
 //   A vertex is the global grid point of its three lines, in floats: origin + line * cell.
+// (The paper's records start each stream at a byte, in groups of values to a quad-word; see
+// packed_stream.hpp for why these do not.)
 #pragma once
 
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -62,11 +65,14 @@ namespace wavetrace::hmq {
 inline constexpr std::uint32_t kMaxBlockSlots = 64;
 inline constexpr std::uint32_t kInnerBit = 1u << 30;
 inline constexpr std::uint32_t kBlockHeaderBytes = 4;
-inline constexpr std::uint32_t kLeafHeaderBytes = 9;
+inline constexpr std::uint32_t kLeafHeaderBits = 41;
+// The bytes read_leaf_header loads: the header and the widest id base, as two 8-byte loads.
+inline constexpr std::size_t kLeafHeaderReadBytes = 13;
 // No leaf record, with the slack its decode reads past it, is longer: the header's fields
-// bound it. 9 header bytes; three offset streams of at most 63 vertices of 32 bits (756
-// bytes); indices of at most 42 slots (14 one-triangle strips) of 7 bits (37); ids of 14
-// triangles of 31 bits (55); corners of 14 of 3 bits (6); 3 bytes read past the last: 866.
+// bound it. 41 header bits and a 32-bit id base; three offset streams of at most 63 vertices
+// of 32 bits (6,048 bits); indices of at most 42 slots (14 one-triangle strips) of 6 bits
+// (252); ids of 14 triangles of 31 bits (434); corners of 14 of 3 bits (42): 857 bytes, and 7
+// read past the last: 864.
 // A paged walk reads a record from a frame whose tail holds this much of the next page.
 inline constexpr std::size_t kMaxLeafRecordBytes = 1024;
 
@@ -89,22 +95,28 @@ inline Box decode_child_box(const Box& parent, std::uint32_t node) {
 }
 
 struct LeafHeader {
-  std::uint32_t entry, vertex_count, index_bits, id_bits, id_base;
+  std::uint32_t entry, vertex_count, id_bits, id_base;
+  std::uint32_t index_bits;   // indexed strips: the bit width of vertex_count - 1; else 0
+  std::uint32_t stream_bit;   // where the x offsets start: after the header and the id base
   bool indexed;
   std::uint32_t axis_bits[3];
 };
 
+// Reads kLeafHeaderReadBytes from `record`: past a short record's end, within an array's slack.
 inline LeafHeader read_leaf_header(const std::byte* record) {
-  std::uint64_t bits = 0;
-  std::memcpy(&bits, record, 5);
+  std::uint64_t bits, base_bits;
+  std::memcpy(&bits, record, 8);
+  std::memcpy(&base_bits, record + 5, 8);  // bit 40 of the record is this word's bit 0
   LeafHeader header;
   header.entry = bits & 511u;
   header.indexed = (bits >> 9) & 1u;
   header.vertex_count = (bits >> 10) & 63u;
   for (int axis = 0; axis < 3; ++axis) header.axis_bits[axis] = (bits >> (16 + 5 * axis)) & 31u;
-  header.index_bits = (bits >> 31) & 7u;
-  header.id_bits = (bits >> 34) & 31u;
-  std::memcpy(&header.id_base, record + 5, 4);
+  header.id_bits = (bits >> 31) & 31u;
+  const std::uint32_t base_width = ((bits >> 36) & 31u) + 1;
+  header.id_base = static_cast<std::uint32_t>((base_bits >> 1) & ((std::uint64_t{1} << base_width) - 1));
+  header.index_bits = header.indexed ? std::uint32_t(std::bit_width(header.vertex_count - 1)) : 0u;
+  header.stream_bit = kLeafHeaderBits + base_width;
   return header;
 }
 

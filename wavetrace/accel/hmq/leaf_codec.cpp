@@ -160,8 +160,8 @@ LeafStrips strips_of_leaf(const TriangleMesh& mesh, std::span<const std::uint32_
 
 }  // namespace
 
-void encode_leaf(const QuantizedMesh& quantized, std::span<const std::uint32_t> triangles, const GridBox& box,
-                 LargeArray<std::byte>& out) {
+std::size_t encode_leaf(const QuantizedMesh& quantized, std::span<const std::uint32_t> triangles, const GridBox& box,
+                        LargeArray<std::byte>& out) {
   if (triangles.empty() || triangles.size() > kMaxLeafTriangles) {
     throw std::invalid_argument("hmq: a leaf holds 1 .. 14 triangles");
   }
@@ -199,12 +199,12 @@ void encode_leaf(const QuantizedMesh& quantized, std::span<const std::uint32_t> 
   std::uint32_t axis_bits[3];
   SlotList streams[3];
   for (int axis = 0; axis < 3; ++axis) offsets(unique, axis, axis_bits[axis], streams[axis]);
-  std::size_t indexed_bytes = stream_bytes(index_bits, layout.slots), strip_bytes = 0;
+  std::size_t indexed_bits = stream_bits(index_bits, layout.slots), strip_bits = 0;
   for (int axis = 0; axis < 3; ++axis) {
-    indexed_bytes += stream_bytes(axis_bits[axis] + 1, static_cast<std::uint32_t>(unique.size()));
-    strip_bytes += stream_bytes(axis_bits[axis] + 1, layout.slots);
+    indexed_bits += stream_bits(axis_bits[axis] + 1, static_cast<std::uint32_t>(unique.size()));
+    strip_bits += stream_bits(axis_bits[axis] + 1, layout.slots);
   }
-  const bool indexed = indexed_bytes < strip_bytes;
+  const bool indexed = indexed_bits < strip_bits;
   if (!indexed) {
     for (int axis = 0; axis < 3; ++axis) offsets(slot_vertex, axis, axis_bits[axis], streams[axis]);
   }
@@ -229,17 +229,20 @@ void encode_leaf(const QuantizedMesh& quantized, std::span<const std::uint32_t> 
   }
   const std::uint32_t id_bits = bits_for(largest_delta);
   if (id_bits > 31) throw std::length_error("hmq: a leaf's triangle ids span 2^31 or more");
+  const std::uint32_t base_bits = std::max(1u, bits_for(id_base));
 
-  std::uint64_t header = entry | std::uint64_t(indexed) << 9 | std::uint64_t(vertex_count) << 10 |
-                         std::uint64_t(axis_bits[0]) << 16 | std::uint64_t(axis_bits[1]) << 21 |
-                         std::uint64_t(axis_bits[2]) << 26 | std::uint64_t(indexed ? index_bits : 0) << 31 |
-                         std::uint64_t(id_bits) << 34;
-  for (int b = 0; b < 5; ++b) out.push_back(static_cast<std::byte>(header >> (8 * b)));
-  for (int b = 0; b < 4; ++b) out.push_back(static_cast<std::byte>(id_base >> (8 * b)));
-  for (int axis = 0; axis < 3; ++axis) append_stream(out, streams[axis], axis_bits[axis] + 1);
-  if (indexed) append_stream(out, slot_index, index_bits);
-  append_stream(out, id_delta, id_bits);
-  append_stream(out, corners, 3);
+  BitWriter record(out);
+  record.append(entry | std::uint32_t(indexed) << 9 | vertex_count << 10, 16);
+  for (int axis = 0; axis < 3; ++axis) record.append(axis_bits[axis], 5);
+  record.append(id_bits, 5);
+  record.append(base_bits - 1, 5);
+  record.append(id_base, base_bits);
+  for (int axis = 0; axis < 3; ++axis) record.append_stream(streams[axis], axis_bits[axis] + 1);
+  if (indexed) record.append_stream(slot_index, index_bits);
+  record.append_stream(id_delta, id_bits);
+  record.append_stream(corners, 3);
+  record.finish();
+  return base_bits + stream_bits(id_bits + 3, static_cast<std::uint32_t>(leaf_triangles.size()));
 }
 
 std::size_t leaf_record_bytes(const std::byte* record) {

@@ -72,8 +72,10 @@ inline void prefetch_leaf_grid_points(const QuantizedMesh& quantized, std::span<
   }
 }
 
-// Appends the record of `triangles` (1 .. 14 mesh triangle ids) to `out`.
-void encode_leaf(const QuantizedMesh& quantized, std::span<const std::uint32_t> triangles, const GridBox& box,
+// Appends the record of `triangles` (1 .. 14 mesh triangle ids) to `out`. Returns the bits of
+// it that name the mesh's triangles and corners (the id base, ids and corner codes), for the
+// statistics' split of a record's bytes.
+std::size_t encode_leaf(const QuantizedMesh& quantized, std::span<const std::uint32_t> triangles, const GridBox& box,
                  LargeArray<std::byte>& out);
 
 // A decoded leaf: vertex positions in columns (SoA, ready to gather into triangle lanes)
@@ -83,26 +85,21 @@ struct DecodedLeaf {
   const StripLayoutEntry* layout;
   alignas(64) float position[3][64];  // per axis, per vertex; rows aligned for 16-lane loads
   alignas(64) std::uint32_t slot_vertex[64];  // indexed strips: the vertex of each slot; else unused
-  const std::byte* ids;      // the id stream
-  const std::byte* corners;  // the corner stream
+  const std::byte* record;
+  std::uint32_t ids_bit;      // where the id stream starts in the record
+  std::uint32_t corners_bit;  // where the corner stream starts
 
   // One past the record's last byte: its corner stream ends it.
-  const std::byte* end() const { return corners + stream_bytes(3, layout->triangles); }
+  const std::byte* end() const { return record + (corners_bit + stream_bits(3, layout->triangles) + 7) / 8; }
   std::uint32_t vertex_of_slot(std::uint32_t slot) const { return header.indexed ? slot_vertex[slot] : slot; }
   glm::vec3 slot_position(std::uint32_t slot) const {
     const std::uint32_t v = vertex_of_slot(slot);
     return {position[0][v], position[1][v], position[2][v]};
   }
   std::uint32_t triangle_id(std::uint32_t k) const {
-    std::uint32_t delta[kMaxLeafTriangles];
-    read_stream(ids, header.id_bits, k + 1, delta);
-    return header.id_base + delta[k];
+    return header.id_base + read_value(record, ids_bit + k * header.id_bits, header.id_bits);
   }
-  std::uint32_t corner_code(std::uint32_t k) const {
-    std::uint32_t codes[kMaxLeafTriangles];
-    read_stream(corners, 3, k + 1, codes);
-    return codes[k];
-  }
+  std::uint32_t corner_code(std::uint32_t k) const { return read_value(record, corners_bit + 3 * k, 3); }
 };
 
 #if WAVETRACE_AVX512_DISPATCH
@@ -111,13 +108,13 @@ template <KernelIsa kIsa>
 inline constexpr bool kSixteenLanes = kIsa == KernelIsa::avx512;
 
 // One axis of decode_leaf's positions, sixteen vertices at a time (the same operations).
-[[WAVETRACE_AVX512_TARGET]] inline void decode_axis_sixteen(const std::byte* data, std::uint32_t bits,
-                                                            std::uint32_t vertices, int lower, int upper,
-                                                            float origin, float cell, float* position) {
+[[WAVETRACE_AVX512_TARGET]] inline void decode_axis_sixteen(const std::byte* data, std::uint32_t first_bit,
+                                                            std::uint32_t bits, std::uint32_t vertices, int lower,
+                                                            int upper, float origin, float cell, float* position) {
   using SixteenI32 = std::int32_t __attribute__((vector_size(64)));
   using SixteenF32 = float __attribute__((vector_size(64)));
   for (std::uint32_t first = 0; first < vertices; first += 16) {
-    const SixteenU32 value = read_stream_sixteen(data, bits, first, vertices);
+    const SixteenU32 value = read_stream_sixteen(data, first_bit, bits, first, vertices);
     const SixteenU32 offset = value >> 1u;
     // In unsigned arithmetic, as the scalar decode: the adds and subtracts wrap modulo 2^32.
     const SixteenU32 line = (value & 1u) != 0u ? std::uint32_t(upper) - offset : std::uint32_t(lower) + offset;
@@ -127,10 +124,11 @@ inline constexpr bool kSixteenLanes = kIsa == KernelIsa::avx512;
 }
 
 // The slots' vertex indices of an indexed record, sixteen at a time.
-[[WAVETRACE_AVX512_TARGET]] inline void decode_indices_sixteen(const std::byte* data, std::uint32_t bits,
-                                                               std::uint32_t slots, std::uint32_t* slot_vertex) {
+[[WAVETRACE_AVX512_TARGET]] inline void decode_indices_sixteen(const std::byte* data, std::uint32_t first_bit,
+                                                               std::uint32_t bits, std::uint32_t slots,
+                                                               std::uint32_t* slot_vertex) {
   for (std::uint32_t first = 0; first < slots; first += 16) {
-    const SixteenU32 vertex = read_stream_sixteen(data, bits, first, slots);
+    const SixteenU32 vertex = read_stream_sixteen(data, first_bit, bits, first, slots);
     std::memcpy(slot_vertex + first, &vertex, sizeof(vertex));
   }
 }
@@ -148,18 +146,20 @@ template <KernelIsa kIsa = KernelIsa::baseline>
 inline void decode_leaf(const std::byte* record, const GlobalGrid& grid, const GridBox& box, DecodedLeaf& leaf) {
   leaf.header = read_leaf_header(record);
   leaf.layout = &StripTable::instance().entry(leaf.header.entry);
+  leaf.record = record;
   const std::uint32_t vertices = leaf.header.vertex_count;
-  const std::byte* data = record + kLeafHeaderBytes;
+  std::uint32_t bit = leaf.header.stream_bit;
   for (int axis = 0; axis < 3; ++axis) {
     const std::uint32_t bits = leaf.header.axis_bits[axis] + 1;
     const int lower = box.lower[axis], upper = box.upper[axis];
     const float origin = grid.origin[axis], cell = grid.cell[axis];
     float* position = leaf.position[axis];
+    const std::uint32_t first_bit = bit;
+    bit += bits * vertices;
 #if WAVETRACE_AVX512_DISPATCH
     if constexpr (kSixteenLanes<kIsa>) {
       if (bits <= kLaneStreamBits) {
-        decode_axis_sixteen(data, bits, vertices, lower, upper, origin, cell, position);
-        data += stream_bytes(bits, vertices);
+        decode_axis_sixteen(record, first_bit, bits, vertices, lower, upper, origin, cell, position);
         continue;
       }
     }
@@ -167,7 +167,7 @@ inline void decode_leaf(const std::byte* record, const GlobalGrid& grid, const G
 #if WAVETRACE_AVX2
     if (bits <= kLaneStreamBits) {
       for (std::uint32_t first = 0; first < vertices; first += 8) {
-        const __m256i value = read_stream_lanes(data, bits, first, vertices);
+        const __m256i value = read_stream_lanes(record, first_bit, bits, first, vertices);
         // In unsigned arithmetic, as below: the lanes' adds and subtracts wrap modulo 2^32.
         const __m256i offset = _mm256_srli_epi32(value, 1);
         const __m256i from_upper = _mm256_cmpeq_epi32(_mm256_and_si256(value, _mm256_set1_epi32(1)), _mm256_set1_epi32(1));
@@ -176,13 +176,11 @@ inline void decode_leaf(const std::byte* record, const GlobalGrid& grid, const G
         _mm256_store_ps(position + first, _mm256_add_ps(_mm256_set1_ps(origin),
                                                         _mm256_mul_ps(_mm256_cvtepi32_ps(line), _mm256_set1_ps(cell))));
       }
-      data += stream_bytes(bits, vertices);
       continue;
     }
 #endif
     alignas(32) std::uint32_t values[64];
-    read_stream(data, bits, vertices, values);
-    data += stream_bytes(bits, vertices);
+    read_stream(record, first_bit, bits, vertices, values);
     for (std::uint32_t i = 0; i < vertices; ++i) {
       // In unsigned arithmetic (C++20 converts back modulo 2^32): the same lines for every
       // record the encoder writes, and no signed overflow for one a crafted file holds.
@@ -195,39 +193,43 @@ inline void decode_leaf(const std::byte* record, const GlobalGrid& grid, const G
   if (leaf.header.indexed) {
     const std::uint32_t bits = leaf.header.index_bits;
 #if WAVETRACE_AVX512_DISPATCH
-    if (kSixteenLanes<kIsa> && bits != 0) {
-      decode_indices_sixteen(data, bits, slots, leaf.slot_vertex);
+    if (kSixteenLanes<kIsa> && bits != 0 && bits <= kLaneStreamBits) {
+      decode_indices_sixteen(record, bit, bits, slots, leaf.slot_vertex);
     } else
 #endif
     {
 #if WAVETRACE_AVX2
-      if (bits != 0) {
+      if (bits != 0 && bits <= kLaneStreamBits) {
         for (std::uint32_t first = 0; first < slots; first += 8) {
-          _mm256_store_si256(reinterpret_cast<__m256i*>(leaf.slot_vertex + first), read_stream_lanes(data, bits, first, slots));
+          _mm256_store_si256(reinterpret_cast<__m256i*>(leaf.slot_vertex + first),
+                             read_stream_lanes(record, bit, bits, first, slots));
         }
       } else {
-        read_stream(data, 0, slots, leaf.slot_vertex);
+        read_stream(record, bit, bits, slots, leaf.slot_vertex);
       }
 #else
-      read_stream(data, bits, slots, leaf.slot_vertex);
+      read_stream(record, bit, bits, slots, leaf.slot_vertex);
 #endif
     }
-    data += stream_bytes(bits, slots);
+    bit += bits * slots;
   }
-  const std::uint32_t triangles = leaf.layout->triangles;
-  leaf.ids = data;
-  leaf.corners = data + stream_bytes(leaf.header.id_bits, triangles);
+  leaf.ids_bit = bit;
+  leaf.corners_bit = bit + leaf.header.id_bits * leaf.layout->triangles;
 }
 
-// Bytes a record of this header and strip layout occupies: its streams in record order.
+// Bits a record of this header and strip layout occupies: its header, id base and streams.
+inline std::size_t leaf_record_bits(const LeafHeader& header, const StripLayoutEntry& layout) {
+  std::size_t bits = header.stream_bit;
+  for (int axis = 0; axis < 3; ++axis) bits += stream_bits(header.axis_bits[axis] + 1, header.vertex_count);
+  if (header.indexed) bits += stream_bits(header.index_bits, layout.slots);
+  return bits + stream_bits(header.id_bits, layout.triangles) + stream_bits(3, layout.triangles);
+}
 inline std::size_t leaf_record_bytes(const LeafHeader& header, const StripLayoutEntry& layout) {
-  std::size_t bytes = kLeafHeaderBytes;
-  for (int axis = 0; axis < 3; ++axis) bytes += stream_bytes(header.axis_bits[axis] + 1, header.vertex_count);
-  if (header.indexed) bytes += stream_bytes(header.index_bits, layout.slots);
-  return bytes + stream_bytes(header.id_bits, layout.triangles) + stream_bytes(3, layout.triangles);
+  return (leaf_record_bits(header, layout) + 7) / 8;
 }
 
-// Bytes the record at `record` occupies (for tests and statistics).
+// Bytes the record at `record` occupies (for tests and statistics); reads its header's
+// kLeafHeaderReadBytes.
 std::size_t leaf_record_bytes(const std::byte* record);
 
 }  // namespace wavetrace::hmq

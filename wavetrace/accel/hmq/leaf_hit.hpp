@@ -27,18 +27,15 @@ namespace wavetrace::hmq {
 struct LeafHit {
   float t = std::numeric_limits<float>::infinity();
   float u = 0.0f, v = 0.0f;  // weights of the strip triangle's second and third corner
-  LeafHeader header{};
-  const std::byte* ids = nullptr;
-  const std::byte* corners = nullptr;
+  const std::byte* record = nullptr;
+  std::uint32_t id_base = 0, id_bits = 0;
+  std::uint32_t ids_bit = 0, corners_bit = 0;  // where the record's id and corner streams start
   std::uint32_t triangle = 0;
   glm::vec3 corner[3];  // the strip triangle's decoded corners, for the hit's point and normal
   bool found = false;
 
-  std::uint32_t triangle_id() const {
-    std::uint32_t delta[kMaxLeafTriangles];
-    read_stream(ids, header.id_bits, triangle + 1, delta);
-    return header.id_base + delta[triangle];
-  }
+  std::uint32_t triangle_id() const { return id_base + read_value(record, ids_bit + triangle * id_bits, id_bits); }
+  std::uint32_t corner_code() const { return read_value(record, corners_bit + 3 * triangle, 3); }
 };
 
 // A leaf decoded once, with its triangles' corners gathered into lanes (triangle k in lane k),
@@ -155,8 +152,17 @@ template <bool kAnyHit, KernelIsa kIsa = KernelIsa::baseline>
       return false;
     }
     tmax = hit.t;
-    best = {hit.t, hit.u, hit.v, decoded.header, decoded.ids, decoded.corners, k,
-            {leaf.corner(k, 0), leaf.corner(k, 1), leaf.corner(k, 2)}, true};
+    best = {hit.t,
+            hit.u,
+            hit.v,
+            decoded.record,
+            decoded.header.id_base,
+            decoded.header.id_bits,
+            decoded.ids_bit,
+            decoded.corners_bit,
+            k,
+            {leaf.corner(k, 0), leaf.corner(k, 1), leaf.corner(k, 2)},
+            true};
     return true;
   };
 #if WAVETRACE_AVX2
@@ -232,13 +238,10 @@ template <bool kAnyHit, KernelIsa kIsa = KernelIsa::baseline, typename Probe>
 template <bool kSurface>
 inline void write_leaf_hit(const LeafHit& best, HitBatch& hits, std::uint32_t i) {
   if (!best.found) return hits.set_miss(i);
-  std::uint32_t delta[kMaxLeafTriangles], code[kMaxLeafTriangles];
-  read_stream(best.ids, best.header.id_bits, best.triangle + 1, delta);
-  read_stream(best.corners, 3, best.triangle + 1, code);
+  const std::uint32_t code = best.corner_code();
   const float weight[3] = {1.0f - best.u - best.v, best.u, best.v};
-  hits.set_hit(i, best.t, best.header.id_base + delta[best.triangle], weight[code[best.triangle] / 3],
-               weight[code[best.triangle] % 3]);
-  if constexpr (kSurface) set_surface_from_strip(hits, i, best.corner, code[best.triangle]);
+  hits.set_hit(i, best.t, best.triangle_id(), weight[code / 3], weight[code % 3]);
+  if constexpr (kSurface) set_surface_from_strip(hits, i, best.corner, code);
 }
 
 }  // namespace wavetrace::hmq

@@ -1,9 +1,13 @@
-// Bit strings laid out for fast decoding (HMQ Appendix A): values of `bits` bits are packed
-// p = floor(64 / bits) to a 64-bit little-endian quad-word, and the next group starts at the
-// next *byte* after them, so every group is read with one unaligned 8-byte load and shifts,
-// never a value straddling two words. A stream of `count` values takes
-// (count / p) * ceil(p * bits / 8) + ceil((count % p) * bits / 8) bytes; decoding may read up
-// to 8 bytes from a group's start, so the buffer holding streams keeps 8 bytes of slack.
+// Bit strings: values of `bits` bits laid end to end from a bit position of a byte array, the
+// array read as one little-endian number, so that value i of a stream starting at bit s holds
+// bits s + i·bits .. s + (i + 1)·bits - 1. Each value is read with one unaligned load at its
+// first byte: 8 bytes for up to 32 bits, 4 for up to 25 (the lanes' gathers). An array holding
+// streams keeps 8 bytes of slack after its last value for those loads.
+//
+// HMQ's Appendix A packs floor(64 / bits) values to a quad-word and starts the next group, and
+// every stream, at a byte, so that no value straddles two quad-words of an aligned load. An
+// unaligned load at a value's first byte never straddles either, so nothing needs the groups,
+// and streams laid end to end save their tails: a quarter of a byte a triangle on the scans.
 #pragma once
 
 #include "wavetrace/build_config.hpp"  // WAVETRACE_AVX2
@@ -13,7 +17,6 @@
 #include <cstdint>
 #include <cstring>
 #include <span>
-#include <vector>
 
 #include "wavetrace/memory/cache_aligned_allocator.hpp"
 
@@ -23,60 +26,74 @@
 
 namespace wavetrace::hmq {
 
-struct StreamShape {
-  std::uint32_t per_group;    // values per quad-word
-  std::uint32_t group_bytes;  // bytes from one group's start to the next
-};
+// Bits a stream of `count` values of `bits` bits takes.
+constexpr std::size_t stream_bits(std::uint32_t bits, std::uint32_t count) { return std::size_t(bits) * count; }
 
-constexpr StreamShape compute_stream_shape(std::uint32_t bits) {
-  const std::uint32_t per_group = bits == 0 ? 64 : 64 / bits;
-  return {per_group, (per_group * bits + 7) / 8};
-}
-
-// Appendix A's look-up table: the shape for every width 0 .. 64, so decoding divides nothing.
-inline constexpr auto kStreamShapes = [] {
-  std::array<StreamShape, 65> shapes{};
-  for (std::uint32_t bits = 0; bits <= 64; ++bits) shapes[bits] = compute_stream_shape(bits);
-  return shapes;
-}();
-
-constexpr StreamShape stream_shape(std::uint32_t bits) { return kStreamShapes[bits]; }
-
-// Where value i (< 64) of a stream of `bits` (1 .. 32) bits starts, in bits from the stream's
-// start: the group's start, (i / per_group) * group_bytes bytes in, and (i % per_group) * bits.
+// i · bits for every width 1 .. 32 and i < 64, as 16-bit lanes: the lane readers' offsets
+// within a stream, loaded rather than multiplied.
 inline constexpr auto kStreamBitOffsets = [] {
   std::array<std::array<std::uint16_t, 64>, 33> offsets{};
   for (std::uint32_t bits = 1; bits <= 32; ++bits) {
-    const StreamShape shape = compute_stream_shape(bits);
-    for (std::uint32_t i = 0; i < 64; ++i) {
-      offsets[bits][i] = static_cast<std::uint16_t>(i / shape.per_group * shape.group_bytes * 8 + i % shape.per_group * bits);
-    }
+    for (std::uint32_t i = 0; i < 64; ++i) offsets[bits][i] = static_cast<std::uint16_t>(i * bits);
   }
   return offsets;
 }();
 
-// Bytes a stream of `count` values takes. Up to 64 values (every stream of a leaf record) from
-// where its last value ends: a decoder steps from stream to stream by it, and the division
-// by per_group the general formula needs would sit in that chain once a stream.
-constexpr std::size_t stream_bytes(std::uint32_t bits, std::uint32_t count) {
-  if (bits == 0 || count == 0) return 0;
-  if (count <= 64 && bits <= 32) return (std::size_t(kStreamBitOffsets[bits][count - 1]) + bits + 7) / 8;
-  const StreamShape shape = stream_shape(bits);
-  return std::size_t(count / shape.per_group) * shape.group_bytes + ((count % shape.per_group) * bits + 7) / 8;
+// The value of `bits` (0 .. 32) bits at bit `bit` of `data`.
+inline std::uint32_t read_value(const std::byte* data, std::size_t bit, std::uint32_t bits) {
+  std::uint64_t word;
+  std::memcpy(&word, data + bit / 8, 8);  // unaligned
+  return static_cast<std::uint32_t>((word >> (bit % 8)) & ((std::uint64_t{1} << bits) - 1));
 }
 
-// The widest values read_stream_lanes takes: a value and its bit offset within its first byte
+// Decodes `count` values of `bits` bits, the first at bit `first_bit` of `data`, into `out`.
+inline void read_stream(const std::byte* data, std::size_t first_bit, std::uint32_t bits, std::uint32_t count,
+                        std::uint32_t* out) {
+  for (std::uint32_t i = 0; i < count; ++i) out[i] = read_value(data, first_bit + std::size_t(i) * bits, bits);
+}
+
+// Appends values to a byte array as one bit string; finish() pads the last byte with zeros.
+class BitWriter {
+ public:
+  explicit BitWriter(LargeArray<std::byte>& out) : out_(out) {}
+
+  // `value` must fit in `bits` (0 .. 32) bits.
+  void append(std::uint32_t value, std::uint32_t bits) {
+    pending_ |= std::uint64_t(value) << pending_bits_;
+    pending_bits_ += bits;
+    written_bits_ += bits;
+    for (; pending_bits_ >= 8; pending_bits_ -= 8, pending_ >>= 8) out_.push_back(static_cast<std::byte>(pending_));
+  }
+  void append_stream(std::span<const std::uint32_t> values, std::uint32_t bits) {
+    for (const std::uint32_t value : values) append(value, bits);
+  }
+  std::size_t written_bits() const { return written_bits_; }
+  void finish() {
+    if (pending_bits_ > 0) out_.push_back(static_cast<std::byte>(pending_));
+    pending_ = 0;
+    pending_bits_ = 0;
+  }
+
+ private:
+  LargeArray<std::byte>& out_;
+  std::uint64_t pending_ = 0;
+  std::uint32_t pending_bits_ = 0;
+  std::size_t written_bits_ = 0;
+};
+
+// The widest values the lane readers take: a value and its bit offset within its first byte
 // fit one 4-byte load.
 inline constexpr std::uint32_t kLaneStreamBits = 25;
 
 #if WAVETRACE_AVX2
-// Values first .. first + 7 of a stream of `bits` (1 .. kLaneStreamBits) bits in eight lanes,
-// each from one 4-byte load at its first byte; lanes at or past `count` read nothing and hold
-// 0. A value's load ends at most 3 bytes past its stream, within a record's 8 bytes of slack.
-[[gnu::always_inline]] inline __m256i read_stream_lanes(const std::byte* data, std::uint32_t bits, std::uint32_t first,
-                                                        std::uint32_t count) {
-  const __m256i offset = _mm256_cvtepu16_epi32(
-      _mm_loadu_si128(reinterpret_cast<const __m128i*>(kStreamBitOffsets[bits].data() + first)));
+// Values first .. first + 7 (first + 7 < 64) of a stream of `bits` (1 .. kLaneStreamBits) bits
+// starting at bit `first_bit` of `data`, in eight lanes, each from one 4-byte load at its first
+// byte; lanes at or past `count` read nothing and hold 0.
+[[gnu::always_inline]] inline __m256i read_stream_lanes(const std::byte* data, std::uint32_t first_bit,
+                                                        std::uint32_t bits, std::uint32_t first, std::uint32_t count) {
+  const __m256i offset = _mm256_add_epi32(
+      _mm256_cvtepu16_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(kStreamBitOffsets[bits].data() + first))),
+      _mm256_set1_epi32(int(first_bit)));
   const __m256i index = _mm256_add_epi32(_mm256_set1_epi32(int(first)), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
   const __m256i live = _mm256_cmpgt_epi32(_mm256_set1_epi32(int(count)), index);
   const __m256i word = _mm256_mask_i32gather_epi32(_mm256_setzero_si256(), reinterpret_cast<const int*>(data),
@@ -93,46 +110,19 @@ inline constexpr std::uint32_t kLaneStreamBits = 25;
 using SixteenU32 = std::uint32_t __attribute__((vector_size(64)));
 using SixteenU16 = std::uint16_t __attribute__((vector_size(32)));
 
-// read_stream_lanes in sixteen lanes, for the AVX-512 walks (a function of that target).
-[[WAVETRACE_AVX512_TARGET]] inline SixteenU32 read_stream_sixteen(const std::byte* data, std::uint32_t bits,
-                                                                  std::uint32_t first, std::uint32_t count) {
+// read_stream_lanes in sixteen lanes (first + 15 < 64), for the AVX-512 walks (a function of
+// that target).
+[[WAVETRACE_AVX512_TARGET]] inline SixteenU32 read_stream_sixteen(const std::byte* data, std::uint32_t first_bit,
+                                                                  std::uint32_t bits, std::uint32_t first,
+                                                                  std::uint32_t count) {
   SixteenU16 offset16;
   std::memcpy(&offset16, kStreamBitOffsets[bits].data() + first, sizeof(offset16));
-  const SixteenU32 offset = __builtin_convertvector(offset16, SixteenU32);
+  const SixteenU32 offset = __builtin_convertvector(offset16, SixteenU32) + first_bit;
   const __mmask16 live = static_cast<__mmask16>(count - first >= 16 ? 0xffffu : (1u << (count - first)) - 1u);
   const SixteenU32 word = SixteenU32(
       _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), live, __m512i(offset >> 3u), data, 1));
   return (word >> (offset & 7u)) & ((std::uint32_t{1} << bits) - 1u);
 }
 #endif
-
-// Appends the stream to `out`; every value must fit in `bits` (0 .. 32) bits.
-inline void append_stream(LargeArray<std::byte>& out, std::span<const std::uint32_t> values, std::uint32_t bits) {
-  if (bits == 0) return;
-  const StreamShape shape = stream_shape(bits);
-  for (std::size_t first = 0; first < values.size(); first += shape.per_group) {
-    std::uint64_t word = 0;
-    const std::size_t count = std::min<std::size_t>(shape.per_group, values.size() - first);
-    for (std::size_t j = 0; j < count; ++j) word |= std::uint64_t(values[first + j]) << (j * bits);
-    const std::size_t bytes = (count * bits + 7) / 8;
-    for (std::size_t b = 0; b < bytes; ++b) out.push_back(static_cast<std::byte>(word >> (8 * b)));
-  }
-}
-
-// Decodes `count` values of `bits` bits from `data` into `out`.
-inline void read_stream(const std::byte* data, std::uint32_t bits, std::uint32_t count, std::uint32_t* out) {
-  if (bits == 0) {
-    for (std::uint32_t i = 0; i < count; ++i) out[i] = 0;
-    return;
-  }
-  const StreamShape shape = stream_shape(bits);
-  const std::uint64_t mask = (std::uint64_t{1} << bits) - 1;
-  for (std::uint32_t first = 0; first < count; first += shape.per_group, data += shape.group_bytes) {
-    std::uint64_t word;
-    std::memcpy(&word, data, 8);  // unaligned
-    const std::uint32_t end = std::min(count - first, shape.per_group);
-    for (std::uint32_t j = 0; j < end; ++j) out[first + j] = static_cast<std::uint32_t>((word >> (j * bits)) & mask);
-  }
-}
 
 }  // namespace wavetrace::hmq

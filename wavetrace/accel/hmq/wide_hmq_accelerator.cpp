@@ -31,7 +31,8 @@ namespace {
 
 using namespace hmq;
 // Leaf records start 2-byte aligned; a reference counts 2-byte units (at most 254 a record:
-// 508 bytes, above the largest, 472: 14 triangles, 42 vertices of 3 x 25 bits, 32-bit id deltas).
+// 508 bytes, above the largest, 463: a 41-bit header, a 32-bit id base, 14 triangles over 42
+// vertices of 3 x 25 bits, 31-bit id deltas and 3-bit corners).
 constexpr std::size_t kUnit = 2;
 constexpr std::size_t kSlackBytes = 8;  // read slack after the last record for unaligned 8-byte stream loads
 
@@ -63,7 +64,7 @@ struct WideHmqSavedState {
   std::uint32_t children, leaves;
 };
 static_assert(sizeof(WideHmqSavedState) == 112);
-constexpr std::uint32_t kWideHmqSavedVersion = 1;
+constexpr std::uint32_t kWideHmqSavedVersion = 2;  // 2: leaf records as one bit string
 
 // A tree's leaf records, encoded in batches on every core and appended in the order the
 // tree references its leaves: the bytes one encoder going leaf by leaf would append.
@@ -97,13 +98,10 @@ class LeafRecordWriter {
         return std::span<const std::uint32_t>(snapped_.tree.primitive_order.data() + leaf.first, leaf.count);
       };
       for (std::size_t i = block * kBlockLeaves, end = std::min(pending_.size(), i + kBlockLeaves); i < end; ++i) {
-        const BuildNode& leaf = *pending_[i].leaf;
         if (i + kCornersAhead < end) prefetch_leaf_corners(snapped_.quantized, triangles_of(i + kCornersAhead));
         if (i + kGridPointsAhead < end) prefetch_leaf_grid_points(snapped_.quantized, triangles_of(i + kGridPointsAhead));
         const std::size_t at = out.size();
-        encode_leaf(snapped_.quantized, triangles_of(i), pending_[i].box, out);
-        const LeafHeader header = read_leaf_header(out.data() + at);
-        const std::size_t identity = stream_bytes(header.id_bits, leaf.count) + stream_bytes(3, leaf.count);
+        const std::size_t identity = encode_leaf(snapped_.quantized, triangles_of(i), pending_[i].box, out) / 8;
         const std::size_t record = out.size() - at;
         out.resize(at + (record + kUnit - 1) / kUnit * kUnit, std::byte{0});
         parts.other += identity;
