@@ -1,6 +1,7 @@
 // The kernel sets compiled into one binary (kernels/kernel_isa.hpp): the AVX-512 walks answer
 // what the baseline's do, bit for bit, and a set is chosen, forced and refused by name.
 #include <bit>
+#include <cstring>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -8,6 +9,7 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -60,6 +62,52 @@ TEST(KernelIsa, LaneSortOrdersChildrenAsTheBaselineDoes) {
     _mm256_store_si256(reinterpret_cast<__m256i*>(expected), lane_sort::nearest_last(_mm256_load_ps(near), entered));
     _mm256_store_si256(reinterpret_cast<__m256i*>(actual), lane_sort::nearest_last_avx512(_mm256_load_ps(near), entered));
     for (int lane = 0; lane < 8; ++lane) ASSERT_EQ(expected[lane], actual[lane]) << "trial " << trial << " lane " << lane;
+  }
+#else
+  GTEST_SKIP() << "this build (-march=" WAVETRACE_ARCH ") has one set of walks";
+#endif
+}
+
+#if WAVETRACE_AVX512_DISPATCH
+// Through memory: a vector of sixteen is returned in a register only between functions of
+// the AVX-512 target.
+[[WAVETRACE_AVX512_TARGET]] void read_sixteen_into(const std::byte* data, std::uint32_t first_bit, std::uint32_t bits,
+                                                   std::uint32_t first, std::uint32_t count, std::uint32_t* out) {
+  const hmq::SixteenU32 lanes = hmq::read_stream_sixteen(data, first_bit, bits, first, count);
+  std::memcpy(out, &lanes, sizeof(lanes));
+}
+#endif
+
+// The AVX-512 walks read a leaf's streams sixteen values at a time by permutes of one masked
+// load: value for value what the scalar reader reads, at every width they take, from starting
+// bits within and past the first byte, at counts that end inside, at and past a block of
+// sixteen, with the stream ending at the buffer's last byte (so that a read past it faults
+// under the sanitizers).
+TEST(KernelIsa, SixteenLanesReadWhatTheScalarReaderReads) {
+#if WAVETRACE_AVX512_DISPATCH
+  if (!cpu_runs_avx512()) GTEST_SKIP() << "this CPU has no AVX-512";
+  std::mt19937 random(13);
+  for (const std::uint32_t lead : {0u, 3u, 7u, 45u}) {
+    for (std::uint32_t bits = 1; bits <= hmq::kLaneStreamBits; ++bits) {
+      for (const std::uint32_t count : {1u, 7u, 15u, 16u, 17u, 42u, 63u}) {
+        std::vector<std::uint32_t> values(count);
+        for (auto& v : values) v = static_cast<std::uint32_t>(random() & ((std::uint64_t{1} << bits) - 1));
+        LargeArray<std::byte> out;
+        hmq::BitWriter writer(out);
+        for (std::uint32_t b = 0; b < lead; ++b) writer.append(1, 1);  // ones before the stream
+        writer.append_stream(values, bits);
+        writer.finish();
+        const std::vector<std::byte> exact(out.begin(), out.end());
+        for (std::uint32_t first = 0; first < count; first += 16) {
+          std::uint32_t lanes[16];
+          read_sixteen_into(exact.data(), lead, bits, first, count, lanes);
+          for (std::uint32_t lane = 0; lane < 16; ++lane) {
+            const std::uint32_t expected = first + lane < count ? values[first + lane] : 0u;
+            ASSERT_EQ(lanes[lane], expected) << bits << " bits, value " << first + lane << " of " << count << " from bit " << lead;
+          }
+        }
+      }
+    }
   }
 #else
   GTEST_SKIP() << "this build (-march=" WAVETRACE_ARCH ") has one set of walks";

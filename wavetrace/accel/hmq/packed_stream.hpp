@@ -87,19 +87,31 @@ inline constexpr std::uint32_t kLaneStreamBits = 25;
 
 #if WAVETRACE_AVX2
 // Values first .. first + 7 (first + 7 < 64) of a stream of `bits` (1 .. kLaneStreamBits) bits
-// starting at bit `first_bit` of `data`, in eight lanes, each from one 4-byte load at its first
-// byte; lanes at or past `count` read nothing and hold 0.
+// starting at bit `first_bit` of `data`, in eight lanes; lanes at or past `count` hold 0. No
+// gather: the eight values span at most 7 four-byte words from the first one's byte, so one
+// masked load takes them (its last word reaches at most 3 bytes past the last value, within an
+// array's slack), and each lane picks the word its value starts in and the next by permutes,
+// and shifts the value out of the pair.
 [[gnu::always_inline]] inline __m256i read_stream_lanes(const std::byte* data, std::uint32_t first_bit,
                                                         std::uint32_t bits, std::uint32_t first, std::uint32_t count) {
-  const __m256i offset = _mm256_add_epi32(
-      _mm256_cvtepu16_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(kStreamBitOffsets[bits].data() + first))),
-      _mm256_set1_epi32(int(first_bit)));
-  const __m256i index = _mm256_add_epi32(_mm256_set1_epi32(int(first)), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
-  const __m256i live = _mm256_cmpgt_epi32(_mm256_set1_epi32(int(count)), index);
-  const __m256i word = _mm256_mask_i32gather_epi32(_mm256_setzero_si256(), reinterpret_cast<const int*>(data),
-                                                   _mm256_srli_epi32(offset, 3), live, 1);
-  const __m256i value = _mm256_srlv_epi32(word, _mm256_and_si256(offset, _mm256_set1_epi32(7)));
-  return _mm256_and_si256(value, _mm256_set1_epi32(int((std::uint32_t{1} << bits) - 1)));
+  const std::uint32_t start = first_bit + first * bits;
+  const std::uint32_t values = count - first >= 8 ? 8u : count - first;
+  const std::uint32_t lead = start % 8;
+  const std::uint32_t words = (lead + values * bits + 31) / 32;
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m256i window = _mm256_maskload_epi32(reinterpret_cast<const int*>(data + start / 8),
+                                               _mm256_cmpgt_epi32(_mm256_set1_epi32(int(words)), lane));
+  const __m256i offset = _mm256_add_epi32(  // from the window's first bit
+      _mm256_cvtepu16_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(kStreamBitOffsets[bits].data()))),
+      _mm256_set1_epi32(int(lead)));
+  const __m256i word = _mm256_srli_epi32(offset, 5), shift = _mm256_and_si256(offset, _mm256_set1_epi32(31));
+  const __m256i low = _mm256_permutevar8x32_epi32(window, word);
+  const __m256i high = _mm256_permutevar8x32_epi32(window, _mm256_add_epi32(word, _mm256_set1_epi32(1)));
+  // A shift by 32 (a value that starts its word) gives 0, as the next word's part must be.
+  const __m256i value = _mm256_or_si256(_mm256_srlv_epi32(low, shift),
+                                        _mm256_sllv_epi32(high, _mm256_sub_epi32(_mm256_set1_epi32(32), shift)));
+  const __m256i live = _mm256_cmpgt_epi32(_mm256_set1_epi32(int(values)), lane);
+  return _mm256_and_si256(_mm256_and_si256(value, live), _mm256_set1_epi32(int((std::uint32_t{1} << bits) - 1)));
 }
 #endif
 
@@ -111,17 +123,29 @@ using SixteenU32 = std::uint32_t __attribute__((vector_size(64)));
 using SixteenU16 = std::uint16_t __attribute__((vector_size(32)));
 
 // read_stream_lanes in sixteen lanes (first + 15 < 64), for the AVX-512 walks (a function of
-// that target).
+// that target), without a gather: the sixteen values span at most 51 bytes from the first
+// one's byte, so one load masked to those bytes takes them all (nothing past the last value
+// is read), and each lane picks the 4-byte word its value starts in and the next by permutes,
+// and shifts the value out of the pair.
 [[WAVETRACE_AVX512_TARGET]] inline SixteenU32 read_stream_sixteen(const std::byte* data, std::uint32_t first_bit,
                                                                   std::uint32_t bits, std::uint32_t first,
                                                                   std::uint32_t count) {
+  const std::uint32_t start = first_bit + first * bits;
+  const std::uint32_t values = count - first >= 16 ? 16u : count - first;
+  const __mmask16 live = static_cast<__mmask16>((1u << values) - 1u);
+  const std::uint32_t lead = start % 8;
+  const std::uint32_t bytes = (lead + values * bits + 7) / 8;  // at most 51
+  const __m512i window = _mm512_maskz_loadu_epi8((std::uint64_t{1} << bytes) - 1u, data + start / 8);
   SixteenU16 offset16;
-  std::memcpy(&offset16, kStreamBitOffsets[bits].data() + first, sizeof(offset16));
-  const SixteenU32 offset = __builtin_convertvector(offset16, SixteenU32) + first_bit;
-  const __mmask16 live = static_cast<__mmask16>(count - first >= 16 ? 0xffffu : (1u << (count - first)) - 1u);
-  const SixteenU32 word = SixteenU32(
-      _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), live, __m512i(offset >> 3u), data, 1));
-  return (word >> (offset & 7u)) & ((std::uint32_t{1} << bits) - 1u);
+  std::memcpy(&offset16, kStreamBitOffsets[bits].data(), sizeof(offset16));
+  const SixteenU32 offset = __builtin_convertvector(offset16, SixteenU32) + lead;  // from the window's first bit
+  const SixteenU32 shift = offset & 31u;
+  const __m512i low = _mm512_maskz_permutexvar_epi32(live, __m512i(offset >> 5u), window);
+  const __m512i high = _mm512_maskz_permutexvar_epi32(live, __m512i((offset >> 5u) + 1u), window);
+  // A shift by 32 (a value that starts its word) gives 0, as the next word's part must be.
+  const SixteenU32 value = SixteenU32(_mm512_maskz_srlv_epi32(live, low, __m512i(shift))) |
+                           SixteenU32(_mm512_maskz_sllv_epi32(live, high, __m512i(32u - shift)));
+  return value & ((std::uint32_t{1} << bits) - 1u);
 }
 #endif
 
