@@ -134,6 +134,12 @@ template <typename T>
 void poke(char* at, T value) {
   std::memcpy(at, &value, sizeof value);
 }
+template <typename T>
+T peek(const char* at) {
+  T value;
+  std::memcpy(&value, at, sizeof value);
+  return value;
+}
 
 TEST_P(CraftedWorld, IsRefusedOnLoadNamingTheSection) {
   const CraftedCase& c = GetParam();
@@ -155,6 +161,19 @@ TEST_P(CraftedWorld, IsRefusedOnLoadNamingTheSection) {
 void point_wide_node_past_its_arrays(char* node) {
   poke<std::uint32_t>(node + 48, 0);        // child_base
   poke<std::uint32_t>(node + 52, 1u << 30);  // leaf_base
+}
+
+// The first leaf record (hmq_format.hpp's bits) made plain strips of 63 vertices, as many as
+// any layout has slots, so that no other check fails first, and given a 32-bit id base of
+// all ones: every triangle it names lies past the mesh.
+void set_first_leaf_id_base_past_every_triangle(char* record) {
+  std::uint64_t header = peek<std::uint64_t>(record);
+  header &= ~(std::uint64_t{1} << 9);                          // plain strips
+  header |= std::uint64_t{63} << 10;                           // vertex count
+  header |= std::uint64_t{31} << 36 | ~std::uint64_t{0} << 41;  // the base 32 bits wide, its first 23 ones
+  poke<std::uint64_t>(record, header);
+  poke<std::uint8_t>(record + 8, 0xff);                                         // the next 8
+  poke<std::uint8_t>(record + 9, std::uint8_t(peek<std::uint8_t>(record + 9) | 1u));  // and the last
 }
 
 // Offsets from the formats' comments: BvhNode first at 24 (bvh_node.hpp), WideBvhNode child[0]
@@ -191,6 +210,11 @@ INSTANTIATE_TEST_SUITE_P(
         CraftedCase{"WideHmqChildAndLeafPastTheirArrays", {"accel.type=hmq", "accel.hmq.width=8"}, "hmq8.nodes",
                     point_wide_node_past_its_arrays,
                     "node 0"},
+        CraftedCase{"WideHmqLeafOfAStripLayoutPastTheTable", {"accel.type=hmq", "accel.hmq.width=8"}, "hmq8.leaves",
+                    [](char* d) { poke<std::uint16_t>(d, std::uint16_t(peek<std::uint16_t>(d) | 511u)); },
+                    "has a leaf of strip table entry 511"},
+        CraftedCase{"WideHmqLeafOfAMissingTriangle", {"accel.type=hmq", "accel.hmq.width=8"}, "hmq8.leaves",
+                    set_first_leaf_id_base_past_every_triangle, "has a leaf naming a triangle that does not exist"},
         CraftedCase{"WideHmqTogetherChildBeforeItsParent",
                     {"accel.type=hmq", "accel.hmq.width=8", "accel.hmq.leaves_beside_nodes=true"}, "hmq8.tree",
                     point_wide_node_past_its_arrays, "node at unit 0 names child 0"},
