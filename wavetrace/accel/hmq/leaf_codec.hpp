@@ -76,7 +76,7 @@ inline void prefetch_leaf_grid_points(const QuantizedMesh& quantized, std::span<
 // it that name the mesh's triangles and corners (the id base, ids and corner codes), for the
 // statistics' split of a record's bytes.
 std::size_t encode_leaf(const QuantizedMesh& quantized, std::span<const std::uint32_t> triangles, const GridBox& box,
-                 LargeArray<std::byte>& out);
+                        LargeArray<std::byte>& out);
 
 // A decoded leaf: vertex positions in columns (SoA, ready to gather into triangle lanes)
 // and which vertex each strip slot holds.

@@ -53,8 +53,8 @@ SnappedTree build_snapped_tree(const TriangleMesh& mesh, const HmqOptions& optio
   SahOptions sah;
   sah.max_leaf_size = options.leaf_triangles();
   sah.bins = options.bins;
-  // A leaf record has a fixed cost (header, id base, the vertices it shares with others) that makes small
-  // leaves expensive in bytes; a traversal step priced at half a full leaf keeps leaves
+  // A leaf record has a fixed cost (header, id base, the vertices it shares with others) that
+  // makes small leaves expensive in bytes; a traversal step priced at half a full leaf keeps leaves
   // near full, as in the paper's Table 2 (about 3.3, 6.2 and 9.2 triangles per leaf for
   // leaf sizes 4, 8, 12 on Lucy).
   sah.traversal_cost = 0.5f * float(options.leaf_triangles());
