@@ -29,12 +29,12 @@ namespace wavetrace::hmq {
 // Bits a stream of `count` values of `bits` bits takes.
 constexpr std::size_t stream_bits(std::uint32_t bits, std::uint32_t count) { return std::size_t(bits) * count; }
 
-// i · bits for every width 1 .. 32 and i < 64, as 16-bit lanes: the lane readers' offsets
-// within a stream, loaded rather than multiplied.
+// i · bits for every width 1 .. 32 and i < 16, as 16-bit lanes: the lane readers' offsets
+// from their first value, loaded rather than multiplied.
 inline constexpr auto kStreamBitOffsets = [] {
-  std::array<std::array<std::uint16_t, 64>, 33> offsets{};
+  std::array<std::array<std::uint16_t, 16>, 33> offsets{};
   for (std::uint32_t bits = 1; bits <= 32; ++bits) {
-    for (std::uint32_t i = 0; i < 64; ++i) offsets[bits][i] = static_cast<std::uint16_t>(i * bits);
+    for (std::uint32_t i = 0; i < 16; ++i) offsets[bits][i] = static_cast<std::uint16_t>(i * bits);
   }
   return offsets;
 }();
@@ -86,7 +86,7 @@ class BitWriter {
 inline constexpr std::uint32_t kLaneStreamBits = 25;
 
 #if WAVETRACE_AVX2
-// Values first .. first + 7 (first + 7 < 64) of a stream of `bits` (1 .. kLaneStreamBits) bits
+// Values first .. first + 7 of a stream of `bits` (1 .. kLaneStreamBits) bits
 // starting at bit `first_bit` of `data`, in eight lanes; lanes at or past `count` hold 0. No
 // gather: the eight values span at most 7 four-byte words from the first one's byte, so one
 // masked load takes them (its last word reaches at most 3 bytes past the last value, within an
@@ -122,11 +122,11 @@ inline constexpr std::uint32_t kLaneStreamBits = 25;
 using SixteenU32 = std::uint32_t __attribute__((vector_size(64)));
 using SixteenU16 = std::uint16_t __attribute__((vector_size(32)));
 
-// read_stream_lanes in sixteen lanes (first + 15 < 64), for the AVX-512 walks (a function of
-// that target), without a gather: the sixteen values span at most 51 bytes from the first
-// one's byte, so one load masked to those bytes takes them all (nothing past the last value
-// is read), and each lane picks the 4-byte word its value starts in and the next by permutes,
-// and shifts the value out of the pair.
+// read_stream_lanes in sixteen lanes, for the AVX-512 walks (a function of that target),
+// without a gather: the sixteen values span at most 51 bytes from the first one's byte, so
+// one load masked to those bytes takes them all (nothing past the last value is read), and
+// each lane picks the 4-byte word its value starts in and the next by permutes, and shifts
+// the value out of the pair.
 [[WAVETRACE_AVX512_TARGET]] inline SixteenU32 read_stream_sixteen(const std::byte* data, std::uint32_t first_bit,
                                                                   std::uint32_t bits, std::uint32_t first,
                                                                   std::uint32_t count) {
