@@ -78,6 +78,16 @@ inline void prefetch_leaf_grid_points(const QuantizedMesh& quantized, std::span<
 std::size_t encode_leaf(const QuantizedMesh& quantized, std::span<const std::uint32_t> triangles, const GridBox& box,
                         LargeArray<std::byte>& out);
 
+// Where a record names its mesh triangles and their corners: all a hit keeps of its leaf.
+struct LeafIdentity {
+  const std::byte* record = nullptr;
+  std::uint32_t id_base = 0, id_bits = 0;
+  std::uint32_t ids_bit = 0, corners_bit = 0;  // where the id and corner streams start
+
+  std::uint32_t triangle_id(std::uint32_t k) const { return id_base + read_value(record, ids_bit + k * id_bits, id_bits); }
+  std::uint32_t corner_code(std::uint32_t k) const { return read_value(record, corners_bit + 3 * k, 3); }
+};
+
 // A decoded leaf: vertex positions in columns (SoA, ready to gather into triangle lanes)
 // and which vertex each strip slot holds.
 struct DecodedLeaf {
@@ -96,10 +106,9 @@ struct DecodedLeaf {
     const std::uint32_t v = vertex_of_slot(slot);
     return {position[0][v], position[1][v], position[2][v]};
   }
-  std::uint32_t triangle_id(std::uint32_t k) const {
-    return header.id_base + read_value(record, ids_bit + k * header.id_bits, header.id_bits);
-  }
-  std::uint32_t corner_code(std::uint32_t k) const { return read_value(record, corners_bit + 3 * k, 3); }
+  LeafIdentity identity() const { return {record, header.id_base, header.id_bits, ids_bit, corners_bit}; }
+  std::uint32_t triangle_id(std::uint32_t k) const { return identity().triangle_id(k); }
+  std::uint32_t corner_code(std::uint32_t k) const { return identity().corner_code(k); }
 };
 
 #if WAVETRACE_AVX512_DISPATCH

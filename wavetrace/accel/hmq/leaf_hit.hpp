@@ -27,15 +27,13 @@ namespace wavetrace::hmq {
 struct LeafHit {
   float t = std::numeric_limits<float>::infinity();
   float u = 0.0f, v = 0.0f;  // weights of the strip triangle's second and third corner
-  const std::byte* record = nullptr;
-  std::uint32_t id_base = 0, id_bits = 0;
-  std::uint32_t ids_bit = 0, corners_bit = 0;  // where the record's id and corner streams start
+  LeafIdentity leaf{};
   std::uint32_t triangle = 0;
   glm::vec3 corner[3];  // the strip triangle's decoded corners, for the hit's point and normal
   bool found = false;
 
-  std::uint32_t triangle_id() const { return id_base + read_value(record, ids_bit + triangle * id_bits, id_bits); }
-  std::uint32_t corner_code() const { return read_value(record, corners_bit + 3 * triangle, 3); }
+  std::uint32_t triangle_id() const { return leaf.triangle_id(triangle); }
+  std::uint32_t corner_code() const { return leaf.corner_code(triangle); }
 };
 
 // A leaf decoded once, with its triangles' corners gathered into lanes (triangle k in lane k),
@@ -152,17 +150,7 @@ template <bool kAnyHit, KernelIsa kIsa = KernelIsa::baseline>
       return false;
     }
     tmax = hit.t;
-    best = {hit.t,
-            hit.u,
-            hit.v,
-            decoded.record,
-            decoded.header.id_base,
-            decoded.header.id_bits,
-            decoded.ids_bit,
-            decoded.corners_bit,
-            k,
-            {leaf.corner(k, 0), leaf.corner(k, 1), leaf.corner(k, 2)},
-            true};
+    best = {hit.t, hit.u, hit.v, decoded.identity(), k, {leaf.corner(k, 0), leaf.corner(k, 1), leaf.corner(k, 2)}, true};
     return true;
   };
 #if WAVETRACE_AVX2
