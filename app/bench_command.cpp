@@ -33,6 +33,7 @@ struct BenchArguments {
   int threads = 0;
   int repeat = 3;
   bool packets = false;
+  bool one_at_a_time = false;
   std::string json;
   std::string budgets;
   bool reads = false;
@@ -97,6 +98,7 @@ int run_accel(const BenchArguments& args) {
   request.threads = args.threads;
   request.repeats = args.repeat;
   request.packets = args.packets;
+  request.one_at_a_time = args.one_at_a_time;
   request.memory = plan_memory(setup.config);
   request.budgets = split_commas(args.budgets);
   request.count_reads = args.reads;
@@ -355,7 +357,12 @@ void add_bench_command(CLI::App& app, int& exit_code) {
   CLI::App* accel = bench->add_subcommand("accel", "build and trace the same rays with each accelerator");
   add_common_options(accel, *accel_args);
   accel->add_option("--rays", accel_args->rays, "primary, diffuse, shadow or random");
-  accel->add_option("--repeat", accel_args->repeat, "timed runs per accelerator (the median is reported)");
+  accel->add_option("--repeat", accel_args->repeat,
+                    "timed rounds: every accelerator is built first, then timed once a round in turn; the median run "
+                    "and the median of the rounds' ratios to the first accelerator are reported");
+  accel->add_flag("--one-at-a-time", accel_args->one_at_a_time,
+                  "build, time and drop each accelerator before the next (scenes where they do not all fit at once); "
+                  "the ratio to the first is then of the medians");
   accel->add_flag("--packets", accel_args->packets,
                   "primary rays as 2x2 packets (intersect_coherent) where an accelerator has packet traversal");
   accel->add_option("--reference", accel_args->reference,

@@ -20,7 +20,7 @@ for size in $sizes; do
 done
 for size in 8M 64M; do
   "$wavetrace" bench accel --scene "builtin:room:$size" --accel embree,bvh,raystrips,hmq --rays diffuse \
-      --count 1000000 --threads 2 --repeat 3 --json "$out/bench_${size}.json" > "$out/bench_${size}.txt" 2>&1
+      --count 1000000 --threads 2 --repeat 3 --one-at-a-time --json "$out/bench_${size}.json" > "$out/bench_${size}.txt" 2>&1
 done
 # Chunked (1M) against monolithic (one chunk of 2^30) on the same mesh, against robust Embree.
 whole=chunk_triangles=1073741824

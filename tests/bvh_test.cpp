@@ -485,13 +485,39 @@ TEST(AccelBench, ReportsEveryFieldAgainstTheChosenReference) {
   EXPECT_GE(report.results[0].hit_agreement, 0.999);  // default Embree against robust Embree
   EXPECT_EQ(report.results[0].mrays_per_s_runs.size(), 3u);
   EXPECT_GT(report.results[1].mrays_per_s, 0.0);
+  // Interleaved rounds: each result's ratio to the first is the median of run k against run k.
+  EXPECT_TRUE(report.interleaved);
+  for (const AccelBenchResult& result : report.results) {
+    ASSERT_EQ(result.vs_first_runs.size(), 3u);
+    std::vector<double> ratios;
+    for (std::size_t run = 0; run < 3; ++run) {
+      ratios.push_back(result.mrays_per_s_runs[run] / report.results[0].mrays_per_s_runs[run]);
+      EXPECT_DOUBLE_EQ(result.vs_first_runs[run], ratios.back());
+    }
+    std::sort(ratios.begin(), ratios.end());
+    EXPECT_DOUBLE_EQ(result.vs_first, ratios[1]);
+  }
+  EXPECT_DOUBLE_EQ(report.results[0].vs_first, 1.0);
   const nlohmann::json json = to_json(report);
   for (const char* key : {"accel", "bytes", "bytes_per_triangle", "parts", "build_seconds", "build_peak_accounted_bytes",
                           "mrays_per_s", "hit_agreement", "prim_agreement", "t_error_max", "t_error_mean"}) {
     EXPECT_TRUE(json["results"][1].contains(key)) << key;
   }
   EXPECT_EQ(json["results"][1]["accel"], "bvh:layout=veb");
+  EXPECT_EQ(json["results"][1]["vs_first_runs"].size(), 3u);
   EXPECT_NE(to_csv(report).find("bvh:layout=veb"), std::string::npos);
+  EXPECT_NE(to_table(report).find("3 rounds, each accelerator once a round in turn"), std::string::npos);
+
+  // One at a time: the same fields, no rounds to pair, the ratio of the medians.
+  request.one_at_a_time = true;
+  const AccelBenchReport apart = run_accel_bench(scene, request);
+  EXPECT_FALSE(apart.interleaved);
+  ASSERT_EQ(apart.results.size(), 2u);
+  EXPECT_EQ(apart.results[1].mrays_per_s_runs.size(), 3u);
+  EXPECT_TRUE(apart.results[1].vs_first_runs.empty());
+  EXPECT_DOUBLE_EQ(apart.results[1].vs_first, apart.results[1].mrays_per_s / apart.results[0].mrays_per_s);
+  EXPECT_EQ(apart.results[1].hit_agreement, report.results[1].hit_agreement);
+  EXPECT_NE(to_table(apart).find("3 runs, one accelerator at a time"), std::string::npos);
 }
 
 TEST(AccelBench, BadSpecsNameTheProblem) {

@@ -81,6 +81,25 @@ void measure_agreement_beyond_error(const RaySet& rays, const Accelerator& refer
   result.self_hits = double(self_hits) / double(std::max<std::size_t>(rays.count(), 1));
 }
 
+// Each result's speed against the first's. Interleaved, run k of each was timed in the same
+// round, so the rounds' ratios pair runs that shared the machine's state of that moment and
+// their median is the figure; one at a time, the ratio of the medians.
+void set_ratios_to_first(AccelBenchReport& report) {
+  if (report.results.empty()) return;
+  const AccelBenchResult& first = report.results.front();
+  for (AccelBenchResult& r : report.results) {
+    r.vs_first_runs.clear();
+    if (report.interleaved) {
+      for (std::size_t run = 0; run < r.mrays_per_s_runs.size() && run < first.mrays_per_s_runs.size(); ++run) {
+        r.vs_first_runs.push_back(r.mrays_per_s_runs[run] / first.mrays_per_s_runs[run]);
+      }
+      r.vs_first = median(r.vs_first_runs);
+    } else {
+      r.vs_first = first.mrays_per_s > 0 ? r.mrays_per_s / first.mrays_per_s : 0.0;
+    }
+  }
+}
+
 }  // namespace
 
 AcceleratorSpec parse_accelerator_spec(const std::string& text, const Config& base) {
@@ -168,6 +187,8 @@ AccelBenchReport run_accel_bench(const Scene& scene, const AccelBenchRequest& re
   report.reference = request.reference.label;
   report.threads = arena.threads();
   report.repeats = request.repeats;
+  // Interleaved rounds need every subject held at once; a lone subject has nothing to alternate with.
+  report.interleaved = !request.one_at_a_time && (request.world != nullptr ? 1 : request.accelerators.size()) > 1;
   report.packets = request.packets && request.rays == RaySetKind::primary;
   report.memory_observed = request.memory.enabled() || !request.budgets.empty();
   const float diagonal = scene.bounds.diagonal();
@@ -188,57 +209,93 @@ AccelBenchReport run_accel_bench(const Scene& scene, const AccelBenchRequest& re
     }
     report.reference_hit_rate = double(reference_hit_count) / double(std::max<std::size_t>(1, report.ray_count));
 
-    const std::size_t subjects = request.world != nullptr ? 1 : request.accelerators.size();
-    for (std::size_t subject = 0; subject < subjects; ++subject) {
+    // A subject from its build (or the world's load) to its report: built, timed, checked.
+    struct Subject {
       AccelBenchResult result;
       std::unique_ptr<Accelerator> built;
+      const Accelerator* accelerator = nullptr;
+      std::vector<std::unique_ptr<HitBatch>> hits;  // of its last timed run
+    };
+    const auto prepare = [&](std::size_t index) {
+      Subject subject;
+      AccelBenchResult& result = subject.result;
       if (request.world != nullptr) {
         result.label = request.world_label;
         result.build = request.world->build();
         result.build.seconds = request.world_load_seconds;  // the world's load stands for its build
       } else {
-        const AcceleratorSpec& spec = request.accelerators[subject];
+        const AcceleratorSpec& spec = request.accelerators[index];
         result.label = spec.label;
         result.auto_choice = spec.auto_choice;
         // The build's peak resident memory, from the OS: the peak window starts here, so it
-        // holds what the process already had (scene, rays, reference) plus the build's own.
+        // holds what the process already had (scene, rays, reference, the subjects built
+        // before it) plus the build's own.
         const bool windowed = reset_peak_resident_memory();
         const std::size_t resident_before = read_resident_memory().current_bytes;
-        built = build_world_accelerator(scene, spec.options);
+        subject.built = build_world_accelerator(scene, spec.options);
         const std::size_t peak = read_resident_memory().peak_bytes;
         if (windowed) result.build_peak_rss_above_start_bytes = peak > resident_before ? peak - resident_before : 0;
-        result.build = built->build();
+        result.build = subject.built->build();
       }
-      const Accelerator* accelerator = built ? built.get() : request.world;
-      result.memory = accelerator->memory();
+      subject.accelerator = subject.built ? subject.built.get() : request.world;
+      result.memory = subject.accelerator->memory();
       result.bytes_per_triangle = double(result.memory.total()) / double(scene.triangle_count);
-      result.build_notes = accelerator->build_notes();
-      result.isa = accelerator->isa();
-      std::vector<std::unique_ptr<HitBatch>> hits;
-      for (int run = 0; run < std::max(1, request.repeats); ++run) {
-        const auto start = std::chrono::steady_clock::now();
-        hits = trace_ray_set(*accelerator, rays, report.packets);
-        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        result.mrays_per_s_runs.push_back(double(report.ray_count) / seconds * 1e-6);
-      }
+      result.build_notes = subject.accelerator->build_notes();
+      result.isa = subject.accelerator->isa();
+      return subject;
+    };
+    const auto time_run = [&](Subject& subject) {
+      const auto start = std::chrono::steady_clock::now();
+      subject.hits = trace_ray_set(*subject.accelerator, rays, report.packets);
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      subject.result.mrays_per_s_runs.push_back(double(report.ray_count) / seconds * 1e-6);
+    };
+    const auto finish = [&](Subject& subject) {
+      AccelBenchResult& result = subject.result;
+      const Accelerator& accelerator = *subject.accelerator;
       result.mrays_per_s = median(result.mrays_per_s_runs);
-      compare(rays, hits, reference_hits, diagonal, result);
-      if (!rays.any_hit() && has_mesh) measure_surface_error(scene.mesh, *accelerator, rays, hits, result);
-      if (has_mesh) measure_agreement_beyond_error(rays, *reference, *accelerator, hits, reference_hits, result);
-      result.probed = accelerator->probed();
-      if (report.memory_observed && result.probed) {
-        result.memory_runs = memory_runs(*accelerator, rays, request, report.threads);
-      }
+      compare(rays, subject.hits, reference_hits, diagonal, result);
+      if (!rays.any_hit() && has_mesh) measure_surface_error(scene.mesh, accelerator, rays, subject.hits, result);
+      if (has_mesh) measure_agreement_beyond_error(rays, *reference, accelerator, subject.hits, reference_hits, result);
+      result.probed = accelerator.probed();
+      if (report.memory_observed && result.probed) result.memory_runs = memory_runs(accelerator, rays, request, report.threads);
       if (request.count_reads && result.probed) {
-        ReadTally tally(accelerator->memory_spans(), std::size_t(std::max(report.threads, 1)));
+        ReadTally tally(accelerator.memory_spans(), std::size_t(std::max(report.threads, 1)));
         MemoryObservers observers;
         observers.tally = &tally;
-        trace_ray_set_probed(*accelerator, rays, observers);
+        trace_ray_set_probed(accelerator, rays, observers);
         result.reads_by_array = tally.totals();
         for (const auto& array : tally.arrays()) result.array_bytes.push_back(array.size());
       }
       report.results.push_back(std::move(result));
+      subject = {};  // its structure goes before the next one is built
+    };
+
+    const std::size_t subjects = request.world != nullptr ? 1 : request.accelerators.size();
+    const int runs = std::max(1, request.repeats);
+    if (report.interleaved) {
+      std::vector<Subject> all;
+      for (std::size_t index = 0; index < subjects; ++index) all.push_back(prepare(index));
+      // A round untimed first: this machine's speed climbs over a process's first seconds.
+      // Then the order turns each round (A B C, C B A, ...), so that a steady drift favours
+      // no accelerator over a pair of rounds.
+      for (Subject& subject : all) subject.hits = trace_ray_set(*subject.accelerator, rays, report.packets);
+      for (int run = 0; run < runs; ++run) {
+        if (run % 2 == 0) {
+          for (Subject& subject : all) time_run(subject);
+        } else {
+          for (auto subject = all.rbegin(); subject != all.rend(); ++subject) time_run(*subject);
+        }
+      }
+      for (Subject& subject : all) finish(subject);
+    } else {
+      for (std::size_t index = 0; index < subjects; ++index) {
+        Subject subject = prepare(index);
+        for (int run = 0; run < runs; ++run) time_run(subject);
+        finish(subject);
+      }
     }
+    set_ratios_to_first(report);
   });
   return report;
 }
@@ -283,6 +340,8 @@ nlohmann::json to_json(const AccelBenchReport& report) {
                        {"isa", r.isa},
                        {"mrays_per_s", r.mrays_per_s},
                        {"mrays_per_s_runs", r.mrays_per_s_runs},
+                       {"vs_first", r.vs_first},
+                       {"vs_first_runs", r.vs_first_runs},
                        {"hit_agreement", r.hit_agreement},
                        {"prim_agreement", json_or_null(r.prim_agreement)},
                        {"surface_error_max", json_or_null(r.surface_error_max)},
@@ -303,6 +362,7 @@ nlohmann::json to_json(const AccelBenchReport& report) {
           {"rays", {{"kind", report.rays}, {"count", report.ray_count}, {"reference_hit_rate", report.reference_hit_rate}}},
           {"threads", report.threads},
           {"repeats", report.repeats},
+          {"interleaved", report.interleaved},
           {"packets", report.packets},
           {"results", results}};
 }
@@ -372,19 +432,22 @@ std::string memory_table(const AccelBenchReport& report) {
 
 std::string to_table(const AccelBenchReport& report) {
   std::string table = fmt::format(
-      "{}: {} triangles; {} {} rays{} ({:.1f}% hit the reference, {}); {} threads; median of {} runs\n", report.scene,
+      "{}: {} triangles; {} {} rays{} ({:.1f}% hit the reference, {}); {} threads; median of {}\n", report.scene,
       report.triangles, report.ray_count, report.rays, report.packets ? " as 2x2 packets" : "",
-      100.0 * report.reference_hit_rate, report.reference, report.threads, report.repeats);
-  table += fmt::format("{:<24} {:<7} {:>9} {:>8} {:>8} {:>8} {:>9} {:>11} {:>8} {:>10} {:>10} {:>10} {:>10}\n", "accel",
-                       "isa", "MB", "B/tri", "hier", "geom", "build s", "peak RSS MB", "Mrays/s", "vs first", "hit agr", "prim agr",
-                       "t err max");
-  const double first = report.results.empty() ? 0.0 : report.results.front().mrays_per_s;
+      100.0 * report.reference_hit_rate, report.reference, report.threads,
+      report.interleaved ? fmt::format("{} rounds, each accelerator once a round in turn", report.repeats)
+                         : fmt::format("{} runs, one accelerator at a time", report.repeats));
+  table += fmt::format("{:<24} {:<7} {:>9} {:>8} {:>8} {:>8} {:>9} {:>11} {:>8} {:>10} {:>11} {:>10} {:>10} {:>10}\n", "accel",
+                       "isa", "MB", "B/tri", "hier", "geom", "build s", "peak RSS MB", "Mrays/s", "vs first", "its rounds",
+                       "hit agr", "prim agr", "t err max");
   const double triangles = double(report.triangles);
   for (const AccelBenchResult& r : report.results) {
-    table += fmt::format("{:<24} {:<7} {:>9.1f} {:>8.1f} {:>8.1f} {:>8.1f} {:>9.3f} {:>11.1f} {:>8.2f} {:>9.2f}x {:>9.4f}% {:>9} {:>10}\n",
+    const auto [lowest, highest] = std::minmax_element(r.vs_first_runs.begin(), r.vs_first_runs.end());
+    const std::string rounds = r.vs_first_runs.empty() ? "-" : fmt::format("{:.2f}-{:.2f}", *lowest, *highest);
+    table += fmt::format("{:<24} {:<7} {:>9.1f} {:>8.1f} {:>8.1f} {:>8.1f} {:>9.3f} {:>11.1f} {:>8.2f} {:>9.2f}x {:>11} {:>9.4f}% {:>9} {:>10}\n",
                          r.label, r.isa.empty() ? "-" : r.isa, double(r.memory.total()) * 1e-6, r.bytes_per_triangle,
                          double(r.memory.hierarchy) / triangles, double(r.memory.geometry) / triangles, r.build.seconds,
-                         double(r.build_peak_rss_above_start_bytes) * 1e-6, r.mrays_per_s, first > 0 ? r.mrays_per_s / first : 0.0,
+                         double(r.build_peak_rss_above_start_bytes) * 1e-6, r.mrays_per_s, r.vs_first, rounds,
                          100.0 * r.hit_agreement,
                          r.prim_agreement ? fmt::format("{:.4f}%", 100.0 * *r.prim_agreement) : std::string("-"),
                          r.t_error_max ? fmt::format("{:.2e}", *r.t_error_max) : std::string("-"));

@@ -60,6 +60,10 @@ struct AccelBenchResult {
   std::string isa;  // the instruction set its walks ran (Accelerator::isa)
   std::vector<double> mrays_per_s_runs;
   double mrays_per_s = 0.0;      // median of the runs
+  // Its speed against the first result's: interleaved, the median of the rounds' ratios
+  // (vs_first_runs, run k against the first's run k); one at a time, the ratio of the medians.
+  double vs_first = 0.0;
+  std::vector<double> vs_first_runs;
   double hit_agreement = 0.0;    // same hit / miss as the reference
   std::optional<double> prim_agreement;  // same primitive where both hit (closest-hit sets only)
   std::optional<double> t_error_max;     // |t - t_ref| / scene diagonal where both hit
@@ -95,6 +99,9 @@ struct AccelBenchReport {
   std::size_t ray_count = 0;
   int threads = 0;
   int repeats = 0;
+  // The runs were timed in rounds, each accelerator once a round in turn, all of them built
+  // first; else each accelerator was built, timed and dropped before the next.
+  bool interleaved = false;
   bool packets = false;
   double reference_hit_rate = 0.0;  // share of rays Embree finds a hit (occluded, for shadow rays)
   bool memory_observed = false;     // memory runs were asked for
@@ -108,6 +115,10 @@ struct AccelBenchRequest {
   std::size_t count = 1 << 20;
   int threads = 0;
   int repeats = 3;
+  // Time each accelerator's runs back to back and drop it before building the next, where
+  // holding all of them at once would not fit (a 64M room's Embree and BVHs): the ratios
+  // then compare runs minutes apart on a machine whose speed drifts.
+  bool one_at_a_time = false;
   bool packets = false;  // primary rays through intersect_coherent (packets where an accelerator has them)
   // The simulated pager's settings and cache; `budgets` (e.g. "100%", "20%") replace memory.budget when given.
   MemoryPlan memory;
