@@ -214,7 +214,7 @@ AccelBenchReport run_accel_bench(const Scene& scene, const AccelBenchRequest& re
       AccelBenchResult result;
       std::unique_ptr<Accelerator> built;
       const Accelerator* accelerator = nullptr;
-      std::vector<std::unique_ptr<HitBatch>> hits;  // of its last timed run
+      std::vector<std::unique_ptr<HitBatch>> hits;  // made once, written by every run
     };
     const auto prepare = [&](std::size_t index) {
       Subject subject;
@@ -238,6 +238,7 @@ AccelBenchReport run_accel_bench(const Scene& scene, const AccelBenchRequest& re
         result.build = subject.built->build();
       }
       subject.accelerator = subject.built ? subject.built.get() : request.world;
+      subject.hits = make_hit_batches(rays);
       result.memory = subject.accelerator->memory();
       result.bytes_per_triangle = double(result.memory.total()) / double(scene.triangle_count);
       result.build_notes = subject.accelerator->build_notes();
@@ -246,7 +247,7 @@ AccelBenchReport run_accel_bench(const Scene& scene, const AccelBenchRequest& re
     };
     const auto time_run = [&](Subject& subject) {
       const auto start = std::chrono::steady_clock::now();
-      subject.hits = trace_ray_set(*subject.accelerator, rays, report.packets);
+      trace_ray_set(*subject.accelerator, rays, subject.hits, report.packets);
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       subject.result.mrays_per_s_runs.push_back(double(report.ray_count) / seconds * 1e-6);
     };
@@ -279,7 +280,7 @@ AccelBenchReport run_accel_bench(const Scene& scene, const AccelBenchRequest& re
       // A round untimed first: this machine's speed climbs over a process's first seconds.
       // Then the order turns each round (A B C, C B A, ...), so that a steady drift favours
       // no accelerator over a pair of rounds.
-      for (Subject& subject : all) subject.hits = trace_ray_set(*subject.accelerator, rays, report.packets);
+      for (Subject& subject : all) trace_ray_set(*subject.accelerator, rays, subject.hits, report.packets);
       for (int run = 0; run < runs; ++run) {
         if (run % 2 == 0) {
           for (Subject& subject : all) time_run(subject);
@@ -291,6 +292,7 @@ AccelBenchReport run_accel_bench(const Scene& scene, const AccelBenchRequest& re
     } else {
       for (std::size_t index = 0; index < subjects; ++index) {
         Subject subject = prepare(index);
+        trace_ray_set(*subject.accelerator, rays, subject.hits, report.packets);  // untimed, as above
         for (int run = 0; run < runs; ++run) time_run(subject);
         finish(subject);
       }

@@ -175,11 +175,16 @@ RaySet make_ray_set(RaySetKind kind, const Scene& scene, const Accelerator& refe
   return set;
 }
 
-std::vector<std::unique_ptr<HitBatch>> trace_ray_set(const Accelerator& accelerator, const RaySet& rays,
-                                                     bool coherent) {
+std::vector<std::unique_ptr<HitBatch>> make_hit_batches(const RaySet& rays) {
   std::vector<std::unique_ptr<HitBatch>> hits(rays.batches.size());
+  tbb::parallel_for(std::size_t{0}, rays.batches.size(),
+                    [&](std::size_t b) { hits[b] = std::make_unique<HitBatch>(rays.batches[b]->capacity()); });
+  return hits;
+}
+
+void trace_ray_set(const Accelerator& accelerator, const RaySet& rays, std::vector<std::unique_ptr<HitBatch>>& hits,
+                   bool coherent) {
   tbb::parallel_for(std::size_t{0}, rays.batches.size(), [&](std::size_t b) {
-    hits[b] = std::make_unique<HitBatch>(rays.batches[b]->capacity());
     if (rays.any_hit()) {
       accelerator.intersect_any(*rays.batches[b], *hits[b], rays.batches[b]->all());
     } else if (coherent && rays.kind == RaySetKind::primary) {
@@ -188,6 +193,12 @@ std::vector<std::unique_ptr<HitBatch>> trace_ray_set(const Accelerator& accelera
       accelerator.intersect_closest(*rays.batches[b], *hits[b], rays.batches[b]->all());
     }
   });
+}
+
+std::vector<std::unique_ptr<HitBatch>> trace_ray_set(const Accelerator& accelerator, const RaySet& rays,
+                                                     bool coherent) {
+  std::vector<std::unique_ptr<HitBatch>> hits = make_hit_batches(rays);
+  trace_ray_set(accelerator, rays, hits, coherent);
   return hits;
 }
 
