@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <bit>
 #include <chrono>
+#include <cstddef>
 #include <limits>
 
 #include <fmt/format.h>
@@ -42,6 +43,19 @@ struct WideRay {
   glm::vec3 origin;
   glm::vec3 inverse;
   int zero_axes;  // bit a set: direction[a] == 0, that slab is tested by comparison
+  // Per axis, the byte offset in a node of the planes the ray enters by: lower_a where it
+  // moves up the axis, upper_a where down. The exit planes are the other row (offset ^ 32).
+  std::uint32_t entry_row[3];
+
+  static_assert(offsetof(WideBvhNode, upper_x) == 32 && offsetof(WideBvhNode, lower_y) == 64 &&
+                offsetof(WideBvhNode, upper_y) == 96 && offsetof(WideBvhNode, lower_z) == 128 &&
+                offsetof(WideBvhNode, upper_z) == 160, "a node's rows of planes, lower and upper by turns, 32 bytes each");
+  WideRay() = default;
+  WideRay(const glm::vec3& origin_, const glm::vec3& inverse_, const glm::vec3& direction)
+      : origin(origin_), inverse(inverse_),
+        zero_axes((direction.x == 0.0f) | (direction.y == 0.0f) << 1 | (direction.z == 0.0f) << 2) {
+    for (int axis = 0; axis < 3; ++axis) entry_row[axis] = 64u * axis + (direction[axis] < 0.0f ? 32u : 0u);
+  }
 };
 
 // The traversal stack, one column per field so that the entered children are pushed with one
@@ -60,27 +74,27 @@ struct WideStack {
 [[gnu::always_inline]] inline unsigned intersect_children(const WideBvhNode& node, const WideRay& ray, float tmin,
                                                           float tmax, float distance[kWidth]) {
 #if WAVETRACE_AVX2
-  const float* lower[3] = {node.lower_x, node.lower_y, node.lower_z};
-  const float* upper[3] = {node.upper_x, node.upper_y, node.upper_z};
   const __m256 infinity = _mm256_set1_ps(kInfinity);
   __m256 near = _mm256_set1_ps(tmin);
   __m256 far = infinity;
+  const char* planes = reinterpret_cast<const char*>(&node);
   for (int axis = 0; axis < 3; ++axis) {
-    const __m256 lo = _mm256_load_ps(lower[axis]);
-    const __m256 hi = _mm256_load_ps(upper[axis]);
+    // The planes it enters and leaves by, chosen once a ray, not sorted by a min and a max
+    // a node (as Embree's walks do).
+    const __m256 entry_plane = _mm256_load_ps(reinterpret_cast<const float*>(planes + ray.entry_row[axis]));
+    const __m256 exit_plane = _mm256_load_ps(reinterpret_cast<const float*>(planes + (ray.entry_row[axis] ^ 32u)));
     const __m256 origin = _mm256_set1_ps(ray.origin[axis]);
     __m256 entry, exit;
     if (ray.zero_axes & (1 << axis)) {
       // The ray never moves along this axis: inside the slab for all t, or never.
-      const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(lo, origin, _CMP_LE_OQ), _mm256_cmp_ps(origin, hi, _CMP_LE_OQ));
+      const __m256 inside =
+          _mm256_and_ps(_mm256_cmp_ps(entry_plane, origin, _CMP_LE_OQ), _mm256_cmp_ps(origin, exit_plane, _CMP_LE_OQ));
       entry = _mm256_blendv_ps(infinity, _mm256_set1_ps(-kInfinity), inside);
       exit = _mm256_blendv_ps(_mm256_set1_ps(-kInfinity), infinity, inside);
     } else {
       const __m256 inverse = _mm256_set1_ps(ray.inverse[axis]);
-      const __m256 t0 = _mm256_mul_ps(_mm256_sub_ps(lo, origin), inverse);
-      const __m256 t1 = _mm256_mul_ps(_mm256_sub_ps(hi, origin), inverse);
-      entry = _mm256_min_ps(t0, t1);
-      exit = _mm256_max_ps(t0, t1);
+      entry = _mm256_mul_ps(_mm256_sub_ps(entry_plane, origin), inverse);
+      exit = _mm256_mul_ps(_mm256_sub_ps(exit_plane, origin), inverse);
     }
     near = _mm256_max_ps(near, entry);
     far = _mm256_min_ps(far, exit);
@@ -299,9 +313,7 @@ class WideBvhAccelerator final : public ProbedAccelerator<WideBvhAccelerator> {
     WideStack stack;
     const WideBvhNode* nodes = nodes_.data();
     for_each_ray(rays, hits, range, [&](const SingleRay& ray, std::uint32_t i) {
-      const glm::vec3& direction = ray.direction;
-      const WideRay box_ray{ray.origin, ray.box.inverse_direction,
-                            (direction.x == 0.0f) | (direction.y == 0.0f) << 1 | (direction.z == 0.0f) << 2};
+      const WideRay box_ray(ray.origin, ray.box.inverse_direction, ray.direction);
       LeafQuery query(geometry_, {}, ray);
       const float tmin = query.tmin;
       float& tmax = query.tmax;
@@ -375,9 +387,7 @@ class WideBvhAccelerator final : public ProbedAccelerator<WideBvhAccelerator> {
       const std::uint32_t i = begin + r;
       limit[r] = i < end ? pruning_distance(query[r].tmax) : -kInfinity;
       if (i >= end || !(rays.flags[i] & ray_flags::alive)) continue;
-      const glm::vec3& direction = packet[r].direction;
-      box_ray[r] = {packet[r].origin, packet[r].box.inverse_direction,
-                    (direction.x == 0.0f) | (direction.y == 0.0f) << 1 | (direction.z == 0.0f) << 2};
+      box_ray[r] = WideRay(packet[r].origin, packet[r].box.inverse_direction, packet[r].direction);
       live |= 1u << r;
     }
     PacketEntry current{{}, 0, 0, live};  // the root
