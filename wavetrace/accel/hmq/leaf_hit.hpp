@@ -195,7 +195,7 @@ template <bool kAnyHit, KernelIsa kIsa = KernelIsa::baseline>
 // reused while its decoded copy is held. 32 entries (55 KB, one per batch call): against 8,
 // hmq:width=8 2-7% faster on camera and diffuse rays of the rooms and scans (diffuse rays of
 // room:1M missed 91% of the time with 8); 128 gained camera rays and lost diffuse ones
-// (docs/measurements.md, "A larger cache of decoded leaves").
+// (docs/measurements.md, "Entry planes once a ray, and a larger cache of decoded leaves").
 class DecodedLeafCache {
  public:
   static constexpr std::size_t kEntries = 32;
