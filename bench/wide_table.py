@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Issue 17's table as Markdown, from bench/wide_suite.sh's JSON files: per scene and ray kind,
-each layout's bytes per triangle (total and by part), Mrays/s, the ratio to default Embree and
+each layout's bytes per triangle (total and by part), Mrays/s, the ratio to default Embree (the
+median of bench accel's rounds' ratios where the JSON has them) and
 the hit agreement with robust Embree; then the leak counts.
 Usage: bench/wide_table.py OUT_DIR"""
 import glob
@@ -24,7 +25,7 @@ for name in order:
             parts = {k: v / triangles for k, v in r["parts"].items()}
             print(f"| {name} ({triangles / 1e6:.2f}M) | {rays} | {r['accel']} | {r['bytes_per_triangle']:.1f} | "
                   f"{parts['hierarchy']:.1f} | {parts['geometry']:.1f} | {parts['other']:.1f} | {r['mrays_per_s']:.2f} | "
-                  f"{r['mrays_per_s'] / first['mrays_per_s']:.2f}x | {100 * r['hit_agreement']:.4f}% | "
+                  f"{r.get('vs_first') or r['mrays_per_s'] / first['mrays_per_s']:.2f}x | {100 * r['hit_agreement']:.4f}% | "
                   f"{100 * r['prim_agreement']:.2f}% |")
 for path in sorted(glob.glob(os.path.join(out, "leak_*.json"))):
     report = json.load(open(path))
