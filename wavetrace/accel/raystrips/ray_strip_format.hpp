@@ -109,6 +109,7 @@ class StripView {
   std::size_t size() const { return layout_.size; }
   const StripLayout& layout() const { return layout_; }
   std::uint8_t widths() const { return widths_; }
+  std::uint32_t vertex_base() const { return vertex_base_; }
 
   const std::uint8_t* split_steps(std::uint32_t node) const {
     return reinterpret_cast<const std::uint8_t*>(base_ + layout_.splits) + 2 * node;

@@ -597,6 +597,12 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
       }
       probe.read(strip_data, ray_strip::kHeaderBytes);
       const StripView strip(strip_data);
+      if constexpr (!Probe::kRecords) {
+        const char* first_vertex = reinterpret_cast<const char*>(positions + strip.vertex_base());
+        _mm_prefetch(first_vertex, _MM_HINT_T0);
+        _mm_prefetch(first_vertex + 64, _MM_HINT_T0);
+        _mm_prefetch(first_vertex + 128, _MM_HINT_T0);
+      }
       ray.traverse<kAnyHit>(strip, frame, positions, near, far, options_.run_triangles, probe);
       if (kAnyHit && ray.found()) return true;
       strip_data += strip.size();

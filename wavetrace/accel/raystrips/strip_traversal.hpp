@@ -21,6 +21,11 @@
 
 #include <glm/vec3.hpp>
 
+#include "wavetrace/build_config.hpp"  // WAVETRACE_AVX2
+#if WAVETRACE_AVX2
+#include <immintrin.h>
+#endif
+
 #include "wavetrace/accel/ray_loop.hpp"
 #include "wavetrace/accel/raystrips/ray_strip_format.hpp"
 #include "wavetrace/kernels/nearest_hit.hpp"
@@ -161,12 +166,34 @@ class StripRay {
                   std::uint32_t count, Probe& probe) {
     const std::uint32_t vertices = count + 2;
     probe.read(strip.vertex_address(first), vertices * ((strip.widths() & ray_strip::kShortIndices) ? 2 : 4));
+    if constexpr (Probe::kRecords) {
+      for (std::uint32_t i = 0; i < vertices; ++i) probe.read(&positions[strip.vertex(first + i)], sizeof(glm::vec3));
+    }
     Lanes px, py, pz;
-    for (std::uint32_t i = 0; i < kRunVertices; ++i) {
+    bool gathered = false;
+#if WAVETRACE_AVX2
+    // Gathered, not assembled lane by lane: eight scalar stores read back as one vector stall
+    // store forwarding, which cost more than the gathers. Lanes past the run repeat its last
+    // vertex, so no load leaves the strip's indices (a 16-bit index is read as the 32-bit word
+    // at its address, whose upper half, masked off, lies in the strip's indices or records).
+    // Offsets are 3 * stored index from the strip's first vertex, so they fit the gathers'
+    // signed 32 bits below 2^29; the rare strip spread wider takes the scalar loads.
+    const __m256i lane = _mm256_min_epu32(_mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7), _mm256_set1_epi32(int(vertices - 1)));
+    const auto* index_base = static_cast<const int*>(strip.vertex_address(first));
+    const bool short_indices = (strip.widths() & ray_strip::kShortIndices) != 0;
+    const __m256i stored = short_indices ? _mm256_and_si256(_mm256_i32gather_epi32(index_base, lane, 2), _mm256_set1_epi32(0xffff))
+                                         : _mm256_i32gather_epi32(index_base, lane, 4);
+    if (short_indices || _mm256_testz_si256(stored, _mm256_set1_epi32(~((1 << 29) - 1)))) {
+      const __m256i offset = _mm256_add_epi32(stored, _mm256_add_epi32(stored, stored));  // 3 floats a vertex
+      const float* coordinates = &positions[strip.vertex_base()].x;
+      px = Lanes(_mm256_i32gather_ps(coordinates + sheared_.kx, offset, 4)) - sheared_.origin[sheared_.kx];
+      py = Lanes(_mm256_i32gather_ps(coordinates + sheared_.ky, offset, 4)) - sheared_.origin[sheared_.ky];
+      pz = Lanes(_mm256_i32gather_ps(coordinates + sheared_.kz, offset, 4)) - sheared_.origin[sheared_.kz];
+      gathered = true;
+    }
+#endif
+    for (std::uint32_t i = 0; !gathered && i < kRunVertices; ++i) {
       const glm::vec3& p = positions[strip.vertex(first + std::min(i, vertices - 1))];
-      if constexpr (Probe::kRecords) {
-        if (i < vertices) probe.read(&p, sizeof p);
-      }
       px[i] = p[sheared_.kx] - sheared_.origin[sheared_.kx];
       py[i] = p[sheared_.ky] - sheared_.origin[sheared_.ky];
       pz[i] = p[sheared_.kz] - sheared_.origin[sheared_.kz];
