@@ -12,6 +12,7 @@
 #include "wavetrace/accel/raystrips/ray_strip_format.hpp"
 #include "wavetrace/accel/raystrips/raystrips_accelerator.hpp"
 #include "wavetrace/accel/raystrips/strip_encode.hpp"
+#include "wavetrace/accel/raystrips/strip_traversal.hpp"
 #include "wavetrace/accel/raystrips/stripify.hpp"
 #include "wavetrace/accel/registry.hpp"
 #include "wavetrace/bench/accel_bench.hpp"
@@ -32,23 +33,99 @@ namespace {
 using namespace ray_strip;
 
 TEST(RayStripFormat, SizeOfAStripOfNTrianglesFollowsTheFormula) {
-  // 12-byte header, 3 bytes per node (ceil(n/2) - 1 of them), indices and records, each
-  // aligned to its width, the whole to 4 bytes.
+  // 12-byte header, 3 bytes per node (ceil(n/2) - 1 of them above 6 triangles, none at or
+  // below), indices and records, each aligned to its width, the whole to 4 bytes.
   EXPECT_EQ(strip_layout(1, kShortIndices | kShortRecords).size, 12u + 3 * 2 + 1 * 2 + 0);  // 20
   EXPECT_EQ(strip_layout(2, kShortIndices | kShortRecords).size, 24u);  // 12 + 8 + 4
-  EXPECT_EQ(strip_layout(5, kShortIndices | kShortRecords).size, 44u);  // 12 + 6 = 18, +14 = 32, +10 = 42 -> 44
-  EXPECT_EQ(strip_layout(5, 0).size, 68u);                              // 18 -> 20, +28 = 48, +20 = 68
+  EXPECT_EQ(strip_layout(5, kShortIndices | kShortRecords).size, 36u);  // 12, +14 = 26, +10 = 36
+  EXPECT_EQ(strip_layout(5, kByteIndices | kShortRecords).size, 32u);   // 12, +7 = 19 -> 20, +10 = 30 -> 32
+  EXPECT_EQ(strip_layout(5, 0).size, 60u);                              // 12, +28 = 40, +20 = 60
+  EXPECT_EQ(strip_layout(7, kByteIndices | kShortRecords).size, 44u);   // 12 + 9 = 21, +9 = 30, +14 = 44
   EXPECT_EQ(strip_layout(100, kShortIndices).size, 764u);   // 12 + 147 = 159 -> 160, +204 = 364, +400 = 764
   for (std::uint32_t n = 1; n <= 2000; ++n) {
-    for (std::uint8_t widths = 0; widths < 4; ++widths) {
-      const std::size_t w = (widths & kShortIndices) ? 2 : 4, v = (widths & kShortRecords) ? 2 : 4;
-      const std::size_t nodes = (n + 1) / 2 - 1;
+    for (const std::uint8_t widths : {0, 1, 2, 3, 4, 6}) {
+      const std::size_t w = (widths & kByteIndices) ? 1 : (widths & kShortIndices) ? 2 : 4;
+      const std::size_t v = (widths & kShortRecords) ? 2 : 4;
+      const std::size_t nodes = n > 6 ? (n + 1) / 2 - 1 : 0;
       std::size_t size = 12 + 3 * nodes;
       size = (size + w - 1) / w * w + w * (n + 2);
       size = (size + v - 1) / v * v + v * n;
       size = (size + 3) / 4 * 4;
       ASSERT_EQ(strip_layout(n, widths).size, size) << n << " triangles, widths " << int(widths);
       ASSERT_LE(strip_layout(n, widths).size, 12 + 1.5 * n + w * (n + 2) + v * n + 6);
+      ASSERT_EQ(node_count(n), nodes);
+    }
+  }
+}
+
+TEST(RayStripTraversal, EveryIndexWidthFindsTheHitsOfTheWatertightTest) {
+  // One strip of 20 triangles (so it has a tree) over a bent 2 x 11 quad row, its vertices
+  // spaced 1, 300 and 5000 ids apart so that it is stored with 8-, 16- and 32-bit indices: the
+  // gathered runs find, for every ray, the triangle and t the watertight test finds alone,
+  // bit for bit the same at every width.
+  std::vector<std::pair<std::uint32_t, float>> first_answers;
+  for (const std::uint32_t spacing : {1u, 300u, 5000u}) {
+    TriangleMesh mesh;
+    mesh.positions.assign(22 * spacing, glm::vec3(0.0f));
+    for (int column = 0; column < 11; ++column) {
+      for (int row = 0; row < 2; ++row) {
+        mesh.positions[(2 * column + row) * spacing] = {float(column), float(row), 0.3f * std::sin(float(column))};
+      }
+    }
+    for (std::uint32_t k = 0; k < 20; ++k) mesh.triangles.emplace_back(k * spacing, (k + 1) * spacing, (k + 2) * spacing);
+    std::vector<std::uint32_t> all(20);
+    for (std::uint32_t t = 0; t < 20; ++t) all[t] = t;
+    const std::vector<TriangleStrip> strips = stripify(mesh, all, StripifierKind::dual_path, kMaxTriangles);
+    ASSERT_EQ(strips.size(), 1u);
+    std::vector<std::uint32_t> identity(mesh.vertex_count());
+    for (std::uint32_t v = 0; v < identity.size(); ++v) identity[v] = v;
+    const StripEncoding encoding = choose_encoding(strips[0], identity);
+    const std::uint8_t expected_width = spacing == 1 ? kByteIndices : spacing == 300 ? kShortIndices : 0;
+    ASSERT_EQ(encoding.widths & (kByteIndices | kShortIndices), expected_width) << spacing;
+    const auto n = static_cast<std::uint32_t>(strips[0].triangles.size());
+    ASSERT_TRUE(has_tree(n));
+    std::vector<std::byte> buffer(encoding.size(n));
+    Bounds3 frame;
+    for (const std::uint32_t vertex : strips[0].vertices) frame.extend(mesh.positions[vertex]);
+    encode_strip(strips[0], encoding, identity, mesh.positions, mesh, frame, buffer.data());
+    const StripView view(buffer.data());
+
+    std::vector<std::pair<std::uint32_t, float>> answers;
+    std::uint32_t hits = 0;
+    for (int i = 0; i < 4000; ++i) {
+      // Rays from above and below at many slants, through the row and past its ends.
+      const float u = -0.5f + 11.0f * float(i % 400) / 400.0f, v = -0.2f + 1.4f * float(i / 400) / 10.0f;
+      const glm::vec3 origin(u + 0.7f * std::sin(float(i)), v, i % 2 ? 3.0f : -3.0f);
+      const glm::vec3 direction = glm::vec3(u, v, 0.1f * std::cos(float(i))) - origin;
+      const SingleRay single{origin, direction, 0.0f, 100.0f, make_box_ray(origin, direction),
+                             make_watertight_ray(origin, direction)};
+      TriangleHit nearest{std::numeric_limits<float>::infinity(), 0, 0};
+      std::uint32_t expected = kNoTriangle;
+      for (std::uint32_t t = 0; t < 20; ++t) {
+        TriangleHit hit;
+        const glm::uvec3& c = mesh.triangles[t];
+        if (intersect_watertight(single.sheared, mesh.positions[c.x], mesh.positions[c.y], mesh.positions[c.z], 0.0f,
+                                 nearest.t, hit) && hit.t < nearest.t) {
+          nearest = hit;
+          expected = t;
+        }
+      }
+      StripRay ray(single);
+      NullProbe probe;
+      ray.traverse<false>(view, frame, mesh.positions.data(), 0.0f, 100.0f, 2, probe);
+      const std::uint32_t found = ray.found() ? view.triangle(ray.hit.triangle) : kNoTriangle;
+      ASSERT_EQ(found, expected) << "ray " << i << ", spacing " << spacing;
+      if (found != kNoTriangle) {
+        ++hits;
+        EXPECT_NEAR(ray.hit.t, nearest.t, 1e-5f * nearest.t) << "ray " << i;
+      }
+      answers.emplace_back(found, ray.found() ? ray.hit.t : -1.0f);
+    }
+    EXPECT_GT(hits, 1000u);
+    if (first_answers.empty()) {
+      first_answers = answers;
+    } else {
+      EXPECT_EQ(answers, first_answers) << "spacing " << spacing;
     }
   }
 }

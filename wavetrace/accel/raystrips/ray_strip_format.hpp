@@ -5,15 +5,19 @@
 // A Ray-Strip of n triangles (1 <= n <= 65535) lists n + 2 vertices s[0 .. n+1]; triangle k
 // has the corners (s[k], s[k+1], s[k+2]). Turns of the strip repeat a triangle (a swap
 // vertex), so n counts those repeats too; a repeated triangle answers exactly as its first
-// copy. Little-endian; a strip starts 4-byte aligned; N = ceil(n / 2) - 1 kd-tree nodes. The
+// copy. Little-endian; a strip starts 4-byte aligned; N = ceil(n / 2) - 1 kd-tree nodes when
+// n > 6, else N = 0: one 8-lane shared-edge test covers 6 triangles whole (strip_traversal.hpp),
+// so a tree over so few would cost bytes and a descent and spare no test. The
 // strip's frame F is the box of the top leaf that holds it (its float box in the binary top,
 // its decoded box in the 8-wide one), which the owner knows when it encodes and traverses.
 //
 //   offset            size        field
 //        0               2        n             uint16  triangles (repeats included)
-//        2               1        widths        bit 0: vertex indices are uint16 (else uint32)
+//        2               1        widths        bit 0: vertex indices are uint16
 //                                               bit 1: triangle records are uint16 (else uint32)
-//                                               bits 2-7: zero
+//                                               bit 2: vertex indices are uint8 (bit 0 clear)
+//                                               neither bit 0 nor 2: vertex indices are uint32
+//                                               bits 3-7: zero
 //        3               1        zero
 //        4               4        vertex_base   uint32  added to every stored vertex index
 //        8               4        triangle_base uint32  added to every record's triangle delta
@@ -24,13 +28,13 @@
 //                                               (rounded outward by the encoder through this arithmetic)
 //   12 + 2N              N        node_bits     per node: bits 0-1 split axis (0 x, 1 y, 2 z),
 //                                               bit 2 reverse, bits 3-7 zero
-//   I = align(12 + 3N, W)         indices       (n + 2) x W bytes, W = 2 or 4 (widths bit 0):
+//   I = align(12 + 3N, W)         indices       (n + 2) x W bytes, W = 1, 2 or 4 (widths bits 0, 2):
 //                                               s[i] = vertex_base + stored[i]
 //   R = align(I + W(n + 2), V)    records       n x V bytes, V = 2 or 4 (widths bit 1):
 //                                               record = (triangle - triangle_base) << 3 | corners
 //   size = align(R + V n, 4)
 //
-// The kd-tree. Leaves are pairs of triangles, leaf j = triangles {2j, 2j + 1} (the last leaf
+// The kd-tree (only when n > 6). Leaves are pairs of triangles, leaf j = triangles {2j, 2j + 1} (the last leaf
 // of an odd strip holds one); they are implicit. A node spans the leaves [a, a + c), c >= 2,
 // and splits them into its first ceil(c / 2) leaves (the strip-first child) and the rest
 // (the strip-second child), so the tree is balanced and needs no child pointers. Nodes are
@@ -60,18 +64,28 @@ inline constexpr std::size_t kHeaderBytes = 12;
 inline constexpr std::uint32_t kMaxTriangles = 65535;
 inline constexpr std::uint8_t kShortIndices = 1u << 0;
 inline constexpr std::uint8_t kShortRecords = 1u << 1;
+inline constexpr std::uint8_t kByteIndices = 1u << 2;
+inline constexpr std::uint8_t kKnownWidths = kShortIndices | kShortRecords | kByteIndices;
+// Strips of at most this many triangles carry no kd-tree (the comment above).
+inline constexpr std::uint32_t kUntreedTriangles = 6;
 inline constexpr std::uint8_t kAxisMask = 3u;
 inline constexpr std::uint8_t kReverse = 1u << 2;
 inline constexpr std::uint32_t kCornerBits = 3;
 inline constexpr std::uint32_t kShortDeltaLimit = 1u << (16 - kCornerBits);
 inline constexpr std::uint32_t kLongDeltaLimit = 1u << (32 - kCornerBits);
 
+// `alignment` a power of two: a mask, not a division, since every strip a ray meets works its
+// layout out again.
 constexpr std::size_t align_up(std::size_t offset, std::size_t alignment) {
-  return (offset + alignment - 1) / alignment * alignment;
+  return (offset + alignment - 1) & ~(alignment - 1);
 }
 
 constexpr std::uint32_t leaf_count(std::uint32_t triangles) { return (triangles + 1) / 2; }
-constexpr std::uint32_t node_count(std::uint32_t triangles) { return leaf_count(triangles) - 1; }
+constexpr bool has_tree(std::uint32_t triangles) { return triangles > kUntreedTriangles; }
+constexpr std::uint32_t node_count(std::uint32_t triangles) { return has_tree(triangles) ? leaf_count(triangles) - 1 : 0; }
+constexpr std::size_t index_bytes(std::uint8_t widths) {
+  return (widths & kByteIndices) ? 1 : (widths & kShortIndices) ? 2 : 4;
+}
 
 // Where each part of a strip of n triangles starts, and its size (the formula above).
 struct StripLayout {
@@ -80,13 +94,13 @@ struct StripLayout {
 
 constexpr StripLayout strip_layout(std::uint32_t triangles, std::uint8_t widths) {
   const std::size_t nodes = node_count(triangles);
-  const std::size_t index_bytes = (widths & kShortIndices) ? 2 : 4;
+  const std::size_t index_width = index_bytes(widths);
   const std::size_t record_bytes = (widths & kShortRecords) ? 2 : 4;
   StripLayout layout{};
   layout.splits = kHeaderBytes;
   layout.node_bits = kHeaderBytes + 2 * nodes;
-  layout.indices = align_up(layout.node_bits + nodes, index_bytes);
-  layout.records = align_up(layout.indices + index_bytes * (triangles + 2), record_bytes);
+  layout.indices = align_up(layout.node_bits + nodes, index_width);
+  layout.records = align_up(layout.indices + index_width * (triangles + 2), record_bytes);
   layout.size = align_up(layout.records + record_bytes * triangles, 4);
   return layout;
 }
@@ -118,12 +132,12 @@ class StripView {
 
   std::uint32_t vertex(std::uint32_t i) const {
     const std::byte* indices = base_ + layout_.indices;
+    if (widths_ & kByteIndices) return vertex_base_ + reinterpret_cast<const std::uint8_t*>(indices)[i];
     if (widths_ & kShortIndices) return vertex_base_ + reinterpret_cast<const std::uint16_t*>(indices)[i];
     return vertex_base_ + reinterpret_cast<const std::uint32_t*>(indices)[i];
   }
-  const void* vertex_address(std::uint32_t i) const {
-    return base_ + layout_.indices + i * ((widths_ & kShortIndices) ? 2 : 4);
-  }
+  std::size_t index_width() const { return index_bytes(widths_); }
+  const void* vertex_address(std::uint32_t i) const { return base_ + layout_.indices + i * index_width(); }
 
   std::uint32_t record(std::uint32_t k) const {
     const std::byte* records = base_ + layout_.records;

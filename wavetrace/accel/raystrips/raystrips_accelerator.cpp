@@ -105,7 +105,7 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> cut_submeshes(const BuildTr
   return submeshes;
 }
 
-// What a raystrips world saves besides its arrays, `PREFIX` + "raystrips.state" (176 bytes):
+// What a raystrips world saves besides its arrays, `PREFIX` + "raystrips.state" (184 bytes):
 //   offset  size  field
 //        0     4  run_triangles, uint32 (traversal's span size)
 //        4     4  packet_min_active, uint32
@@ -116,8 +116,8 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> cut_submeshes(const BuildTr
 //       24     4  width of the top, uint32 (2 or 8)
 //       28     4  zero
 //       32    24  the 8-wide top's root frame: float lower x, y, z, upper x, y, z (width 2: unused)
-//       56   120  the build's statistics, 15 fields of 8 bytes in RayStripStats' order: strips
-//                 (uint64), 10 doubles (mean triangles .. encode seconds), 4 byte counts (uint64)
+//       56   128  the build's statistics, 16 fields of 8 bytes in RayStripStats' order: strips
+//                 (uint64), 11 doubles (mean triangles .. encode seconds), 4 byte counts (uint64)
 // and the triangle count and build report in "common" (section_archive.hpp). Arrays:
 // "raystrips.nodes" (width 2: BvhNode, bvh_node.hpp; a leaf's first is a word offset into the
 // strips), "raystrips.wide_nodes" (width 8: QuantizedWideNode, a leaf child's reference is its
@@ -127,7 +127,8 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> cut_submeshes(const BuildTr
 struct RayStripsSavedOptions {
   std::uint32_t run_triangles, packet_min_active, packets, stripifier, submesh_triangles, strips_per_leaf, width, zero;
 };
-constexpr std::uint32_t kRayStripsSavedVersion = 3;  // 3: 8-bit split planes; 2: the width 8 top
+// 4: 8-bit indices, no tree under 7 triangles; 3: 8-bit split planes; 2: the width 8 top
+constexpr std::uint32_t kRayStripsSavedVersion = 4;
 
 class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator> {
   friend class ProbedAccelerator<RayStripsAccelerator>;
@@ -146,7 +147,7 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
       Bounds3 root;
       RayStripStats stats;
     };
-    static_assert(sizeof(State) == 176);
+    static_assert(sizeof(State) == 184);
     State state{{self.options_.run_triangles, self.options_.packet_min_active, self.options_.packets ? 1u : 0u,
                  static_cast<std::uint32_t>(self.options_.stripifier), self.options_.submesh_triangles,
                  self.options_.strips_per_leaf, self.options_.width, 0},
@@ -418,10 +419,12 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
     const RayStripStats& s = stats_;
     return fmt::format(
         "{} strips ({}), {:.1f} triangles per strip ({:.1f} with turn repeats), {:.2f} strips per top leaf, "
-        "{:.2f}% of triangles in strips of one, {:.1f}% turn repeats, {:.1f}% short indices, {:.1f}% short records; "
+        "{:.2f}% of triangles in strips of one, {:.1f}% turn repeats, {:.1f}% 8-bit and {:.1f}% 16-bit indices, "
+        "{:.1f}% short records; "
         "build: SAH cut {:.3f} s, stripify {:.3f} s, top BVH + encode {:.3f} s",
         s.strips, to_string(options_.stripifier), s.mean_triangles, s.mean_strip_triangles, s.strips_per_leaf,
-        100.0 * s.single_share, 100.0 * s.repeat_share, 100.0 * s.short_index_share, 100.0 * s.short_record_share,
+        100.0 * s.single_share, 100.0 * s.repeat_share, 100.0 * s.byte_index_share, 100.0 * s.short_index_share,
+        100.0 * s.short_record_share,
         s.sah_seconds, s.stripify_seconds, s.encode_seconds);
   }
 
@@ -433,7 +436,7 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
   struct RayStripStats {
     std::size_t strips = 0;
     double mean_triangles = 0, mean_strip_triangles = 0, strips_per_leaf = 0;
-    double single_share = 0, repeat_share = 0, short_index_share = 0, short_record_share = 0;
+    double single_share = 0, repeat_share = 0, byte_index_share = 0, short_index_share = 0, short_record_share = 0;
     double sah_seconds = 0, stripify_seconds = 0, encode_seconds = 0;
     std::size_t header_and_tree_bytes = 0, index_bytes = 0, record_bytes = 0, strip_vectors_bytes = 0;
   };
@@ -442,7 +445,7 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
                      const std::vector<std::uint32_t>& strip_order) {
     RayStripStats& s = stats_;
     s.strips = strips.size();
-    std::size_t distinct = 0, listed = 0, in_singles = 0, short_indices = 0, short_records = 0, leaves = 0;
+    std::size_t distinct = 0, listed = 0, in_singles = 0, byte_indices = 0, short_indices = 0, short_records = 0, leaves = 0;
     for (std::size_t i = 0; i < strip_order.size(); ++i) {
       const TriangleStrip& strip = strips[strip_order[i]];
       const auto n = static_cast<std::uint32_t>(strip.triangles.size());
@@ -454,6 +457,7 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
       distinct += real;
       listed += n;
       if (real == 1) ++in_singles;
+      byte_indices += (encodings[i].widths & ray_strip::kByteIndices) != 0;
       short_indices += (encodings[i].widths & ray_strip::kShortIndices) != 0;
       short_records += (encodings[i].widths & ray_strip::kShortRecords) != 0;
       const ray_strip::StripLayout layout = ray_strip::strip_layout(n, encodings[i].widths);
@@ -469,6 +473,7 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
     s.strips_per_leaf = double(strips.size()) / double(leaves);
     s.single_share = double(in_singles) / double(distinct);
     s.repeat_share = double(listed - distinct) / double(listed);
+    s.byte_index_share = double(byte_indices) / double(strips.size());
     s.short_index_share = double(short_indices) / double(strips.size());
     s.short_record_share = double(short_records) / double(strips.size());
   }

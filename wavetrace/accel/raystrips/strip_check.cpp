@@ -12,6 +12,9 @@ std::optional<std::string> strip_problem(std::span<const std::byte> bytes, std::
   if (at % 4 != 0 || at + kHeaderBytes > bytes.size()) return fmt::format("a strip at byte {} lies past the strips", at);
   const StripView strip(bytes.data() + at);
   if (strip.triangles() == 0) return fmt::format("the strip at byte {} has no triangles", at);
+  if ((strip.widths() & ~kKnownWidths) != 0 || (strip.widths() & kShortIndices && strip.widths() & kByteIndices)) {
+    return fmt::format("the strip at byte {} has index or record widths this version does not know", at);
+  }
   if (at + strip.size() > bytes.size()) return fmt::format("the strip at byte {} runs past the strips", at);
   for (std::uint32_t node = 0; node < node_count(strip.triangles()); ++node) {
     if ((strip.node_bits(node) & kAxisMask) > 2) return fmt::format("the strip at byte {} splits on no axis", at);

@@ -90,7 +90,10 @@ StripEncoding choose_encoding(const TriangleStrip& strip, std::span<const std::u
     low = std::min(low, vertex_id[vertex]);
     high = std::max(high, vertex_id[vertex]);
   }
-  if (high - low <= 0xffffu) {
+  if (high - low <= 0xffu) {
+    encoding.widths |= kByteIndices;
+    encoding.vertex_base = low;
+  } else if (high - low <= 0xffffu) {
     encoding.widths |= kShortIndices;
     encoding.vertex_base = low;
   }
@@ -123,14 +126,16 @@ void encode_strip(const TriangleStrip& strip, const StripEncoding& encoding, std
   std::memcpy(out + 4, &encoding.vertex_base, 4);
   std::memcpy(out + 8, &encoding.triangle_base, 4);
 
-  if (leaf_count(triangles) >= 2) {
+  if (has_tree(triangles)) {
     TreeWriter writer{strip, vertex_id, positions, frame, reinterpret_cast<std::uint8_t*>(out + layout.splits),
                       out + layout.node_bits, triangles};
     writer.write(0, 0, leaf_count(triangles));
   }
   for (std::uint32_t i = 0; i < triangles + 2; ++i) {
     const std::uint32_t stored = vertex_id[strip.vertices[i]] - encoding.vertex_base;
-    if (encoding.widths & kShortIndices) {
+    if (encoding.widths & kByteIndices) {
+      reinterpret_cast<std::uint8_t*>(out + layout.indices)[i] = static_cast<std::uint8_t>(stored);
+    } else if (encoding.widths & kShortIndices) {
       reinterpret_cast<std::uint16_t*>(out + layout.indices)[i] = static_cast<std::uint16_t>(stored);
     } else {
       reinterpret_cast<std::uint32_t*>(out + layout.indices)[i] = stored;

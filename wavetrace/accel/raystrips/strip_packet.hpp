@@ -155,8 +155,7 @@ struct PacketTraversal {
                                       current.dmax[r], run_triangles, probe);
           lanes.tmax[r] = pruning_distance(ray.tmax);
         }
-      } else if (current.leaves >= 2 &&
-                 std::min(2 * (current.first + current.leaves), triangles) - 2 * current.first > run_triangles) {
+      } else if (descends(triangles, current.first, current.leaves, run_triangles)) {
         const std::uint8_t bits = strip.node_bits(current.node);
         const int axis = bits & kAxisMask;
         const SplitPlanes planes = decode_split(strip.split_steps(current.node), frame, axis);

@@ -43,6 +43,13 @@ inline float widen_entry(float t) { return t * (t > 0.0f ? 1.0f - kPlaneDistance
 
 inline constexpr std::uint32_t kRunVertices = 8;
 inline constexpr std::uint32_t kRunTriangles = kRunVertices - 2;
+static_assert(kRunTriangles == ray_strip::kUntreedTriangles, "a strip without a tree is one run's test");
+
+// Whether a walk goes below the kd-node over leaves [first, first + leaves) of a strip of
+// `triangles`: while its span holds more triangles than one run tests, where there is a tree.
+inline bool descends(std::uint32_t triangles, std::uint32_t first, std::uint32_t leaves, std::uint32_t run_triangles) {
+  return ray_strip::has_tree(triangles) && leaves >= 2 && std::min(2 * (first + leaves), triangles) - 2 * first > run_triangles;
+}
 
 // The nearest hit so far of one ray, in strip terms until it is written out.
 struct StripHit {
@@ -69,6 +76,7 @@ class StripRay {
   template <bool kAnyHit, typename Probe>
   void traverse(const ray_strip::StripView& strip, const Bounds3& frame, const glm::vec3* positions, float dmin,
                 float dmax, std::uint32_t run_triangles, Probe& probe) {
+    if (!ray_strip::has_tree(strip.triangles())) return test_run<kAnyHit>(strip, positions, 0, strip.triangles(), probe);
     traverse_subtree<kAnyHit>(strip, frame, positions, 0, 0, ray_strip::leaf_count(strip.triangles()), dmin, dmax,
                               run_triangles, probe);
   }
@@ -90,7 +98,7 @@ class StripRay {
     dmax = std::min(dmax, pruning_distance(tmax));
     while (true) {
       // Descend while the span holds more triangles than one run tests.
-      while (leaves >= 2 && std::min(2 * (first + leaves), triangles) - 2 * first > run_triangles) {
+      while (descends(triangles, first, leaves, run_triangles)) {
         probe.read(strip.split_steps(node), 2);
         probe.read(strip.data() + strip.layout().node_bits + node, 1);
         const std::uint8_t bits = strip.node_bits(node);
@@ -165,7 +173,7 @@ class StripRay {
   void test_chunk(const ray_strip::StripView& strip, const glm::vec3* positions, std::uint32_t first,
                   std::uint32_t count, Probe& probe) {
     const std::uint32_t vertices = count + 2;
-    probe.read(strip.vertex_address(first), vertices * ((strip.widths() & ray_strip::kShortIndices) ? 2 : 4));
+    probe.read(strip.vertex_address(first), vertices * strip.index_width());
     if constexpr (Probe::kRecords) {
       for (std::uint32_t i = 0; i < vertices; ++i) probe.read(&positions[strip.vertex(first + i)], sizeof(glm::vec3));
     }
@@ -174,16 +182,18 @@ class StripRay {
 #if WAVETRACE_AVX2
     // Gathered, not assembled lane by lane: eight scalar stores read back as one vector stall
     // store forwarding, which cost more than the gathers. Lanes past the run repeat its last
-    // vertex, so no load leaves the strip's indices (a 16-bit index is read as the 32-bit word
-    // at its address, whose upper half, masked off, lies in the strip's indices or records).
+    // vertex, so no load leaves the strip: a narrow index is read as the 32-bit word that ends
+    // with it, whose lower bytes, shifted out, lie in the strip's header, tree or indices.
     // Offsets are 3 * stored index from the strip's first vertex, so they fit the gathers'
     // signed 32 bits below 2^29; the rare strip spread wider takes the scalar loads.
     const __m256i lane = _mm256_min_epu32(_mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7), _mm256_set1_epi32(int(vertices - 1)));
-    const auto* index_base = static_cast<const int*>(strip.vertex_address(first));
-    const bool short_indices = (strip.widths() & ray_strip::kShortIndices) != 0;
-    const __m256i stored = short_indices ? _mm256_and_si256(_mm256_i32gather_epi32(index_base, lane, 2), _mm256_set1_epi32(0xffff))
-                                         : _mm256_i32gather_epi32(index_base, lane, 4);
-    if (short_indices || _mm256_testz_si256(stored, _mm256_set1_epi32(~((1 << 29) - 1)))) {
+    const auto* index_base = static_cast<const char*>(strip.vertex_address(first));
+    const std::size_t width = strip.index_width();
+    const __m256i stored =
+        width == 1   ? _mm256_srli_epi32(_mm256_i32gather_epi32(reinterpret_cast<const int*>(index_base - 3), lane, 1), 24)
+        : width == 2 ? _mm256_srli_epi32(_mm256_i32gather_epi32(reinterpret_cast<const int*>(index_base - 2), lane, 2), 16)
+                     : _mm256_i32gather_epi32(reinterpret_cast<const int*>(index_base), lane, 4);
+    if (width < 4 || _mm256_testz_si256(stored, _mm256_set1_epi32(~((1 << 29) - 1)))) {
       const __m256i offset = _mm256_add_epi32(stored, _mm256_add_epi32(stored, stored));  // 3 floats a vertex
       const float* coordinates = &positions[strip.vertex_base()].x;
       px = Lanes(_mm256_i32gather_ps(coordinates + sheared_.kx, offset, 4)) - sheared_.origin[sheared_.kx];
