@@ -48,9 +48,10 @@ void check_options(const RayStripsOptions& options) {
     if (!ok) throw std::invalid_argument("raystrips: " + message);
   };
   require(options.submesh_triangles >= 2 && options.submesh_triangles <= ray_strip::kMaxTriangles,
-          fmt::format("submesh_triangles = {}: must be 2 .. {}", options.submesh_triangles, ray_strip::kMaxTriangles));
+          fmt::format("submesh_triangles = {}: must be 0 (by width) or 2 .. {}", options.submesh_triangles,
+                      ray_strip::kMaxTriangles));
   require(options.strips_per_leaf >= 1 && options.strips_per_leaf <= 16,
-          fmt::format("strips_per_leaf = {}: must be 1 .. 16", options.strips_per_leaf));
+          fmt::format("strips_per_leaf = {}: must be 0 (by width) or 1 .. 16", options.strips_per_leaf));
   require(options.run_triangles >= 2 && options.run_triangles <= 64,
           fmt::format("run_triangles = {}: must be 2 .. 64", options.run_triangles));
   require(options.packet_min_active >= 1 && options.packet_min_active <= kPacketRays,
@@ -228,7 +229,8 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
     archive(*this, saver);
   }
 
-  RayStripsAccelerator(const TriangleMesh& mesh, const RayStripsOptions& options) : options_(options) {
+  RayStripsAccelerator(const TriangleMesh& mesh, const RayStripsOptions& requested) : options_(requested.resolved()) {
+    const RayStripsOptions& options = options_;
     check_options(options);
     if (mesh.triangle_count() == 0) throw std::invalid_argument("raystrips: the mesh has no triangles");
     triangles_ = mesh.triangle_count();

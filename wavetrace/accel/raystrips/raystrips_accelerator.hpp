@@ -16,15 +16,16 @@ namespace wavetrace {
 
 struct RayStripsOptions {
   // Sub-mesh threshold (§4.2): the SAH tree is cut at its highest nodes holding at most
-  // this many triangles; each such sub-mesh is stripified on its own. 2 .. 65535.
-  std::uint32_t submesh_triangles = 256;
+  // this many triangles; each such sub-mesh is stripified on its own. 2 .. 65535, or 0: by
+  // the top's width (kSubmeshTriangles below).
+  std::uint32_t submesh_triangles = 0;
   // OpenMesh's by default: on builtin:sphere:1M its strips are shorter (14.6 triangles
   // against 33.4) but hardly ever turn (2% repeats against 31%), so the kd-tree boxes are
   // tighter and tracing is 1.3x faster at about the same bytes per triangle.
   StripifierKind stripifier = StripifierKind::longest_of_three;
   // Most strips in one leaf of the top BVH; 1 is the paper's partition step (a leaf per
-  // strip). The SAH decides below this bound. 1 .. 16.
-  std::uint32_t strips_per_leaf = 1;
+  // strip). The SAH decides below this bound. 1 .. 16, or 0: by the top's width.
+  std::uint32_t strips_per_leaf = 0;
   // The strip's kd-tree is descended until a span holds at most this many triangles, which
   // are then tested together by shared edges (the paper: 2, a leaf; 6 fills the 8-lane
   // edge test and measured 1.4x faster than 2). 2 .. 64.
@@ -41,6 +42,22 @@ struct RayStripsOptions {
   bool packets = true;
   std::uint32_t packet_min_active = 2;  // 1 .. 4
   bool operator==(const RayStripsOptions&) const = default;
+
+  // What 0 means for submesh_triangles and strips_per_leaf. The binary top keeps the paper's
+  // long strips, one a leaf. Under the 8-wide top short strips trace faster (their leaves'
+  // boxes are tighter) but each costs a 12-byte header: on room:1M and the scans Loop-subdivided
+  // twice, 24 triangles and up to 4 strips a leaf was the fastest within 16 bytes a triangle
+  // (0.37-0.50x Embree on diffuse rays at 15.2-15.8 B/tri, against 0.27-0.39x at 13.6-14.2
+  // with 256 and 1; docs/measurements.md, "Ray-Strips under the 8-wide top").
+  static constexpr std::uint32_t kSubmeshTriangles[2] = {256, 24};  // width 2, width 8
+  static constexpr std::uint32_t kStripsPerLeaf[2] = {1, 4};
+  RayStripsOptions resolved() const {
+    RayStripsOptions options = *this;
+    const int wide = width == 8 ? 1 : 0;
+    if (options.submesh_triangles == 0) options.submesh_triangles = kSubmeshTriangles[wide];
+    if (options.strips_per_leaf == 0) options.strips_per_leaf = kStripsPerLeaf[wide];
+    return options;
+  }
 };
 
 // Throws std::invalid_argument for options outside their ranges. `mesh` must outlive
