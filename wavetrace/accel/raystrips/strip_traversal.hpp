@@ -61,7 +61,9 @@ struct StripHit {
 
 class StripRay {
  public:
-  explicit StripRay(const SingleRay& ray) : tmin(ray.tmin), tmax(ray.tmax), box(ray.box), sheared_(ray.sheared) {}
+  explicit StripRay(const SingleRay& ray)
+      : tmin(ray.tmin), tmax(ray.tmax), box(ray.box), sheared_(ray.sheared),
+        origin_{ray.sheared.origin[ray.sheared.kx], ray.sheared.origin[ray.sheared.ky], ray.sheared.origin[ray.sheared.kz]} {}
 
   float tmin;
   float tmax;  // shrinks to the nearest hit found
@@ -178,36 +180,44 @@ class StripRay {
       for (std::uint32_t i = 0; i < vertices; ++i) probe.read(&positions[strip.vertex(first + i)], sizeof(glm::vec3));
     }
     Lanes px, py, pz;
-    bool gathered = false;
+    // Each vertex of the run is read whole (x, y, z by a masked load, which never reads past
+    // the array) and the eight are transposed into lanes: on Zen 5 gathers of the indices and
+    // then of each axis stalled this test for a third of its time even with the strip in L2.
+    // Lanes past the run repeat its last vertex.
+    std::uint32_t stored[kRunVertices];
+    const std::uint32_t last = vertices - 1;
+    const void* indices = strip.vertex_address(first);
+    switch (strip.index_width()) {
+      case 1:
+        for (std::uint32_t i = 0; i < kRunVertices; ++i) stored[i] = static_cast<const std::uint8_t*>(indices)[std::min(i, last)];
+        break;
+      case 2:
+        for (std::uint32_t i = 0; i < kRunVertices; ++i) stored[i] = static_cast<const std::uint16_t*>(indices)[std::min(i, last)];
+        break;
+      default:
+        for (std::uint32_t i = 0; i < kRunVertices; ++i) stored[i] = static_cast<const std::uint32_t*>(indices)[std::min(i, last)];
+    }
+    const glm::vec3* base = positions + strip.vertex_base();
 #if WAVETRACE_AVX2
-    // Gathered, not assembled lane by lane: eight scalar stores read back as one vector stall
-    // store forwarding, which cost more than the gathers. Lanes past the run repeat its last
-    // vertex, so no load leaves the strip: a narrow index is read as the 32-bit word that ends
-    // with it, whose lower bytes, shifted out, lie in the strip's header, tree or indices.
-    // Offsets are 3 * stored index from the strip's first vertex, so they fit the gathers'
-    // signed 32 bits below 2^29; the rare strip spread wider takes the scalar loads.
-    const __m256i lane = _mm256_min_epu32(_mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7), _mm256_set1_epi32(int(vertices - 1)));
-    const auto* index_base = static_cast<const char*>(strip.vertex_address(first));
-    const std::size_t width = strip.index_width();
-    const __m256i stored =
-        width == 1   ? _mm256_srli_epi32(_mm256_i32gather_epi32(reinterpret_cast<const int*>(index_base - 3), lane, 1), 24)
-        : width == 2 ? _mm256_srli_epi32(_mm256_i32gather_epi32(reinterpret_cast<const int*>(index_base - 2), lane, 2), 16)
-                     : _mm256_i32gather_epi32(reinterpret_cast<const int*>(index_base), lane, 4);
-    if (width < 4 || _mm256_testz_si256(stored, _mm256_set1_epi32(~((1 << 29) - 1)))) {
-      const __m256i offset = _mm256_add_epi32(stored, _mm256_add_epi32(stored, stored));  // 3 floats a vertex
-      const float* coordinates = &positions[strip.vertex_base()].x;
-      px = Lanes(_mm256_i32gather_ps(coordinates + sheared_.kx, offset, 4)) - sheared_.origin[sheared_.kx];
-      py = Lanes(_mm256_i32gather_ps(coordinates + sheared_.ky, offset, 4)) - sheared_.origin[sheared_.ky];
-      pz = Lanes(_mm256_i32gather_ps(coordinates + sheared_.kz, offset, 4)) - sheared_.origin[sheared_.kz];
-      gathered = true;
+    const __m128i xyz = _mm_setr_epi32(-1, -1, -1, 0);
+    const auto vertex = [&](std::uint32_t i) { return _mm_maskload_ps(&base[stored[i]].x, xyz); };
+    const __m256 row0 = _mm256_set_m128(vertex(4), vertex(0)), row1 = _mm256_set_m128(vertex(5), vertex(1));
+    const __m256 row2 = _mm256_set_m128(vertex(6), vertex(2)), row3 = _mm256_set_m128(vertex(7), vertex(3));
+    const __m256 xy01 = _mm256_unpacklo_ps(row0, row1), xy23 = _mm256_unpacklo_ps(row2, row3);  // x0 x1 y0 y1 | x4 ..
+    const __m256 z01 = _mm256_unpackhi_ps(row0, row1), z23 = _mm256_unpackhi_ps(row2, row3);    // z0 z1 0 0 | z4 ..
+    const Lanes axis[3] = {Lanes(_mm256_shuffle_ps(xy01, xy23, 0x44)), Lanes(_mm256_shuffle_ps(xy01, xy23, 0xee)),
+                           Lanes(_mm256_shuffle_ps(z01, z23, 0x44))};
+    px = axis[sheared_.kx] - origin_[0];
+    py = axis[sheared_.ky] - origin_[1];
+    pz = axis[sheared_.kz] - origin_[2];
+#else
+    for (std::uint32_t i = 0; i < kRunVertices; ++i) {
+      const glm::vec3& p = base[stored[i]];
+      px[i] = p[sheared_.kx] - origin_[0];
+      py[i] = p[sheared_.ky] - origin_[1];
+      pz[i] = p[sheared_.kz] - origin_[2];
     }
 #endif
-    for (std::uint32_t i = 0; !gathered && i < kRunVertices; ++i) {
-      const glm::vec3& p = positions[strip.vertex(first + std::min(i, vertices - 1))];
-      px[i] = p[sheared_.kx] - sheared_.origin[sheared_.kx];
-      py[i] = p[sheared_.ky] - sheared_.origin[sheared_.ky];
-      pz[i] = p[sheared_.kz] - sheared_.origin[sheared_.kz];
-    }
     const Lanes x = px - sheared_.shear_x * pz;
     const Lanes y = py - sheared_.shear_y * pz;
     const Lanes z = sheared_.shear_z * pz;
@@ -256,6 +266,7 @@ class StripRay {
   }
 
   WatertightRay sheared_;
+  float origin_[3];  // the origin's kx, ky and kz coordinates
 };
 
 }  // namespace wavetrace
