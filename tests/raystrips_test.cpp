@@ -122,6 +122,22 @@ TEST(RayStripTraversal, EveryIndexWidthFindsTheHitsOfTheWatertightTest) {
       answers.emplace_back(found, ray.found() ? ray.hit.t : -1.0f);
     }
     EXPECT_GT(hits, 1000u);
+    // Straight down onto the shared edges and vertices of the row (x a whole number): edge
+    // functions exactly zero, which the run decides in double. Neither triangle may let the
+    // ray through.
+    for (int column = 1; column < 10; ++column) {
+      for (const float v : {0.0f, 0.25f, 0.5f, 1.0f}) {
+        const glm::vec3 origin(float(column), v, 5.0f), direction(0.0f, 0.0f, -1.0f);
+        const SingleRay single{origin, direction, 0.0f, 100.0f, make_box_ray(origin, direction),
+                               make_watertight_ray(origin, direction)};
+        StripRay ray(single);
+        NullProbe probe;
+        ray.traverse<false>(view, frame, mesh.positions.data(), 0.0f, 100.0f, 2, probe);
+        ASSERT_TRUE(ray.found()) << "through the edge at x = " << column << ", y = " << v << ", spacing " << spacing;
+        EXPECT_FLOAT_EQ(ray.hit.t, 5.0f - 0.3f * std::sin(float(column)));
+        answers.emplace_back(view.triangle(ray.hit.triangle), ray.hit.t);
+      }
+    }
     if (first_answers.empty()) {
       first_answers = answers;
     } else {

@@ -15,6 +15,7 @@
 #pragma once
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -163,6 +164,16 @@ class StripRay {
   // Lane j takes lane j + 1 (j + 2); the last lanes repeat lane 7.
   static Lanes next(Lanes v) { return __builtin_shufflevector(v, v, 1, 2, 3, 4, 5, 6, 7, 7); }
   static Lanes after_next(Lanes v) { return __builtin_shufflevector(v, v, 2, 3, 4, 5, 6, 7, 7, 7); }
+  // Bit j: lane j of the mask is set.
+  static unsigned bits_of(LaneMask mask) {
+#if WAVETRACE_AVX2
+    return static_cast<unsigned>(_mm256_movemask_ps((__m256)mask));
+#else
+    unsigned bits = 0;
+    for (unsigned j = 0; j < kRunVertices; ++j) bits |= unsigned(mask[j] != 0) << j;
+    return bits;
+#endif
+  }
 
   static float edge_in_double(float px, float py, float qx, float qy) {
     return static_cast<float>(double(qx) * double(py) - double(qy) * double(px));
@@ -225,10 +236,10 @@ class StripRay {
     const Lanes x1 = next(x), y1 = next(y), x2 = after_next(x), y2 = after_next(y);
     Lanes strip_edge = x1 * y - y1 * x;
     Lanes diagonal = x2 * y - y2 * x;
-    const LaneMask zero = (strip_edge == 0.0f) | (diagonal == 0.0f);
-    bool any_zero = false;
-    for (std::uint32_t j = 0; j < kRunVertices; ++j) any_zero |= zero[j] != 0;
-    if (any_zero) {  // an exact zero is decided in double, per edge, as the watertight test does
+    // Only the run's edges count: lanes past it repeat the last vertex, whose edges are zero.
+    const unsigned strip_edges = (2u << count) - 1, triangles = (1u << count) - 1;
+    if ((bits_of(strip_edge == 0.0f) & strip_edges) | (bits_of(diagonal == 0.0f) & triangles)) {
+      // an exact zero is decided in double, per edge, as the watertight test does
       for (std::uint32_t j = 0; j < count + 1; ++j) {
         if (strip_edge[j] == 0.0f) strip_edge[j] = edge_in_double(x[j], y[j], x[j + 1], y[j + 1]);
         if (j < count && diagonal[j] == 0.0f) diagonal[j] = edge_in_double(x[j], y[j], x[j + 2], y[j + 2]);
@@ -245,8 +256,8 @@ class StripRay {
     const Lanes signed_t = flip ? -scaled_t : scaled_t;
     const LaneMask accepted = ~(negative & positive) & (determinant != 0.0f) & (signed_t >= tmin * abs_determinant) &
                               (signed_t <= tmax * abs_determinant * kDistancePrecheckSlack);
-    for (std::uint32_t j = 0; j < count; ++j) {
-      if (!accepted[j]) continue;
+    for (unsigned lanes = bits_of(accepted) & triangles; lanes != 0; lanes &= lanes - 1) {
+      const unsigned j = static_cast<unsigned>(std::countr_zero(lanes));
       const float inverse = 1.0f / determinant[j];
       const float t = scaled_t[j] * inverse;
       if (!replaces_nearest(
