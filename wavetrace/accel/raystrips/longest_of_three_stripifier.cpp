@@ -16,6 +16,7 @@ namespace wavetrace {
 namespace {
 
 constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+constexpr std::uint64_t kEmpty = ~std::uint64_t{0};  // no edge: its two vertices would be one
 
 // Half-edge h = 3 t + k of local triangle t runs from corner k to corner k + 1, as OpenMesh's
 // add_face(a, b, c) links them; the triangle's own half-edge (where OpenMesh's walk starts)
@@ -23,10 +24,40 @@ constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 constexpr std::uint32_t next(std::uint32_t h) { return h % 3 == 2 ? h - 2 : h + 1; }
 constexpr std::uint32_t prev(std::uint32_t h) { return h % 3 == 0 ? h + 2 : h - 1; }
 
+// One strip grown from a half-edge: the vertices and triangles met going back (front_*,
+// in the order met; they come first in the strip, reversed) and going on (back_*), and
+// whether the strip needs a swap at its start to keep its winding (`flip`).
+struct Experiment {
+  std::vector<std::uint32_t> front_vertices, back_vertices, front_faces, back_faces;
+  bool flip = false;
+  std::size_t vertex_count() const { return front_vertices.size() + back_vertices.size() + (flip ? 1 : 0); }
+};
+
+// An edge's slot in the table that pairs half-edges.
+struct EdgeSlot {
+  std::uint64_t edge;  // low vertex << 32 | high vertex, or kEmpty
+  std::uint32_t first, second;
+  std::uint32_t count;
+};
+
+// A thread's arrays, kept from one sub-mesh to the next: under the 8-wide top sub-meshes are
+// 24 triangles, and allocating these afresh for each was most of the stripifier's time.
+struct Scratch {
+  std::vector<std::uint32_t> opposite;  // per half-edge, or kNone
+  std::vector<std::uint8_t> state;      // per local triangle: kProcessed (in a strip), kUsed (in this experiment)
+  std::vector<std::uint32_t> degenerate;
+  std::vector<EdgeSlot> table;
+  Experiment experiments[3];
+};
+
 class LongestOfThree {
  public:
-  LongestOfThree(const TriangleMesh& mesh, std::span<const std::uint32_t> triangles)
-      : mesh_(mesh), triangles_(triangles), opposite_(3 * triangles.size(), kNone), state_(triangles.size(), 0) {
+  LongestOfThree(const TriangleMesh& mesh, std::span<const std::uint32_t> triangles, Scratch& scratch)
+      : mesh_(mesh), triangles_(triangles), opposite_(scratch.opposite), state_(scratch.state),
+        degenerate_(scratch.degenerate), table_(scratch.table), experiments_(scratch.experiments) {
+    opposite_.assign(3 * triangles.size(), kNone);
+    state_.assign(triangles.size(), 0);
+    degenerate_.clear();
     // Degenerate triangles, which OpenMesh refuses, take no part in the walk.
     for (std::uint32_t t = 0; t < triangles_.size(); ++t) {
       const glm::uvec3& c = corners(t);
@@ -45,7 +76,7 @@ class LongestOfThree {
       const glm::uvec3& c = corners(t);
       strips.push_back({{c.x, c.y, c.z}, {triangles_[t]}});
     }
-    Experiment experiments[3];
+    Experiment* experiments = experiments_;
     for (std::uint32_t t = 0; t < triangles_.size(); ++t) {
       if (state_[t] & kProcessed) continue;
       const std::uint32_t start[3] = {3 * t + 2, 3 * t, 3 * t + 1};
@@ -66,16 +97,6 @@ class LongestOfThree {
 
  private:
   static constexpr std::uint8_t kProcessed = 1, kUsed = 2;
-  static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};  // no edge: its two vertices would be one
-
-  // One strip grown from a half-edge: the vertices and triangles met going back (front_*,
-  // in the order met; they come first in the strip, reversed) and going on (back_*), and
-  // whether the strip needs a swap at its start to keep its winding (`flip`).
-  struct Experiment {
-    std::vector<std::uint32_t> front_vertices, back_vertices, front_faces, back_faces;
-    bool flip = false;
-    std::size_t vertex_count() const { return front_vertices.size() + back_vertices.size() + (flip ? 1 : 0); }
-  };
 
   const glm::uvec3& corners(std::uint32_t t) const { return mesh_.triangles[triangles_[t]]; }
   std::uint32_t from(std::uint32_t h) const { return corners(h / 3)[int(h % 3)]; }
@@ -86,26 +107,22 @@ class LongestOfThree {
   // open-addressing table (a sub-mesh is a few hundred triangles: sorting its half-edges
   // took most of the stripifier's time).
   void pair_half_edges() {
-    struct Slot {
-      std::uint64_t edge = kEmpty;  // low vertex << 32 | high vertex
-      std::uint32_t first = 0, second = 0;
-      std::uint32_t count = 0;
-    };
     std::size_t size = 16;
     while (size < 2 * opposite_.size()) size *= 2;
-    std::vector<Slot> table(size);
+    std::vector<EdgeSlot>& table = table_;
+    table.assign(size, EdgeSlot{kEmpty, 0, 0, 0});
     for (std::uint32_t h = 0; h < opposite_.size(); ++h) {
       if (state_[h / 3] & kProcessed) continue;
       const std::uint32_t a = from(h), b = to(h);
       const std::uint64_t edge = std::uint64_t(std::min(a, b)) << 32 | std::max(a, b);
       std::size_t at = std::size_t((edge * 0x9E3779B97F4A7C15ull) >> 40) & (size - 1);
       while (table[at].edge != kEmpty && table[at].edge != edge) at = (at + 1) & (size - 1);
-      Slot& slot = table[at];
+      EdgeSlot& slot = table[at];
       if (slot.count == 0) slot.edge = edge, slot.first = h;
       if (slot.count == 1) slot.second = h;
       ++slot.count;
     }
-    for (const Slot& slot : table) {
+    for (const EdgeSlot& slot : table) {
       // Opposite directions: the two triangles agree on their winding.
       if (slot.count == 2 && from(slot.first) == to(slot.second)) {
         opposite_[slot.first] = slot.second;
@@ -175,9 +192,11 @@ class LongestOfThree {
 
   const TriangleMesh& mesh_;
   std::span<const std::uint32_t> triangles_;
-  std::vector<std::uint32_t> opposite_;  // per half-edge, or kNone
-  std::vector<std::uint8_t> state_;      // per local triangle: kProcessed (in a strip), kUsed (in this experiment)
-  std::vector<std::uint32_t> degenerate_;
+  std::vector<std::uint32_t>& opposite_;
+  std::vector<std::uint8_t>& state_;
+  std::vector<std::uint32_t>& degenerate_;
+  std::vector<EdgeSlot>& table_;
+  Experiment* experiments_;
 };
 
 }  // namespace
@@ -190,7 +209,8 @@ std::vector<TriangleStrip> stripify_longest_of_three(const TriangleMesh& mesh, s
     throw std::length_error("a sub-mesh of " + std::to_string(triangles.size()) +
                             " triangles is beyond the stripifier's 32-bit half-edge ids");
   }
-  return cut_long_strips(LongestOfThree(mesh, triangles).run(), max_triangles);
+  thread_local Scratch scratch;
+  return cut_long_strips(LongestOfThree(mesh, triangles, scratch).run(), max_triangles);
 }
 
 }  // namespace wavetrace

@@ -33,6 +33,14 @@ std::vector<TriangleStrip> stripify(const TriangleMesh& mesh, std::span<const st
 }
 
 std::vector<TriangleStrip> cut_long_strips(std::vector<TriangleStrip> strips, std::uint32_t max_triangles) {
+  const auto only_swaps = [](const TriangleStrip& strip) {
+    return std::all_of(strip.triangles.begin(), strip.triangles.end(), [](std::uint32_t t) { return t == kNoTriangle; });
+  };
+  if (std::none_of(strips.begin(), strips.end(), [&](const TriangleStrip& strip) {
+        return strip.triangles.size() > max_triangles || only_swaps(strip);
+      })) {
+    return strips;  // the common case, without a second vector
+  }
   std::vector<TriangleStrip> result;
   for (TriangleStrip& strip : strips) {
     if (strip.triangles.size() <= max_triangles) {
@@ -48,9 +56,7 @@ std::vector<TriangleStrip> cut_long_strips(std::vector<TriangleStrip> strips, st
     }
   }
   // A strip of swaps only (possible after cutting) adds nothing.
-  std::erase_if(result, [](const TriangleStrip& strip) {
-    return std::all_of(strip.triangles.begin(), strip.triangles.end(), [](std::uint32_t t) { return t == kNoTriangle; });
-  });
+  std::erase_if(result, only_swaps);
   return result;
 }
 
