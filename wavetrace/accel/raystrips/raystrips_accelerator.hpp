@@ -47,8 +47,8 @@ struct RayStripsOptions {
   // long strips, one a leaf. Under the 8-wide top short strips trace faster (their leaves'
   // boxes are tighter) but each costs a 12-byte header: on room:1M and the scans Loop-subdivided
   // twice, 24 triangles and up to 4 strips a leaf was the fastest within 16 bytes a triangle
-  // (0.37-0.50x Embree on diffuse rays at 15.2-15.8 B/tri, against 0.27-0.39x at 13.6-14.2
-  // with 256 and 1; docs/measurements.md, "Ray-Strips under the 8-wide top").
+  // (1.2-1.6x the rays a second of 256 and 1 at 1.0-1.7 B/tri more; docs/measurements.md,
+  // "Ray-Strips under the 8-wide top"), and builds about 1.5x slower.
   static constexpr std::uint32_t kSubmeshTriangles[2] = {256, 24};  // width 2, width 8
   static constexpr std::uint32_t kStripsPerLeaf[2] = {1, 4};
   RayStripsOptions resolved() const {
