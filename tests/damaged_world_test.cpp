@@ -229,6 +229,9 @@ INSTANTIATE_TEST_SUITE_P(
                     "has a leaf of more strips than follow it"},
         CraftedCase{"StripOfNoTriangles", {"accel.type=raystrips"}, "raystrips.strips", [](char* d) { poke<std::uint16_t>(d, 0); },
                     "the strip at byte 0 has no triangles"},
+        CraftedCase{"StripOfIndexWidthsThatDoNotExist", {"accel.type=raystrips"}, "raystrips.strips",
+                    [](char* d) { poke<std::uint8_t>(d + 2, 0x05); },  // 16-bit and 8-bit indices at once
+                    "the strip at byte 0 has index or record widths this version does not know"},
         CraftedCase{"WideRayStripsChildAndLeafPastTheirArrays", {"accel.type=raystrips", "accel.raystrips.width=8"}, "raystrips.wide_nodes",
                     point_wide_node_past_its_arrays,
                     "node 0"}),
