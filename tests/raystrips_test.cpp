@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <random>
 #include <set>
 
 #include "wavetrace/accel/raystrips/ray_strip_format.hpp"
@@ -18,6 +19,7 @@
 #include "wavetrace/bench/accel_bench.hpp"
 #include "wavetrace/bench/leak_bench.hpp"
 #include "wavetrace/bench/ray_sets.hpp"
+#include "wavetrace/memory/kernel_isa_choice.hpp"
 #include "wavetrace/scene/builtin_scenes.hpp"
 #include "wavetrace/scene/load_scene.hpp"
 #include "wavetrace/setup/config.hpp"
@@ -33,20 +35,21 @@ namespace {
 using namespace ray_strip;
 
 TEST(RayStripFormat, SizeOfAStripOfNTrianglesFollowsTheFormula) {
-  // 12-byte header, 3 bytes per node (ceil(n/2) - 1 of them above 6 triangles, none at or
+  // 12-byte header, 3 bytes per node (ceil(n/2) - 1 of them above 14 triangles, none at or
   // below), indices and records, each aligned to its width, the whole to 4 bytes.
   EXPECT_EQ(strip_layout(1, kShortIndices | kShortRecords).size, 12u + 3 * 2 + 1 * 2 + 0);  // 20
   EXPECT_EQ(strip_layout(2, kShortIndices | kShortRecords).size, 24u);  // 12 + 8 + 4
   EXPECT_EQ(strip_layout(5, kShortIndices | kShortRecords).size, 36u);  // 12, +14 = 26, +10 = 36
   EXPECT_EQ(strip_layout(5, kByteIndices | kShortRecords).size, 32u);   // 12, +7 = 19 -> 20, +10 = 30 -> 32
   EXPECT_EQ(strip_layout(5, 0).size, 60u);                              // 12, +28 = 40, +20 = 60
-  EXPECT_EQ(strip_layout(7, kByteIndices | kShortRecords).size, 44u);   // 12 + 9 = 21, +9 = 30, +14 = 44
+  EXPECT_EQ(strip_layout(14, kByteIndices | kShortRecords).size, 56u);  // 12, +16 = 28, +28 = 56
+  EXPECT_EQ(strip_layout(15, kByteIndices | kShortRecords).size, 80u);  // 12 + 21 = 33, +17 = 50, +30 = 80
   EXPECT_EQ(strip_layout(100, kShortIndices).size, 764u);   // 12 + 147 = 159 -> 160, +204 = 364, +400 = 764
   for (std::uint32_t n = 1; n <= 2000; ++n) {
     for (const std::uint8_t widths : {0, 1, 2, 3, 4, 6}) {
       const std::size_t w = (widths & kByteIndices) ? 1 : (widths & kShortIndices) ? 2 : 4;
       const std::size_t v = (widths & kShortRecords) ? 2 : 4;
-      const std::size_t nodes = n > 6 ? (n + 1) / 2 - 1 : 0;
+      const std::size_t nodes = n > 14 ? (n + 1) / 2 - 1 : 0;
       std::size_t size = 12 + 3 * nodes;
       size = (size + w - 1) / w * w + w * (n + 2);
       size = (size + v - 1) / v * v + v * n;
@@ -145,6 +148,92 @@ TEST(RayStripTraversal, EveryIndexWidthFindsTheHitsOfTheWatertightTest) {
     }
   }
 }
+
+#if WAVETRACE_SIXTEEN_LANES
+TEST(RayStripTraversal, PackedStripsAnswerAsTheirRunsBitForBit) {
+  // The bent quad row of 20 triangles cut into strips of 5, 5, 4 and 6 triangles (7, 7, 6 and
+  // 8 vertices), packed first and third, second and fourth into sixteen lanes: the lane pairs
+  // and triples across two strips span gaps in the row and must not count as edges or
+  // triangles. The packed test
+  // finds, for every ray, the hit the eight-lane runs find strip by strip: the same triangle,
+  // its t and weights to the bit, also straight down onto the shared edges (exact zeros).
+  if (runnable_kernel_isas().back() != KernelIsa::avx512) GTEST_SKIP() << "this CPU has no AVX-512";
+  TriangleMesh mesh;
+  for (int column = 0; column < 11; ++column) {
+    for (int row = 0; row < 2; ++row) mesh.positions.emplace_back(float(column), float(row), 0.3f * std::sin(float(column)));
+  }
+  for (std::uint32_t k = 0; k < 20; ++k) mesh.triangles.emplace_back(k, k + 1, k + 2);
+  std::vector<std::uint32_t> identity(mesh.vertex_count());
+  for (std::uint32_t v = 0; v < identity.size(); ++v) identity[v] = v;
+  std::vector<std::vector<std::byte>> buffers;
+  for (const auto& [first, end] : {std::pair(0u, 5u), {5u, 10u}, {10u, 14u}, {14u, 20u}}) {
+    std::vector<std::uint32_t> part;
+    for (std::uint32_t t = first; t < end; ++t) part.push_back(t);
+    const std::vector<TriangleStrip> strips = stripify(mesh, part, StripifierKind::dual_path, kMaxTriangles);
+    ASSERT_EQ(strips.size(), 1u);
+    const auto n = static_cast<std::uint32_t>(strips[0].triangles.size());
+    ASSERT_FALSE(has_tree(n));
+    const StripEncoding encoding = choose_encoding(strips[0], identity);
+    Bounds3 frame;
+    for (const std::uint32_t vertex : strips[0].vertices) frame.extend(mesh.positions[vertex]);
+    buffers.emplace_back(encoding.size(n));
+    encode_strip(strips[0], encoding, identity, mesh.positions, mesh, frame, buffers.back().data());
+  }
+  std::vector<PackedStrips> packs(2);
+  for (std::size_t s = 0; s < buffers.size(); ++s) {
+    const StripView view(buffers[s].data());
+    ASSERT_TRUE(packs[s % 2].fits(view.triangles()));
+    packs[s % 2].add(view);
+  }
+  ASSERT_EQ(packs[0].lanes, 13u);
+  ASSERT_EQ(packs[1].lanes, 15u);
+  const auto answer = [](const StripRay& ray) {
+    std::uint32_t bits[4] = {};
+    std::memcpy(&bits[0], &ray.hit.t, 4);
+    for (int c = 0; c < 3; ++c) std::memcpy(&bits[c + 1], &ray.hit.weights[c], 4);
+    const std::uint32_t triangle = ray.found() ? StripView(ray.hit.strip).triangle(ray.hit.triangle) : kNoTriangle;
+    return std::tuple(triangle, bits[0], bits[1], bits[2], bits[3]);
+  };
+  std::uint32_t hits = 0, rays = 0;
+  const auto compare = [&](const glm::vec3& origin, const glm::vec3& direction) {
+    const SingleRay single{origin, direction, 0.0f, 100.0f, make_box_ray(origin, direction),
+                           make_watertight_ray(origin, direction)};
+    StripRay runs(single), packed(single);
+    NullProbe probe;
+    for (const std::vector<std::byte>& buffer : buffers) {
+      const StripView view(buffer.data());
+      runs.test_run<false>(view, mesh.positions.data(), 0, view.triangles(), probe);
+    }
+    for (const PackedStrips& pack : packs) packed.test_packed<false>(pack, mesh.positions.data());
+    ++rays;
+    hits += runs.found();
+    return answer(runs) == answer(packed);
+  };
+  for (int i = 0; i < 4000; ++i) {
+    const float u = -0.5f + 11.0f * float(i % 400) / 400.0f, v = -0.2f + 1.4f * float(i / 400) / 10.0f;
+    const glm::vec3 origin(u + 0.7f * std::sin(float(i)), v, i % 2 ? 3.0f : -3.0f);
+    ASSERT_TRUE(compare(origin, glm::vec3(u, v, 0.1f * std::cos(float(i))) - origin)) << "ray " << i;
+  }
+  for (int column = 0; column <= 10; ++column) {
+    for (const float v : {0.0f, 0.25f, 0.5f, 1.0f}) {
+      ASSERT_TRUE(compare({float(column), v, 5.0f}, {0.0f, 0.0f, -1.0f})) << "down at x = " << column << ", y = " << v;
+    }
+  }
+  // Aimed at points of the row's edges from slanted origins: edge functions that round to
+  // zero in float and not in double, which both tests redo in double.
+  std::mt19937 random(7);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  for (int i = 0; i < 20000; ++i) {
+    const std::uint32_t k = i % 19;  // the edge triangle k shares with triangle k + 1
+    const glm::vec3 a = mesh.positions[k + 1], b = mesh.positions[k + 2];
+    const glm::vec3 on_edge = a + unit(random) * (b - a);
+    const glm::vec3 origin = on_edge + glm::vec3(unit(random) - 0.5f, unit(random) - 0.5f, 1.0f) * 3.0f;
+    ASSERT_TRUE(compare(origin, on_edge - origin)) << "aimed at edge " << k << ", ray " << i;
+  }
+  EXPECT_GT(hits, 1000u);
+  EXPECT_EQ(rays, 24044u);
+}
+#endif
 
 TEST(RayStripFormat, EncodedStripDecodesToItsVerticesTrianglesAndCorners) {
   // A fan-free strip over a 2 x 4 quad grid: vertices 0..9, triangles of both windings.

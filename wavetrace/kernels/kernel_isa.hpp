@@ -5,6 +5,16 @@
 
 #include "wavetrace/build_config.hpp"
 
+// Kernels written for sixteen lanes (__m512 vectors passed between shared helpers), compiled
+// only where they inline into the AVX-512 walks. Clang refuses any call that passes a __m512
+// from a function not of that target, which such shared code is, so a Clang build (the
+// sanitizer build) keeps their eight-lane passes there too (the same hits).
+#if WAVETRACE_AVX512_DISPATCH && !defined(__clang__)
+#define WAVETRACE_SIXTEEN_LANES 1
+#else
+#define WAVETRACE_SIXTEEN_LANES 0
+#endif
+
 namespace wavetrace {
 
 enum class KernelIsa : unsigned char {

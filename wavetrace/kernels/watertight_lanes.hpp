@@ -13,21 +13,15 @@
 
 #include <cstdint>
 
+#include "wavetrace/kernels/kernel_isa.hpp"
 #include "wavetrace/kernels/triangle_intersect.hpp"
 
 #if WAVETRACE_AVX2
 #include <immintrin.h>
 #endif
 
-// Sixteen lanes, for the AVX-512 walks: GCC compiles this file's shared code at 16 lanes where it
-// is inlined into the one function of the AVX-512 target (kernel_isa.hpp). Clang refuses any
-// call that passes a __m512 from a function not of that target, which the shared code is, so a
-// Clang build (the sanitizer build) tests in passes of eight lanes there too (the same hits).
-#if WAVETRACE_AVX512_DISPATCH && !defined(__clang__)
-#define WAVETRACE_WATERTIGHT_SIXTEEN 1
-#else
-#define WAVETRACE_WATERTIGHT_SIXTEEN 0
-#endif
+// Sixteen lanes, for the AVX-512 walks (WAVETRACE_SIXTEEN_LANES, kernel_isa.hpp): GCC compiles
+// this file's shared code at 16 lanes where it is inlined into the one function of that target.
 
 namespace wavetrace {
 
@@ -77,7 +71,7 @@ template <> struct Vector<8> {
   static auto greater(Float a, Float b) { return a > b; }
   template <typename Mask> static unsigned bits(Mask m) { return static_cast<unsigned>(_mm256_movemask_ps(Float(m))); }
 };
-#if WAVETRACE_WATERTIGHT_SIXTEEN
+#if WAVETRACE_SIXTEEN_LANES
 // Only the AVX-512 walks instantiate it: members of that target, which only a function of that
 // target may inline (kernel_isa.hpp).
 template <> struct Vector<16> {
@@ -95,7 +89,7 @@ template <> struct Vector<16> {
 
 }  // namespace lanes
 
-#if WAVETRACE_WATERTIGHT_SIXTEEN
+#if WAVETRACE_SIXTEEN_LANES
 // GCC warns that the 16-lane instance calls functions that return __m512 from a function not
 // of the AVX-512 target; it runs only inlined into one (kernel_isa.hpp), so no call is made.
 #pragma GCC diagnostic push
@@ -152,7 +146,7 @@ template <int kLanes, int kRowLanes>
   out.on_edge = V::bits(on_edge) & used;
   out.candidates = ~V::bits(rejected) & used & ~out.on_edge;
 }
-#if WAVETRACE_WATERTIGHT_SIXTEEN
+#if WAVETRACE_SIXTEEN_LANES
 #pragma GCC diagnostic pop
 #endif
 

@@ -156,7 +156,7 @@ template <bool kAnyHit, KernelIsa kIsa = KernelIsa::baseline>
 #if WAVETRACE_AVX2
   // Candidates of each pass are taken in triangle order against the shrinking tmax, exactly
   // as the scalar loop takes them (same hits, same t).
-  constexpr std::uint32_t kPass = kSixteenLanes<kIsa> && WAVETRACE_WATERTIGHT_SIXTEEN ? 16 : 8;
+  constexpr std::uint32_t kPass = kSixteenLanes<kIsa> && WAVETRACE_SIXTEEN_LANES ? 16 : 8;
   for (std::uint32_t base = 0; base < triangles; base += kPass) {
     const std::uint32_t count = std::min<std::uint32_t>(kPass, triangles - base);
     WatertightLanes<kPass> result;

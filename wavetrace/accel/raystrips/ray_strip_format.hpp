@@ -6,8 +6,9 @@
 // has the corners (s[k], s[k+1], s[k+2]). Turns of the strip repeat a triangle (a swap
 // vertex), so n counts those repeats too; a repeated triangle answers exactly as its first
 // copy. Little-endian; a strip starts 4-byte aligned; N = ceil(n / 2) - 1 kd-tree nodes when
-// n > 6, else N = 0: one 8-lane shared-edge test covers 6 triangles whole (strip_traversal.hpp),
-// so a tree over so few would cost bytes and a descent and spare no test. The
+// n > 14, else N = 0: the AVX-512 walks test up to 14 triangles (16 vertices) in one pass of
+// sixteen lanes, the AVX2 ones in up to three runs of eight (strip_traversal.hpp), and over so
+// few triangles a tree cost more in descents and bytes than the runs it spared. The
 // strip's frame F is the box of the top leaf that holds it (its float box in the binary top,
 // its decoded box in the 8-wide one), which the owner knows when it encodes and traverses.
 //
@@ -34,7 +35,7 @@
 //                                               record = (triangle - triangle_base) << 3 | corners
 //   size = align(R + V n, 4)
 //
-// The kd-tree (only when n > 6). Leaves are pairs of triangles, leaf j = triangles {2j, 2j + 1} (the last leaf
+// The kd-tree (only when n > 14). Leaves are pairs of triangles, leaf j = triangles {2j, 2j + 1} (the last leaf
 // of an odd strip holds one); they are implicit. A node spans the leaves [a, a + c), c >= 2,
 // and splits them into its first ceil(c / 2) leaves (the strip-first child) and the rest
 // (the strip-second child), so the tree is balanced and needs no child pointers. Nodes are
@@ -67,7 +68,7 @@ inline constexpr std::uint8_t kShortRecords = 1u << 1;
 inline constexpr std::uint8_t kByteIndices = 1u << 2;
 inline constexpr std::uint8_t kKnownWidths = kShortIndices | kShortRecords | kByteIndices;
 // Strips of at most this many triangles carry no kd-tree (the comment above).
-inline constexpr std::uint32_t kUntreedTriangles = 6;
+inline constexpr std::uint32_t kUntreedTriangles = 14;
 inline constexpr std::uint8_t kAxisMask = 3u;
 inline constexpr std::uint8_t kReverse = 1u << 2;
 inline constexpr std::uint32_t kCornerBits = 3;

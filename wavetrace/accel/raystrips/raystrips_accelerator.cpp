@@ -128,8 +128,9 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> cut_submeshes(const BuildTr
 struct RayStripsSavedOptions {
   std::uint32_t run_triangles, packet_min_active, packets, stripifier, submesh_triangles, strips_per_leaf, width, zero;
 };
-// 4: 8-bit indices, no tree under 7 triangles; 3: 8-bit split planes; 2: the width 8 top
-constexpr std::uint32_t kRayStripsSavedVersion = 4;
+// 5: no tree under 15 triangles; 4: 8-bit indices, no tree under 7 triangles; 3: 8-bit split
+// planes; 2: the width 8 top
+constexpr std::uint32_t kRayStripsSavedVersion = 5;
 
 class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator> {
   friend class ProbedAccelerator<RayStripsAccelerator>;
@@ -530,7 +531,7 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
         probe.read(leaf_words + leaf, 2 * sizeof(std::uint32_t));
         const std::byte* strip_data = strip_bytes_.data() + std::size_t(leaf_words[leaf]) * 4;
         const std::byte* end = strip_bytes_.data() + std::size_t(leaf_words[leaf + 1]) * 4;
-        return trace_strips<kAnyHit>(ray, box, strip_data, end, near, far, positions, probe);
+        return trace_strips<kAnyHit, kIsa>(ray, box, strip_data, end, near, far, positions, probe);
       }, [&](std::uint32_t leaf) { return strip_bytes_.data() + std::size_t(leaf_words[leaf]) * 4; });
       write_hit<!kAnyHit>(ray, hits, i, &probe);
     });
@@ -574,7 +575,7 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
                   if (!clip_to_box(ray.box, box.lower, box.upper, ray.tmin, pruning_distance(ray.tmax), near, far)) {
                     continue;
                   }
-                  trace_strips<false>(ray, box, strip_data, strips_end, near, far, positions, probe);
+                  trace_strips<false, kIsa>(ray, box, strip_data, strips_end, near, far, positions, probe);
                   tmax[r] = ray.tmax;
                 }
               });
@@ -593,9 +594,15 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
 
   // The strips of one top leaf (whose box is `frame`), from `strip_data` on: `count` of them,
   // or (wide top) up to `end`. True when an any-hit query is answered.
-  template <bool kAnyHit, typename Probe, typename Until>
+  template <bool kAnyHit, KernelIsa kIsa = KernelIsa::baseline, typename Probe, typename Until>
   bool trace_strips(StripRay& ray, const Bounds3& frame, const std::byte* strip_data, Until until, float near,
                     float far, const glm::vec3* positions, Probe& probe) const {
+#if WAVETRACE_SIXTEEN_LANES
+    // Probes that record each read see the strips one at a time, in the order they are read.
+    if constexpr (kIsa == KernelIsa::avx512 && !Probe::kRecords) {
+      return trace_packed_strips<kAnyHit>(ray, frame, strip_data, until, near, far, positions, probe);
+    }
+#endif
     for (std::uint32_t s = 0;; ++s) {
       if constexpr (std::is_integral_v<Until>) {
         if (s == until) return false;
@@ -615,6 +622,52 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
       strip_data += strip.size();
     }
   }
+
+#if WAVETRACE_SIXTEEN_LANES
+  // trace_strips in the AVX-512 walks: the short strips packed whole into sixteen lanes
+  // (PackedStrips) and tested a pack at a time, the others walked one by one as before.
+  template <bool kAnyHit, typename Probe, typename Until>
+  [[WAVETRACE_AVX512_TARGET]] bool trace_packed_strips(StripRay& ray, const Bounds3& frame, const std::byte* strip_data,
+                                                       Until until, float near, float far, const glm::vec3* positions,
+                                                       Probe& probe) const {
+    PackedStrips pack;
+    for (std::uint32_t s = 0;; ++s) {
+      if constexpr (std::is_integral_v<Until>) {
+        if (s == until) break;
+      } else {
+        if (strip_data >= until) break;
+      }
+      probe.read(strip_data, ray_strip::kHeaderBytes);
+      const StripView strip(strip_data);
+      const char* first_vertex = reinterpret_cast<const char*>(positions + strip.vertex_base());
+      _mm_prefetch(first_vertex, _MM_HINT_T0);
+      _mm_prefetch(first_vertex + 64, _MM_HINT_T0);
+      _mm_prefetch(first_vertex + 128, _MM_HINT_T0);
+      if (ray_strip::has_tree(strip.triangles())) {
+        // The strips before it first: an any-hit query answers with the first hit in strip
+        // order, as the baseline walk does.
+        if (!pack.empty()) {
+          ray.test_packed<kAnyHit>(pack, positions);
+          if (kAnyHit && ray.found()) return true;
+          pack.clear();
+        }
+        ray.traverse<kAnyHit>(strip, frame, positions, near, far, options_.run_triangles, probe);
+        if (kAnyHit && ray.found()) return true;
+      } else {
+        probe.read(strip.vertex_address(0), (strip.triangles() + 2) * strip.index_width());
+        if (!pack.fits(strip.triangles())) {
+          ray.test_packed<kAnyHit>(pack, positions);
+          if (kAnyHit && ray.found()) return true;
+          pack.clear();
+        }
+        pack.add(strip);
+      }
+      strip_data += strip.size();
+    }
+    if (!pack.empty()) ray.test_packed<kAnyHit>(pack, positions);
+    return kAnyHit && ray.found();
+  }
+#endif
 
   RayStripsOptions options_;
   StoredArray<BvhNode> nodes_;                      // width 2

@@ -11,7 +11,8 @@
 // arithmetic is the watertight test's (an exact zero is redone in double), and f(q, p) is
 // exactly -f(p, q), so two triangles sharing an edge — in a strip or across strips — see
 // the same edge value and no ray slips between them. Runs are processed 6 triangles
-// (8 vertices, 7 + 6 edges) at a time in 8-lane vectors (AVX2).
+// (8 vertices, 7 + 6 edges) at a time in 8-lane vectors (AVX2); in the AVX-512 walks a top
+// leaf's short strips are packed back to back into sixteen lanes and tested at once.
 #pragma once
 
 #include <algorithm>
@@ -29,6 +30,7 @@
 
 #include "wavetrace/accel/ray_loop.hpp"
 #include "wavetrace/accel/raystrips/ray_strip_format.hpp"
+#include "wavetrace/kernels/kernel_isa.hpp"
 #include "wavetrace/kernels/nearest_hit.hpp"
 #include "wavetrace/kernels/ray_box.hpp"
 #include "wavetrace/kernels/triangle_intersect.hpp"
@@ -44,13 +46,56 @@ inline float widen_entry(float t) { return t * (t > 0.0f ? 1.0f - kPlaneDistance
 
 inline constexpr std::uint32_t kRunVertices = 8;
 inline constexpr std::uint32_t kRunTriangles = kRunVertices - 2;
-static_assert(kRunTriangles == ray_strip::kUntreedTriangles, "a strip without a tree is one run's test");
 
 // Whether a walk goes below the kd-node over leaves [first, first + leaves) of a strip of
 // `triangles`: while its span holds more triangles than one run tests, where there is a tree.
 inline bool descends(std::uint32_t triangles, std::uint32_t first, std::uint32_t leaves, std::uint32_t run_triangles) {
   return ray_strip::has_tree(triangles) && leaves >= 2 && std::min(2 * (first + leaves), triangles) - 2 * first > run_triangles;
 }
+
+// Short strips of one top leaf (no kd-tree: at most 14 triangles, 16 vertices), whole and back
+// to back in sixteen lanes, for one shared-edge test of all of them (StripRay::test_packed):
+// lane j holds one vertex, and is a triangle where j, j + 1 and j + 2 are one strip's. Most
+// leaves under the 8-wide top hold one or two such strips; tested one run at a time, each
+// paid the run's set-up and its own mispredicted branches for 8 lanes of work.
+struct PackedStrips {
+  static constexpr std::uint32_t kLanes = 16;
+  static constexpr std::uint32_t kMostStrips = kLanes / 3;  // a strip has 3 vertices or more
+  std::uint32_t vertex[kLanes];         // mesh vertex of each used lane
+  std::uint8_t strip_of_lane[kLanes];   // for the lanes that start a triangle
+  const std::byte* strip[kMostStrips];  // each packed strip's bytes
+  std::uint8_t first_lane[kMostStrips];
+  std::uint32_t lanes = 0, strips = 0;
+  unsigned triangles = 0;    // bit j: lanes j, j + 1, j + 2 are a triangle of one strip
+  unsigned strip_edges = 0;  // bit j: lanes j, j + 1 are an edge of one strip
+
+  bool empty() const { return lanes == 0; }
+  bool fits(std::uint32_t strip_triangles) const { return lanes + strip_triangles + 2 <= kLanes; }
+  void clear() { lanes = strips = triangles = strip_edges = 0; }
+
+  // `view` has no kd-tree and fits.
+  void add(const ray_strip::StripView& view) {
+    const std::uint32_t n = view.triangles(), base = view.vertex_base();
+    const void* indices = view.vertex_address(0);
+    switch (view.index_width()) {
+      case 1:
+        for (std::uint32_t i = 0; i < n + 2; ++i) vertex[lanes + i] = base + static_cast<const std::uint8_t*>(indices)[i];
+        break;
+      case 2:
+        for (std::uint32_t i = 0; i < n + 2; ++i) vertex[lanes + i] = base + static_cast<const std::uint16_t*>(indices)[i];
+        break;
+      default:
+        for (std::uint32_t i = 0; i < n + 2; ++i) vertex[lanes + i] = base + static_cast<const std::uint32_t*>(indices)[i];
+    }
+    for (std::uint32_t k = 0; k < n; ++k) strip_of_lane[lanes + k] = static_cast<std::uint8_t>(strips);
+    triangles |= ((1u << n) - 1) << lanes;
+    strip_edges |= ((2u << n) - 1) << lanes;
+    strip[strips] = view.data();
+    first_lane[strips++] = static_cast<std::uint8_t>(lanes);
+    lanes += n + 2;
+  }
+};
+static_assert(ray_strip::kUntreedTriangles + 2 == PackedStrips::kLanes, "a strip without a tree fits one pack alone");
 
 // The nearest hit so far of one ray, in strip terms until it is written out.
 struct StripHit {
@@ -145,6 +190,112 @@ class StripRay {
       dmax = std::min(stack[top].dmax, pruning_distance(tmax));
     }
   }
+
+#if WAVETRACE_SIXTEEN_LANES
+  // The packed strips' triangles by shared edges in sixteen lanes: test_chunk's operations in
+  // its order, lane for lane, so each triangle's weights and distance are the eight-lane
+  // test's to the bit (and the nearest hit the same: ties go by triangle id).
+  template <bool kAnyHit>
+  [[WAVETRACE_AVX512_TARGET]] void test_packed(const PackedStrips& pack, const glm::vec3* positions) {
+    // Each vertex read whole and the sixteen transposed into lanes, as test_chunk does;
+    // lanes past the pack repeat its last vertex. (The masked forms of the shuffles start
+    // from zero where the plain ones start from _mm512_undefined, which GCC 12 reports as
+    // maybe uninitialized once inlined.)
+    const std::uint32_t last = pack.lanes - 1;
+    __m128 vertex[PackedStrips::kLanes];
+    for (std::uint32_t i = 0; i < PackedStrips::kLanes; ++i) {
+      vertex[i] = _mm_maskz_loadu_ps(0x7, &positions[pack.vertex[std::min(i, last)]].x);
+    }
+    __m512 row[4];  // row r: vertices r, r + 4, r + 8, r + 12 in its four 128-bit parts
+    for (int r = 0; r < 4; ++r) {
+      row[r] = _mm512_insertf32x4(_mm512_insertf32x4(_mm512_insertf32x4(_mm512_zextps128_ps512(vertex[r]),
+                                                                        vertex[r + 4], 1),
+                                                     vertex[r + 8], 2),
+                                  vertex[r + 12], 3);
+    }
+    const __m512 xy01 = _mm512_maskz_unpacklo_ps(0xffff, row[0], row[1]), xy23 = _mm512_maskz_unpacklo_ps(0xffff, row[2], row[3]);
+    const __m512 z01 = _mm512_maskz_unpackhi_ps(0xffff, row[0], row[1]), z23 = _mm512_maskz_unpackhi_ps(0xffff, row[2], row[3]);
+    const __m512 axis[3] = {_mm512_shuffle_ps(xy01, xy23, 0x44), _mm512_shuffle_ps(xy01, xy23, 0xee),
+                            _mm512_shuffle_ps(z01, z23, 0x44)};
+    const __m512 px = _mm512_sub_ps(axis[sheared_.kx], _mm512_set1_ps(origin_[0]));
+    const __m512 py = _mm512_sub_ps(axis[sheared_.ky], _mm512_set1_ps(origin_[1]));
+    const __m512 pz = _mm512_sub_ps(axis[sheared_.kz], _mm512_set1_ps(origin_[2]));
+    const __m512 x = _mm512_sub_ps(px, _mm512_mul_ps(_mm512_set1_ps(sheared_.shear_x), pz));
+    const __m512 y = _mm512_sub_ps(py, _mm512_mul_ps(_mm512_set1_ps(sheared_.shear_y), pz));
+    const __m512 z = _mm512_mul_ps(_mm512_set1_ps(sheared_.shear_z), pz);
+    // Lane j takes lane j + 1 (j + 2); the last lanes repeat lane 15.
+    const __m512i to_next = _mm512_setr_epi32(1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 15);
+    const __m512i to_after_next = _mm512_setr_epi32(2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 15, 15);
+    const __m512 x1 = _mm512_maskz_permutexvar_ps(0xffff, to_next, x), y1 = _mm512_maskz_permutexvar_ps(0xffff, to_next, y);
+    const __m512 x2 = _mm512_maskz_permutexvar_ps(0xffff, to_after_next, x), y2 = _mm512_maskz_permutexvar_ps(0xffff, to_after_next, y);
+    __m512 strip_edge = _mm512_sub_ps(_mm512_mul_ps(x1, y), _mm512_mul_ps(y1, x));
+    __m512 diagonal = _mm512_sub_ps(_mm512_mul_ps(x2, y), _mm512_mul_ps(y2, x));
+    const __m512 zero = _mm512_setzero_ps();
+    // Only the strips' own edges count: a lane pair across two strips is no edge.
+    if ((_mm512_cmp_ps_mask(strip_edge, zero, _CMP_EQ_OQ) & pack.strip_edges) |
+        (_mm512_cmp_ps_mask(diagonal, zero, _CMP_EQ_OQ) & pack.triangles)) {
+      // an exact zero is decided in double, per edge, as the watertight test does
+      alignas(64) float xs[16], ys[16], strip_edges[16], diagonals[16];
+      _mm512_store_ps(xs, x), _mm512_store_ps(ys, y);
+      _mm512_store_ps(strip_edges, strip_edge), _mm512_store_ps(diagonals, diagonal);
+      for (unsigned j = 0; j + 1 < PackedStrips::kLanes; ++j) {
+        if ((pack.strip_edges >> j & 1u) && strip_edges[j] == 0.0f) {
+          strip_edges[j] = edge_in_double(xs[j], ys[j], xs[j + 1], ys[j + 1]);
+        }
+        if ((pack.triangles >> j & 1u) && diagonals[j] == 0.0f) {
+          diagonals[j] = edge_in_double(xs[j], ys[j], xs[j + 2], ys[j + 2]);
+        }
+      }
+      strip_edge = _mm512_load_ps(strip_edges), diagonal = _mm512_load_ps(diagonals);
+    }
+    const __m512 sign = _mm512_set1_ps(-0.0f);
+    const __m512 w0 = _mm512_maskz_permutexvar_ps(0xffff, to_next, strip_edge), w1 = _mm512_xor_ps(diagonal, sign), w2 = strip_edge;
+    const __mmask16 negative = _mm512_cmp_ps_mask(w0, zero, _CMP_LT_OQ) | _mm512_cmp_ps_mask(w1, zero, _CMP_LT_OQ) |
+                               _mm512_cmp_ps_mask(w2, zero, _CMP_LT_OQ);
+    const __mmask16 positive = _mm512_cmp_ps_mask(w0, zero, _CMP_GT_OQ) | _mm512_cmp_ps_mask(w1, zero, _CMP_GT_OQ) |
+                               _mm512_cmp_ps_mask(w2, zero, _CMP_GT_OQ);
+    const __m512 determinant = _mm512_add_ps(_mm512_add_ps(w0, w1), w2);
+    const __m512 scaled_t =
+        _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(w0, z), _mm512_mul_ps(w1, _mm512_maskz_permutexvar_ps(0xffff, to_next, z))),
+                      _mm512_mul_ps(w2, _mm512_maskz_permutexvar_ps(0xffff, to_after_next, z)));
+    // t * det against [tmin, tmax] * |det| without dividing; the sign of det flips t * det.
+    const __mmask16 flip = _mm512_cmp_ps_mask(determinant, zero, _CMP_LT_OQ);
+    const __m512 abs_determinant = _mm512_mask_xor_ps(determinant, flip, determinant, sign);
+    const __m512 signed_t = _mm512_mask_xor_ps(scaled_t, flip, scaled_t, sign);
+    const __mmask16 accepted =
+        ~(negative & positive) & _mm512_cmp_ps_mask(determinant, zero, _CMP_NEQ_UQ) &
+        _mm512_cmp_ps_mask(signed_t, _mm512_mul_ps(_mm512_set1_ps(tmin), abs_determinant), _CMP_GE_OQ) &
+        _mm512_cmp_ps_mask(
+            signed_t,
+            _mm512_mul_ps(_mm512_mul_ps(_mm512_set1_ps(tmax), abs_determinant), _mm512_set1_ps(kDistancePrecheckSlack)),
+            _CMP_LE_OQ);
+    unsigned lanes = accepted & pack.triangles;
+    if (lanes == 0) return;
+    alignas(64) float determinants[16], scaled_ts[16], weights[3][16];
+    _mm512_store_ps(determinants, determinant), _mm512_store_ps(scaled_ts, scaled_t);
+    _mm512_store_ps(weights[0], w0), _mm512_store_ps(weights[1], w1), _mm512_store_ps(weights[2], w2);
+    for (; lanes != 0; lanes &= lanes - 1) {
+      const unsigned j = static_cast<unsigned>(std::countr_zero(lanes));
+      const std::uint32_t s = pack.strip_of_lane[j], k = j - pack.first_lane[s];
+      const ray_strip::StripView strip(pack.strip[s]);
+      const float inverse = 1.0f / determinants[j];
+      const float t = scaled_ts[j] * inverse;
+      if (!replaces_nearest(
+              t, tmax, found(), [&] { return strip.triangle(k); },
+              [&] { return ray_strip::StripView(hit.strip).triangle(hit.triangle); })) {
+        continue;
+      }
+      tmax = t;
+      hit.strip = strip.data();
+      hit.triangle = k;
+      hit.t = t;
+      hit.weights[0] = weights[0][j] * inverse;
+      hit.weights[1] = weights[1][j] * inverse;
+      hit.weights[2] = weights[2][j] * inverse;
+      if constexpr (kAnyHit) return;
+    }
+  }
+#endif
 
   // Tests strip triangles [begin, end) by shared edges, 6 at a time.
   template <bool kAnyHit, typename Probe>
