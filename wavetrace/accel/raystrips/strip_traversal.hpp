@@ -53,49 +53,56 @@ inline bool descends(std::uint32_t triangles, std::uint32_t first, std::uint32_t
   return ray_strip::has_tree(triangles) && leaves >= 2 && std::min(2 * (first + leaves), triangles) - 2 * first > run_triangles;
 }
 
+#if WAVETRACE_SIXTEEN_LANES
 // Short strips of one top leaf (no kd-tree: at most 14 triangles, 16 vertices), whole and back
 // to back in sixteen lanes, for one shared-edge test of all of them (StripRay::test_packed):
 // lane j holds one vertex, and is a triangle where j, j + 1 and j + 2 are one strip's. Most
-// leaves under the 8-wide top hold one or two such strips; tested one run at a time, each
-// paid the run's set-up and its own mispredicted branches for 8 lanes of work.
+// leaves under the 8-wide top hold one or two such strips. A strip's indices are widened into
+// its lanes by one masked load, with no loop over them whose exit would be mispredicted.
 struct PackedStrips {
   static constexpr std::uint32_t kLanes = 16;
-  static constexpr std::uint32_t kMostStrips = kLanes / 3;  // a strip has 3 vertices or more
-  std::uint32_t vertex[kLanes];         // mesh vertex of each used lane
-  std::uint8_t strip_of_lane[kLanes];   // for the lanes that start a triangle
-  const std::byte* strip[kMostStrips];  // each packed strip's bytes
-  std::uint8_t first_lane[kMostStrips];
-  std::uint32_t lanes = 0, strips = 0;
+  alignas(64) std::uint32_t vertex[kLanes];  // mesh vertex of each used lane
+  const std::byte* strip_at[kLanes];         // the strip whose first vertex is in lane j
+  std::uint32_t lanes = 0;
+  unsigned starts = 0;       // bit j: a strip starts in lane j
   unsigned triangles = 0;    // bit j: lanes j, j + 1, j + 2 are a triangle of one strip
   unsigned strip_edges = 0;  // bit j: lanes j, j + 1 are an edge of one strip
 
   bool empty() const { return lanes == 0; }
   bool fits(std::uint32_t strip_triangles) const { return lanes + strip_triangles + 2 <= kLanes; }
-  void clear() { lanes = strips = triangles = strip_edges = 0; }
+  void clear() { lanes = starts = triangles = strip_edges = 0; }
+
+  // The first lane of the strip that lane j belongs to.
+  std::uint32_t first_lane(unsigned j) const {
+    return 31u - static_cast<std::uint32_t>(std::countl_zero(starts & ((2u << j) - 1)));
+  }
 
   // `view` has no kd-tree and fits.
-  void add(const ray_strip::StripView& view) {
-    const std::uint32_t n = view.triangles(), base = view.vertex_base();
+  [[WAVETRACE_AVX512_TARGET]] void add(const ray_strip::StripView& view) {
+    const std::uint32_t n = view.triangles();
+    const __mmask16 used = static_cast<__mmask16>((1u << (n + 2)) - 1);
     const void* indices = view.vertex_address(0);
+    __m512i stored;
     switch (view.index_width()) {
       case 1:
-        for (std::uint32_t i = 0; i < n + 2; ++i) vertex[lanes + i] = base + static_cast<const std::uint8_t*>(indices)[i];
+        stored = _mm512_maskz_cvtepu8_epi32(used, _mm_maskz_loadu_epi8(used, indices));
         break;
       case 2:
-        for (std::uint32_t i = 0; i < n + 2; ++i) vertex[lanes + i] = base + static_cast<const std::uint16_t*>(indices)[i];
+        stored = _mm512_maskz_cvtepu16_epi32(used, _mm256_maskz_loadu_epi16(used, indices));
         break;
       default:
-        for (std::uint32_t i = 0; i < n + 2; ++i) vertex[lanes + i] = base + static_cast<const std::uint32_t*>(indices)[i];
+        stored = _mm512_maskz_loadu_epi32(used, indices);
     }
-    for (std::uint32_t k = 0; k < n; ++k) strip_of_lane[lanes + k] = static_cast<std::uint8_t>(strips);
+    _mm512_mask_storeu_epi32(vertex + lanes, used, _mm512_add_epi32(stored, _mm512_set1_epi32(int(view.vertex_base()))));
+    strip_at[lanes] = view.data();
+    starts |= 1u << lanes;
     triangles |= ((1u << n) - 1) << lanes;
     strip_edges |= ((2u << n) - 1) << lanes;
-    strip[strips] = view.data();
-    first_lane[strips++] = static_cast<std::uint8_t>(lanes);
     lanes += n + 2;
   }
 };
 static_assert(ray_strip::kUntreedTriangles + 2 == PackedStrips::kLanes, "a strip without a tree fits one pack alone");
+#endif
 
 // The nearest hit so far of one ray, in strip terms until it is written out.
 struct StripHit {
@@ -276,8 +283,8 @@ class StripRay {
     _mm512_store_ps(weights[0], w0), _mm512_store_ps(weights[1], w1), _mm512_store_ps(weights[2], w2);
     for (; lanes != 0; lanes &= lanes - 1) {
       const unsigned j = static_cast<unsigned>(std::countr_zero(lanes));
-      const std::uint32_t s = pack.strip_of_lane[j], k = j - pack.first_lane[s];
-      const ray_strip::StripView strip(pack.strip[s]);
+      const std::uint32_t first = pack.first_lane(j), k = j - first;
+      const ray_strip::StripView strip(pack.strip_at[first]);
       const float inverse = 1.0f / determinants[j];
       const float t = scaled_ts[j] * inverse;
       if (!replaces_nearest(
