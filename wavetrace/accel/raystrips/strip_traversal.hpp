@@ -19,6 +19,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 
 #include <glm/vec3.hpp>
@@ -238,9 +239,14 @@ class StripRay {
     __m512 strip_edge = _mm512_sub_ps(_mm512_mul_ps(x1, y), _mm512_mul_ps(y1, x));
     __m512 diagonal = _mm512_sub_ps(_mm512_mul_ps(x2, y), _mm512_mul_ps(y2, x));
     const __m512 zero = _mm512_setzero_ps();
-    // Only the strips' own edges count: a lane pair across two strips is no edge.
-    if ((_mm512_cmp_ps_mask(strip_edge, zero, _CMP_EQ_OQ) & pack.strip_edges) |
-        (_mm512_cmp_ps_mask(diagonal, zero, _CMP_EQ_OQ) & pack.triangles)) {
+    // Only the strips' own edges count: a lane pair across two strips is no edge. An edge
+    // from a vertex to itself (a turn's repeated triangle) is zero in double too: not redone.
+    const __m512i index = _mm512_maskz_loadu_epi32(static_cast<__mmask16>((1u << pack.lanes) - 1), pack.vertex);
+    const unsigned single_vertex_edges = _mm512_cmpeq_epi32_mask(index, _mm512_maskz_permutexvar_epi32(0xffff, to_next, index));
+    const unsigned single_vertex_diagonals =
+        _mm512_cmpeq_epi32_mask(index, _mm512_maskz_permutexvar_epi32(0xffff, to_after_next, index));
+    if ((_mm512_cmp_ps_mask(strip_edge, zero, _CMP_EQ_OQ) & pack.strip_edges & ~single_vertex_edges) |
+        (_mm512_cmp_ps_mask(diagonal, zero, _CMP_EQ_OQ) & pack.triangles & ~single_vertex_diagonals)) {
       // an exact zero is decided in double, per edge, as the watertight test does
       alignas(64) float xs[16], ys[16], strip_edges[16], diagonals[16];
       _mm512_store_ps(xs, x), _mm512_store_ps(ys, y);
@@ -395,8 +401,17 @@ class StripRay {
     Lanes strip_edge = x1 * y - y1 * x;
     Lanes diagonal = x2 * y - y2 * x;
     // Only the run's edges count: lanes past it repeat the last vertex, whose edges are zero.
-    const unsigned strip_edges = (2u << count) - 1, triangles = (1u << count) - 1;
-    if ((bits_of(strip_edge == 0.0f) & strip_edges) | (bits_of(diagonal == 0.0f) & triangles)) {
+    // An edge from a vertex to itself (a turn's repeated triangle) is zero in double too: not
+    // redone.
+    using IndexLanes = std::uint32_t __attribute__((vector_size(32)));
+    IndexLanes index;
+    std::memcpy(&index, stored, sizeof(index));
+    const unsigned single_vertex_edges = bits_of(LaneMask(index == __builtin_shufflevector(index, index, 1, 2, 3, 4, 5, 6, 7, 7)));
+    const unsigned single_vertex_diagonals =
+        bits_of(LaneMask(index == __builtin_shufflevector(index, index, 2, 3, 4, 5, 6, 7, 7, 7)));
+    const unsigned strip_edges = ((2u << count) - 1) & ~single_vertex_edges;
+    const unsigned triangles = (1u << count) - 1;
+    if ((bits_of(strip_edge == 0.0f) & strip_edges) | (bits_of(diagonal == 0.0f) & triangles & ~single_vertex_diagonals)) {
       // an exact zero is decided in double, per edge, as the watertight test does
       for (std::uint32_t j = 0; j < count + 1; ++j) {
         if (strip_edge[j] == 0.0f) strip_edge[j] = edge_in_double(x[j], y[j], x[j + 1], y[j + 1]);
