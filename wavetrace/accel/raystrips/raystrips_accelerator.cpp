@@ -643,23 +643,20 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
       _mm_prefetch(first_vertex, _MM_HINT_T0);
       _mm_prefetch(first_vertex + 64, _MM_HINT_T0);
       _mm_prefetch(first_vertex + 128, _MM_HINT_T0);
-      if (ray_strip::has_tree(strip.triangles())) {
-        // The strips before it first: an any-hit query answers with the first hit in strip
-        // order, as the baseline walk does.
-        if (!pack.empty()) {
-          ray.test_packed<kAnyHit>(pack, positions);
-          if (kAnyHit && ray.found()) return true;
-          pack.clear();
-        }
+      const bool has_tree = ray_strip::has_tree(strip.triangles());
+      // The packed strips are tested before a strip with a tree, not only when the next one
+      // does not fit: an any-hit query answers with the first hit in strip order, as the
+      // baseline walk does.
+      if (!pack.empty() && (has_tree || !pack.fits(strip.triangles()))) {
+        ray.test_packed<kAnyHit>(pack, positions);
+        if (kAnyHit && ray.found()) return true;
+        pack.clear();
+      }
+      if (has_tree) {
         ray.traverse<kAnyHit>(strip, frame, positions, near, far, options_.run_triangles, probe);
         if (kAnyHit && ray.found()) return true;
       } else {
         probe.read(strip.vertex_address(0), (strip.triangles() + 2) * strip.index_width());
-        if (!pack.fits(strip.triangles())) {
-          ray.test_packed<kAnyHit>(pack, positions);
-          if (kAnyHit && ray.found()) return true;
-          pack.clear();
-        }
         pack.add(strip);
       }
       strip_data += strip.size();
