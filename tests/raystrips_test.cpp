@@ -160,7 +160,9 @@ TEST(RayStripTraversal, PackedStripsAnswerAsTheirRunsBitForBit) {
   if (runnable_kernel_isas().back() != KernelIsa::avx512) GTEST_SKIP() << "this CPU has no AVX-512";
   TriangleMesh mesh;
   for (int column = 0; column < 11; ++column) {
-    for (int row = 0; row < 2; ++row) mesh.positions.emplace_back(float(column), float(row), 0.3f * std::sin(float(column)));
+    for (int row = 0; row < 2; ++row) {
+      mesh.positions.emplace_back(float(column), float(row), 0.3f * std::sin(float(column)));
+    }
   }
   for (std::uint32_t k = 0; k < 20; ++k) mesh.triangles.emplace_back(k, k + 1, k + 2);
   std::vector<std::uint32_t> identity(mesh.vertex_count());

@@ -94,7 +94,8 @@ struct PackedStrips {
       default:
         stored = _mm512_maskz_loadu_epi32(used, indices);
     }
-    _mm512_mask_storeu_epi32(vertex + lanes, used, _mm512_add_epi32(stored, _mm512_set1_epi32(int(view.vertex_base()))));
+    const __m512i base = _mm512_set1_epi32(static_cast<int>(view.vertex_base()));
+    _mm512_mask_storeu_epi32(vertex + lanes, used, _mm512_add_epi32(stored, base));
     strip_at[lanes] = view.data();
     starts |= 1u << lanes;
     triangles |= ((1u << n) - 1) << lanes;
@@ -221,8 +222,10 @@ class StripRay {
                                                      vertex[r + 8], 2),
                                   vertex[r + 12], 3);
     }
-    const __m512 xy01 = _mm512_maskz_unpacklo_ps(0xffff, row[0], row[1]), xy23 = _mm512_maskz_unpacklo_ps(0xffff, row[2], row[3]);
-    const __m512 z01 = _mm512_maskz_unpackhi_ps(0xffff, row[0], row[1]), z23 = _mm512_maskz_unpackhi_ps(0xffff, row[2], row[3]);
+    const __m512 xy01 = _mm512_maskz_unpacklo_ps(0xffff, row[0], row[1]);
+    const __m512 xy23 = _mm512_maskz_unpacklo_ps(0xffff, row[2], row[3]);
+    const __m512 z01 = _mm512_maskz_unpackhi_ps(0xffff, row[0], row[1]);
+    const __m512 z23 = _mm512_maskz_unpackhi_ps(0xffff, row[2], row[3]);
     const __m512 axis[3] = {_mm512_shuffle_ps(xy01, xy23, 0x44), _mm512_shuffle_ps(xy01, xy23, 0xee),
                             _mm512_shuffle_ps(z01, z23, 0x44)};
     const __m512 px = _mm512_sub_ps(axis[sheared_.kx], _mm512_set1_ps(origin_[0]));
@@ -234,15 +237,18 @@ class StripRay {
     // Lane j takes lane j + 1 (j + 2); the last lanes repeat lane 15.
     const __m512i to_next = _mm512_setr_epi32(1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 15);
     const __m512i to_after_next = _mm512_setr_epi32(2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 15, 15);
-    const __m512 x1 = _mm512_maskz_permutexvar_ps(0xffff, to_next, x), y1 = _mm512_maskz_permutexvar_ps(0xffff, to_next, y);
-    const __m512 x2 = _mm512_maskz_permutexvar_ps(0xffff, to_after_next, x), y2 = _mm512_maskz_permutexvar_ps(0xffff, to_after_next, y);
+    const __m512 x1 = _mm512_maskz_permutexvar_ps(0xffff, to_next, x);
+    const __m512 y1 = _mm512_maskz_permutexvar_ps(0xffff, to_next, y);
+    const __m512 x2 = _mm512_maskz_permutexvar_ps(0xffff, to_after_next, x);
+    const __m512 y2 = _mm512_maskz_permutexvar_ps(0xffff, to_after_next, y);
     __m512 strip_edge = _mm512_sub_ps(_mm512_mul_ps(x1, y), _mm512_mul_ps(y1, x));
     __m512 diagonal = _mm512_sub_ps(_mm512_mul_ps(x2, y), _mm512_mul_ps(y2, x));
     const __m512 zero = _mm512_setzero_ps();
     // Only the strips' own edges count: a lane pair across two strips is no edge. An edge
     // from a vertex to itself (a turn's repeated triangle) is zero in double too: not redone.
     const __m512i index = _mm512_maskz_loadu_epi32(static_cast<__mmask16>((1u << pack.lanes) - 1), pack.vertex);
-    const unsigned single_vertex_edges = _mm512_cmpeq_epi32_mask(index, _mm512_maskz_permutexvar_epi32(0xffff, to_next, index));
+    const unsigned single_vertex_edges =
+        _mm512_cmpeq_epi32_mask(index, _mm512_maskz_permutexvar_epi32(0xffff, to_next, index));
     const unsigned single_vertex_diagonals =
         _mm512_cmpeq_epi32_mask(index, _mm512_maskz_permutexvar_epi32(0xffff, to_after_next, index));
     if ((_mm512_cmp_ps_mask(strip_edge, zero, _CMP_EQ_OQ) & pack.strip_edges & ~single_vertex_edges) |
@@ -262,15 +268,17 @@ class StripRay {
       strip_edge = _mm512_load_ps(strip_edges), diagonal = _mm512_load_ps(diagonals);
     }
     const __m512 sign = _mm512_set1_ps(-0.0f);
-    const __m512 w0 = _mm512_maskz_permutexvar_ps(0xffff, to_next, strip_edge), w1 = _mm512_xor_ps(diagonal, sign), w2 = strip_edge;
+    const __m512 w0 = _mm512_maskz_permutexvar_ps(0xffff, to_next, strip_edge);
+    const __m512 w1 = _mm512_xor_ps(diagonal, sign), w2 = strip_edge;
     const __mmask16 negative = _mm512_cmp_ps_mask(w0, zero, _CMP_LT_OQ) | _mm512_cmp_ps_mask(w1, zero, _CMP_LT_OQ) |
                                _mm512_cmp_ps_mask(w2, zero, _CMP_LT_OQ);
     const __mmask16 positive = _mm512_cmp_ps_mask(w0, zero, _CMP_GT_OQ) | _mm512_cmp_ps_mask(w1, zero, _CMP_GT_OQ) |
                                _mm512_cmp_ps_mask(w2, zero, _CMP_GT_OQ);
     const __m512 determinant = _mm512_add_ps(_mm512_add_ps(w0, w1), w2);
+    const __m512 z1 = _mm512_maskz_permutexvar_ps(0xffff, to_next, z);
+    const __m512 z2 = _mm512_maskz_permutexvar_ps(0xffff, to_after_next, z);
     const __m512 scaled_t =
-        _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(w0, z), _mm512_mul_ps(w1, _mm512_maskz_permutexvar_ps(0xffff, to_next, z))),
-                      _mm512_mul_ps(w2, _mm512_maskz_permutexvar_ps(0xffff, to_after_next, z)));
+        _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(w0, z), _mm512_mul_ps(w1, z1)), _mm512_mul_ps(w2, z2));
     // t * det against [tmin, tmax] * |det| without dividing; the sign of det flips t * det.
     const __mmask16 flip = _mm512_cmp_ps_mask(determinant, zero, _CMP_LT_OQ);
     const __m512 abs_determinant = _mm512_mask_xor_ps(determinant, flip, determinant, sign);
@@ -289,23 +297,12 @@ class StripRay {
     _mm512_store_ps(weights[0], w0), _mm512_store_ps(weights[1], w1), _mm512_store_ps(weights[2], w2);
     for (; lanes != 0; lanes &= lanes - 1) {
       const unsigned j = static_cast<unsigned>(std::countr_zero(lanes));
-      const std::uint32_t first = pack.first_lane(j), k = j - first;
+      const std::uint32_t first = pack.first_lane(j);
       const ray_strip::StripView strip(pack.strip_at[first]);
-      const float inverse = 1.0f / determinants[j];
-      const float t = scaled_ts[j] * inverse;
-      if (!replaces_nearest(
-              t, tmax, found(), [&] { return strip.triangle(k); },
-              [&] { return ray_strip::StripView(hit.strip).triangle(hit.triangle); })) {
-        continue;
+      if (offer_hit(strip, j - first, determinants[j], scaled_ts[j], weights[0][j], weights[1][j], weights[2][j]) &&
+          kAnyHit) {
+        return;
       }
-      tmax = t;
-      hit.strip = strip.data();
-      hit.triangle = k;
-      hit.t = t;
-      hit.weights[0] = weights[0][j] * inverse;
-      hit.weights[1] = weights[1][j] * inverse;
-      hit.weights[2] = weights[2][j] * inverse;
-      if constexpr (kAnyHit) return;
     }
   }
 #endif
@@ -406,12 +403,14 @@ class StripRay {
     using IndexLanes = std::uint32_t __attribute__((vector_size(32)));
     IndexLanes index;
     std::memcpy(&index, stored, sizeof(index));
-    const unsigned single_vertex_edges = bits_of(LaneMask(index == __builtin_shufflevector(index, index, 1, 2, 3, 4, 5, 6, 7, 7)));
+    const unsigned single_vertex_edges =
+        bits_of(LaneMask(index == __builtin_shufflevector(index, index, 1, 2, 3, 4, 5, 6, 7, 7)));
     const unsigned single_vertex_diagonals =
         bits_of(LaneMask(index == __builtin_shufflevector(index, index, 2, 3, 4, 5, 6, 7, 7, 7)));
     const unsigned strip_edges = ((2u << count) - 1) & ~single_vertex_edges;
     const unsigned triangles = (1u << count) - 1;
-    if ((bits_of(strip_edge == 0.0f) & strip_edges) | (bits_of(diagonal == 0.0f) & triangles & ~single_vertex_diagonals)) {
+    if ((bits_of(strip_edge == 0.0f) & strip_edges) |
+        (bits_of(diagonal == 0.0f) & triangles & ~single_vertex_diagonals)) {
       // an exact zero is decided in double, per edge, as the watertight test does
       for (std::uint32_t j = 0; j < count + 1; ++j) {
         if (strip_edge[j] == 0.0f) strip_edge[j] = edge_in_double(x[j], y[j], x[j + 1], y[j + 1]);
@@ -431,22 +430,29 @@ class StripRay {
                               (signed_t <= tmax * abs_determinant * kDistancePrecheckSlack);
     for (unsigned lanes = bits_of(accepted) & triangles; lanes != 0; lanes &= lanes - 1) {
       const unsigned j = static_cast<unsigned>(std::countr_zero(lanes));
-      const float inverse = 1.0f / determinant[j];
-      const float t = scaled_t[j] * inverse;
-      if (!replaces_nearest(
-              t, tmax, found(), [&] { return strip.triangle(first + j); },
-              [&] { return ray_strip::StripView(hit.strip).triangle(hit.triangle); })) {
-        continue;
-      }
-      tmax = t;
-      hit.strip = strip.data();
-      hit.triangle = first + j;
-      hit.t = t;
-      hit.weights[0] = w0[j] * inverse;
-      hit.weights[1] = w1[j] * inverse;
-      hit.weights[2] = w2[j] * inverse;
-      if constexpr (kAnyHit) return;
+      if (offer_hit(strip, first + j, determinant[j], scaled_t[j], w0[j], w1[j], w2[j]) && kAnyHit) return;
     }
+  }
+
+  // Strip triangle `triangle`, its scaled distance and corner weights over `determinant`:
+  // kept when it is nearer than the hit so far (at the same t, when its mesh id is smaller).
+  bool offer_hit(const ray_strip::StripView& strip, std::uint32_t triangle, float determinant, float scaled_t,
+                 float w0, float w1, float w2) {
+    const float inverse = 1.0f / determinant;
+    const float t = scaled_t * inverse;
+    if (!replaces_nearest(
+            t, tmax, found(), [&] { return strip.triangle(triangle); },
+            [&] { return ray_strip::StripView(hit.strip).triangle(hit.triangle); })) {
+      return false;
+    }
+    tmax = t;
+    hit.strip = strip.data();
+    hit.triangle = triangle;
+    hit.t = t;
+    hit.weights[0] = w0 * inverse;
+    hit.weights[1] = w1 * inverse;
+    hit.weights[2] = w2 * inverse;
+    return true;
   }
 
   WatertightRay sheared_;
