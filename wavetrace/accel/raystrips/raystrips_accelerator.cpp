@@ -106,6 +106,44 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> cut_submeshes(const BuildTr
   return submeshes;
 }
 
+// The strips of one top leaf read in order, `count` of them (binary top) or up to `end`
+// (wide top): each one's header reported to the probe and, in plain walks, the first lines of
+// its vertices asked for as it is read. A class, not a loop taking a lambda, so that the
+// AVX-512 walk inlines it (a lambda is not of that target).
+template <typename Until>
+class LeafStrips {
+ public:
+  LeafStrips(const std::byte* data, Until until) : data_(data), until_(until) {}
+
+  bool done() const {
+    if constexpr (std::is_integral_v<Until>) {
+      return read_ == until_;
+    } else {
+      return data_ >= until_;
+    }
+  }
+
+  template <typename Probe>
+  [[gnu::always_inline]] ray_strip::StripView next(const glm::vec3* positions, Probe& probe) {
+    probe.read(data_, ray_strip::kHeaderBytes);
+    const ray_strip::StripView strip(data_);
+    if constexpr (!Probe::kRecords) {
+      const char* first_vertex = reinterpret_cast<const char*>(positions + strip.vertex_base());
+      _mm_prefetch(first_vertex, _MM_HINT_T0);
+      _mm_prefetch(first_vertex + 64, _MM_HINT_T0);
+      _mm_prefetch(first_vertex + 128, _MM_HINT_T0);
+    }
+    data_ += strip.size();
+    ++read_;
+    return strip;
+  }
+
+ private:
+  const std::byte* data_;
+  Until until_;
+  std::uint32_t read_ = 0;
+};
+
 // What a raystrips world saves besides its arrays, `PREFIX` + "raystrips.state" (184 bytes):
 //   offset  size  field
 //        0     4  run_triangles, uint32 (traversal's span size)
@@ -603,24 +641,12 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
       return trace_packed_strips<kAnyHit>(ray, frame, strip_data, until, near, far, positions, probe);
     }
 #endif
-    for (std::uint32_t s = 0;; ++s) {
-      if constexpr (std::is_integral_v<Until>) {
-        if (s == until) return false;
-      } else {
-        if (strip_data >= until) return false;
-      }
-      probe.read(strip_data, ray_strip::kHeaderBytes);
-      const StripView strip(strip_data);
-      if constexpr (!Probe::kRecords) {
-        const char* first_vertex = reinterpret_cast<const char*>(positions + strip.vertex_base());
-        _mm_prefetch(first_vertex, _MM_HINT_T0);
-        _mm_prefetch(first_vertex + 64, _MM_HINT_T0);
-        _mm_prefetch(first_vertex + 128, _MM_HINT_T0);
-      }
+    for (LeafStrips<Until> strips(strip_data, until); !strips.done();) {
+      const StripView strip = strips.next(positions, probe);
       ray.traverse<kAnyHit>(strip, frame, positions, near, far, options_.run_triangles, probe);
       if (kAnyHit && ray.found()) return true;
-      strip_data += strip.size();
     }
+    return false;
   }
 
 #if WAVETRACE_SIXTEEN_LANES
@@ -631,18 +657,8 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
                                                        Until until, float near, float far, const glm::vec3* positions,
                                                        Probe& probe) const {
     PackedStrips pack;
-    for (std::uint32_t s = 0;; ++s) {
-      if constexpr (std::is_integral_v<Until>) {
-        if (s == until) break;
-      } else {
-        if (strip_data >= until) break;
-      }
-      probe.read(strip_data, ray_strip::kHeaderBytes);
-      const StripView strip(strip_data);
-      const char* first_vertex = reinterpret_cast<const char*>(positions + strip.vertex_base());
-      _mm_prefetch(first_vertex, _MM_HINT_T0);
-      _mm_prefetch(first_vertex + 64, _MM_HINT_T0);
-      _mm_prefetch(first_vertex + 128, _MM_HINT_T0);
+    for (LeafStrips<Until> strips(strip_data, until); !strips.done();) {
+      const StripView strip = strips.next(positions, probe);
       const bool has_tree = ray_strip::has_tree(strip.triangles());
       // The packed strips are tested before a strip with a tree, not only when the next one
       // does not fit: an any-hit query answers with the first hit in strip order, as the
@@ -659,7 +675,6 @@ class RayStripsAccelerator final : public ProbedAccelerator<RayStripsAccelerator
         probe.read(strip.vertex_address(0), (strip.triangles() + 2) * strip.index_width());
         pack.add(strip);
       }
-      strip_data += strip.size();
     }
     if (!pack.empty()) ray.test_packed<kAnyHit>(pack, positions);
     return kAnyHit && ray.found();
