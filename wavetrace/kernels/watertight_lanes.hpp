@@ -11,6 +11,7 @@
 
 #include "wavetrace/build_config.hpp"
 
+#include <cstddef>
 #include <cstdint>
 
 #include "wavetrace/kernels/kernel_isa.hpp"
@@ -65,6 +66,8 @@ template <> struct Vector<8> {
   using Int = std::int32_t __attribute__((vector_size(32)));
   static Float splat(float x) { return _mm256_set1_ps(x); }
   static Float load(const float* p) { return _mm256_load_ps(p); }
+  // Lanes 0-3 from `p`, lanes 4-7 from `p + stride` (two rows of four, e.g. two blocks').
+  static Float load_fours(const float* p, std::ptrdiff_t stride) { return _mm256_loadu2_m128(p + stride, p); }
   static void store(float* p, Float x) { _mm256_store_ps(p, x); }
   static auto equal(Float a, Float b) { return a == b; }
   static auto less(Float a, Float b) { return a < b; }
@@ -95,11 +98,14 @@ template <> struct Vector<16> {
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpsabi"
 #endif
-// Tests the kLanes triangles of `lanes` from lane `first` on (a multiple of kLanes).
+// Tests the kLanes triangles of `lanes` from lane `first` on (a multiple of kLanes). Rows of
+// four lanes narrower than the test (eight lanes over two blocks of four) are read from
+// `lanes` and from the rows `row_stride` floats after it, which must hold a whole block too.
 template <int kLanes, int kRowLanes>
 [[gnu::always_inline]] inline void intersect_watertight_lanes(const WatertightRay& ray, const TriangleLanes<kRowLanes>& lanes,
                                                               unsigned used, float tmin, float tmax,
-                                                              WatertightLanes<kLanes>& out, int first = 0) {
+                                                              WatertightLanes<kLanes>& out, int first = 0,
+                                                              std::ptrdiff_t row_stride = 0) {
   using V = lanes::Vector<kLanes>;
   using Float = typename V::Float;
   const int axes[3] = {ray.kx, ray.ky, ray.kz};
@@ -109,7 +115,15 @@ template <int kLanes, int kRowLanes>
   for (int k = 0; k < 3; ++k) origin[k] = V::splat(ray_origin[axes[k]]);
   Float relative[3][3];  // corner, permuted axis (x, y, z of the sheared frame before shearing)
   for (int c = 0; c < 3; ++c) {
-    for (int k = 0; k < 3; ++k) relative[c][k] = V::load(lanes.corner[c][axes[k]] + first) - origin[k];
+    for (int k = 0; k < 3; ++k) {
+      const float* row = lanes.corner[c][axes[k]] + first;
+      if constexpr (kRowLanes == 4 && kLanes == 8) {
+        relative[c][k] = V::load_fours(row, row_stride) - origin[k];
+      } else {
+        static_assert(kRowLanes >= kLanes, "rows narrower than the test are read in fours, eight lanes from two");
+        relative[c][k] = V::load(row) - origin[k];
+      }
+    }
   }
   const Float shear_x = V::splat(ray.shear_x), shear_y = V::splat(ray.shear_y);
   Float px[3], py[3];

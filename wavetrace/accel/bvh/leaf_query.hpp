@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <span>
@@ -56,35 +57,37 @@ class LeafQuery {
     }
   }
 
-  // Tests a leaf of `count` triangles stored as consecutive blocks from `block`, one 4-lane
-  // pass a block; the same hits as test_leaf over the same triangles, bit for bit (the lanes
-  // compute what the scalar test does, and a candidate is then taken against the tmax of the
-  // moment, as the scalar loop takes it).
+  // Tests a leaf of `count` triangles stored as consecutive blocks from `block`, two blocks a
+  // pass of eight lanes and a last odd block in four; the same hits as test_leaf over the same
+  // triangles, bit for bit (the lanes compute what the scalar test does, and a candidate is
+  // then taken against the tmax of the moment, in triangle order, as the scalar loop takes it).
   template <bool kAnyHit, typename Probe>
   [[gnu::always_inline]] void test_blocks(const TriangleBlock* block, std::uint32_t count, Probe& probe) {
+#if WAVETRACE_AVX2
+    constexpr std::ptrdiff_t kBlockFloats = sizeof(TriangleBlock) / sizeof(float);
+    static_assert(sizeof(TriangleBlock) % sizeof(float) == 0);
+    for (std::uint32_t base = 0; base < count;) {
+      const std::uint32_t left = count - base;
+      if (left > TriangleBlock::kLanes) {
+        probe.read(block, sizeof *block);
+        probe.read(block + 1, sizeof *block);
+        WatertightLanes<2 * TriangleBlock::kLanes> result;
+        intersect_watertight_lanes(ray_, block->corners, (1u << std::min(2 * TriangleBlock::kLanes, left)) - 1, tmin, tmax,
+                                   result, 0, kBlockFloats);
+        if (take_candidates<kAnyHit>(result, block)) return;
+        base += 2 * TriangleBlock::kLanes, block += 2;
+      } else {
+        probe.read(block, sizeof *block);
+        WatertightLanes<TriangleBlock::kLanes> result;
+        intersect_watertight_lanes(ray_, block->corners, (1u << left) - 1, tmin, tmax, result);
+        if (take_candidates<kAnyHit>(result, block)) return;
+        base += TriangleBlock::kLanes, ++block;
+      }
+    }
+#else
     for (std::uint32_t base = 0; base < count; base += TriangleBlock::kLanes, ++block) {
       probe.read(block, sizeof *block);
       const std::uint32_t used = (1u << std::min(TriangleBlock::kLanes, count - base)) - 1;
-#if WAVETRACE_AVX2
-      WatertightLanes<TriangleBlock::kLanes> result;
-      intersect_watertight_lanes(ray_, block->corners, used, tmin, tmax, result);
-      for (unsigned pending = result.candidates | result.on_edge; pending != 0; pending &= pending - 1) {
-        const int lane = std::countr_zero(pending);
-        TriangleHit hit;
-        if (result.on_edge >> lane & 1u) {
-          if (!intersect_watertight(ray_, block->corner(lane, 0), block->corner(lane, 1), block->corner(lane, 2), tmin,
-                                    tmax, hit)) {
-            continue;
-          }
-        } else {
-          if (result.t[lane] > tmax) continue;
-          hit = {result.t[lane], result.u[lane], result.v[lane]};
-        }
-        if (accept(block->slot[lane], hit, block, static_cast<std::uint32_t>(lane))) {
-          if constexpr (kAnyHit) return;
-        }
-      }
-#else
       for (unsigned lane = 0; used >> lane & 1u; ++lane) {
         TriangleHit hit;
         if (intersect_watertight(ray_, block->corner(lane, 0), block->corner(lane, 1), block->corner(lane, 2), tmin, tmax,
@@ -93,8 +96,8 @@ class LeafQuery {
           if constexpr (kAnyHit) return;
         }
       }
-#endif
     }
+#endif
   }
 
   // The answer in the mesh's triangle numbering (a miss if nothing was found); with
@@ -132,6 +135,32 @@ class LeafQuery {
     found_block_ = block, found_lane_ = lane;
     return true;
   }
+
+#if WAVETRACE_AVX2
+  // Takes a pass's candidates over the blocks from `first` (lane k in block k / 4) in lane
+  // order against the tmax of the moment, lanes on an edge redone by the scalar test; true
+  // when kAnyHit and one was taken.
+  template <bool kAnyHit, int kLanes>
+  [[gnu::always_inline]] bool take_candidates(const WatertightLanes<kLanes>& result, const TriangleBlock* first) {
+    for (unsigned pending = result.candidates | result.on_edge; pending != 0; pending &= pending - 1) {
+      const int lane = std::countr_zero(pending);
+      const TriangleBlock* block = first + lane / TriangleBlock::kLanes;
+      const auto block_lane = static_cast<std::uint32_t>(lane) % TriangleBlock::kLanes;
+      TriangleHit hit;
+      if (result.on_edge >> lane & 1u) {
+        if (!intersect_watertight(ray_, block->corner(block_lane, 0), block->corner(block_lane, 1),
+                                  block->corner(block_lane, 2), tmin, tmax, hit)) {
+          continue;
+        }
+      } else {
+        if (result.t[lane] > tmax) continue;
+        hit = {result.t[lane], result.u[lane], result.v[lane]};
+      }
+      if (accept(block->slot[block_lane], hit, block, block_lane) && kAnyHit) return true;
+    }
+    return false;
+  }
+#endif
 
   const IndexedFaceSet& geometry_;
   const std::uint32_t* leaf_index_;

@@ -1,6 +1,7 @@
 // The 8-wide BVH's leaf triangles, four to a block with their corners in SSE lanes, so one
 // 4-lane watertight test (watertight_lanes.hpp) answers a leaf of up to four triangles from
-// two and a half cache lines, without reading a leaf index, an index triple or a vertex.
+// two and a half cache lines, without reading a leaf index, an index triple or a vertex (two
+// consecutive blocks' rows make one 8-lane test).
 #pragma once
 
 #include <cstdint>

@@ -1,7 +1,7 @@
 // The 8-wide BVH: the binary SAH tree cut into nodes of up to eight children by the
 // surface-area plan (collapse_plan.hpp), traversed one ray at a time (camera rays eight at
 // a time) with all eight child boxes tested in one AVX2 pass, nearest child first; leaves
-// are blocks of four triangles tested in one 4-lane pass.
+// are blocks of four triangles tested two blocks to a pass of eight lanes.
 #include "wavetrace/accel/bvh/wide_bvh_accelerator.hpp"
 #include "wavetrace/build_config.hpp"  // WAVETRACE_AVX2, WAVETRACE_FMA, WAVETRACE_BMI2
 
@@ -152,17 +152,23 @@ template <KernelIsa kIsa>
 // Asks for the lines of every child in `mask` before any is visited: the walk goes down the
 // nearest first, and by the time it pops the others their node or block is in cache
 // (measured: 8% faster on room:1M diffuse and camera rays, 1 thread, median ratio to Embree
-// over three alternating rounds).
+// over three alternating rounds). All four lines of a node, and both blocks of a leaf's first
+// pass (docs/measurements.md, "bvh:width=8's leaves two blocks a pass").
 [[gnu::always_inline]] inline void prefetch_children(const WideBvhNode& node, unsigned mask, const WideBvhNode* nodes,
                                                      const TriangleBlock* blocks) {
 #if WAVETRACE_AVX2
   for (; mask != 0; mask &= mask - 1) {
     const int k = std::countr_zero(mask);
-    const char* child = node.count[k] == 0 ? reinterpret_cast<const char*>(nodes + node.child[k])
-                                           : reinterpret_cast<const char*>(blocks + node.child[k]);
-    _mm_prefetch(child, _MM_HINT_T0);
-    _mm_prefetch(child + 64, _MM_HINT_T0);
-    _mm_prefetch(child + 128, _MM_HINT_T0);
+    if (node.count[k] == 0) {  // a node: its boxes, and the fourth line, its children and counts
+      const char* child = reinterpret_cast<const char*>(nodes + node.child[k]);
+      for (int line = 0; line < 4; ++line) _mm_prefetch(child + 64 * line, _MM_HINT_T0);
+    } else {  // a leaf: the blocks of its first pass (two when it has more than four triangles)
+      const TriangleBlock* first = blocks + node.child[k];
+      const char* begin = reinterpret_cast<const char*>(first);
+      const char* last = reinterpret_cast<const char*>(first + (node.count[k] > TriangleBlock::kLanes ? 2 : 1)) - 1;
+      for (const char* line = begin; line < last; line += 64) _mm_prefetch(line, _MM_HINT_T0);
+      _mm_prefetch(last, _MM_HINT_T0);
+    }
   }
 #else
   (void)node, (void)mask, (void)nodes, (void)blocks;
