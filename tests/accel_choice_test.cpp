@@ -50,12 +50,25 @@ const AccelCandidate& candidate(const AccelChoice& choice, const std::string& ty
   throw std::logic_error("no candidate " + type);
 }
 
-TEST(AccelChoice, ASmallSceneGetsRobustEmbree) {
-  const AccelChoice choice = choose(traits_of("builtin:sphere:20k"), world_budget(1000), 0.01, AcceleratorOptions{}, false);
-  EXPECT_EQ(choice.options.type, "embree");
-  EXPECT_EQ(choice.options.embree.mode, EmbreeMode::robust);
-  EXPECT_TRUE(candidate(choice, "embree").chosen);
-  EXPECT_NE(choice.summary.find("embree:mode=robust"), std::string::npos) << choice.summary;
+// The fastest measured that fits: bvh:width=8 where its build fits, robust Embree where only
+// Embree's smaller build does (bvh's temporaries are about 190 B/tri, Embree's 32).
+TEST(AccelChoice, ASmallSceneGetsTheFastestThatFits) {
+  const SceneTraits sphere = traits_of("builtin:sphere:20k");
+  const AccelChoice roomy = choose(sphere, world_budget(1000), 0.01, AcceleratorOptions{}, false);
+  EXPECT_EQ(roomy.spec, "bvh:width=8");
+  EXPECT_EQ(roomy.options.bvh.width, 8u);
+  EXPECT_TRUE(candidate(roomy, "bvh").chosen);
+  EXPECT_TRUE(candidate(roomy, "embree").fits);
+
+  const double embree_bytes = candidate(roomy, "embree").estimated_bytes;
+  const double bvh_bytes = candidate(roomy, "bvh").estimated_bytes;
+  ASSERT_LT(embree_bytes, bvh_bytes);
+  const AccelChoice tight = choose(sphere, std::size_t((embree_bytes + bvh_bytes) / 2), 0.01, AcceleratorOptions{}, false);
+  EXPECT_EQ(tight.options.type, "embree");
+  EXPECT_EQ(tight.options.embree.mode, EmbreeMode::robust);
+  EXPECT_FALSE(candidate(tight, "bvh").fits);
+  EXPECT_TRUE(candidate(tight, "embree").chosen);
+  EXPECT_NE(tight.summary.find("embree:mode=robust"), std::string::npos) << tight.summary;
 }
 
 TEST(AccelChoice, ABudgetThatExcludesUncompressedStructuresGetsACompactOne) {
