@@ -38,15 +38,22 @@ struct LeafHit {
 
 // A leaf decoded once, with its triangles' corners gathered into lanes (triangle k in lane k),
 // ready to be tested by one ray or by each ray of a packet: eight triangles a pass in AVX2, all
-// fourteen in one pass of the AVX-512 walks (of a GCC build: watertight_lanes.hpp).
+// fourteen in one pass of the AVX-512 walks (of a GCC build: watertight_lanes.hpp). With lanes
+// it keeps only them and where its ids are (640 bytes): the decoded columns it was gathered
+// from (1,152 bytes more) stay in a scratch the next decode overwrites, so that a cache of
+// decoded leaves (DecodedLeafCache) holds four times the leaves in the same bytes.
 struct LeafTriangles {
-  DecodedLeaf decoded;
+  LeafIdentity identity;
+  const StripLayoutEntry* layout = nullptr;
 #if WAVETRACE_AVX2
   TriangleLanes<16> lanes;
-#endif
   glm::vec3 corner(std::uint32_t k, std::uint32_t c) const {
-    return decoded.slot_position(decoded.layout->first_slot[k] + c);
+    return {lanes.corner[c][0][k], lanes.corner[c][1][k], lanes.corner[c][2][k]};
   }
+#else
+  DecodedLeaf decoded;
+  glm::vec3 corner(std::uint32_t k, std::uint32_t c) const { return decoded.slot_position(layout->first_slot[k] + c); }
+#endif
 };
 
 #if WAVETRACE_AVX2
@@ -99,10 +106,17 @@ inline int lane_parts(std::uint32_t entries) { return entries <= 8 ? 1 : entries
 }
 #endif
 
+// Decodes the record at `record` (its decoded box `box`) into `scratch` and gathers its
+// triangles' corners into `leaf`.
 template <KernelIsa kIsa = KernelIsa::baseline, typename Probe>
 [[gnu::always_inline]] inline void prepare_leaf(const std::byte* record, const GlobalGrid& grid, const Box& box,
-                                                LeafTriangles& leaf, Probe& probe) {
+                                                LeafTriangles& leaf, DecodedLeaf& scratch, Probe& probe) {
+#if WAVETRACE_AVX2
+  DecodedLeaf& decoded = scratch;
+#else
+  (void)scratch;
   DecodedLeaf& decoded = leaf.decoded;
+#endif
   // Its first page announced before the decode reads it (paged in frames, where the probe
   // says), its size reported after, by the decode that finds it (a record ending on the next
   // page faults that page in, but in a frame, whose tail holds it).
@@ -110,6 +124,8 @@ template <KernelIsa kIsa = KernelIsa::baseline, typename Probe>
   if constexpr (Probe::kRecords) bytes = probe.template resident_record<kMaxLeafRecordBytes>(record);
   decode_leaf<kIsa>(bytes, grid, snap_outward(grid, box), decoded);
   if constexpr (Probe::kRecords) probe.record_read(record, std::size_t(decoded.end() - bytes));
+  leaf.identity = decoded.identity();
+  leaf.layout = decoded.layout;
 #if WAVETRACE_AVX512_DISPATCH
   if constexpr (kSixteenLanes<kIsa>) return gather_corners_sixteen(decoded, leaf.lanes);
 #endif
@@ -141,16 +157,15 @@ template <KernelIsa kIsa = KernelIsa::baseline, typename Probe>
 template <bool kAnyHit, KernelIsa kIsa = KernelIsa::baseline>
 [[gnu::always_inline]] inline void test_leaf_triangles(const LeafTriangles& leaf, const WatertightRay& sheared,
                                                        float tmin, float& tmax, LeafHit& best) {
-  const DecodedLeaf& decoded = leaf.decoded;
-  const std::uint32_t triangles = decoded.layout->triangles;
+  const std::uint32_t triangles = leaf.layout->triangles;
   // False when the hit loses to `best`; else it becomes `best`.
   auto accept = [&](std::uint32_t k, const TriangleHit& hit) {
     if (!replaces_nearest(
-            hit.t, tmax, best.found, [&] { return decoded.triangle_id(k); }, [&] { return best.triangle_id(); })) {
+            hit.t, tmax, best.found, [&] { return leaf.identity.triangle_id(k); }, [&] { return best.triangle_id(); })) {
       return false;
     }
     tmax = hit.t;
-    best = {hit.t, hit.u, hit.v, decoded.identity(), k, {leaf.corner(k, 0), leaf.corner(k, 1), leaf.corner(k, 2)}, true};
+    best = {hit.t, hit.u, hit.v, leaf.identity, k, {leaf.corner(k, 0), leaf.corner(k, 1), leaf.corner(k, 2)}, true};
     return true;
   };
 #if WAVETRACE_AVX2
@@ -192,20 +207,22 @@ template <bool kAnyHit, KernelIsa kIsa = KernelIsa::baseline>
 // camera's neighbouring pixels, rays sorted by hit point) meet the same leaves one after
 // another, and the decode is most of a leaf's cost. In-core walks only (NullProbe): a probed
 // walk must read, and report, every record it tests, and a paged record's frame may be
-// reused while its decoded copy is held. 32 entries (55 KB, one per batch call): against 8,
-// hmq:width=8 2-7% faster on camera and diffuse rays of the rooms and scans (diffuse rays of
-// room:1M missed 91% of the time with 8); 128 gained camera rays and lost diffuse ones
-// (docs/measurements.md, "Entry planes once a ray, and a larger cache of decoded leaves").
+// reused while its decoded copy is held. 128 entries of lanes alone (80 KB, one per batch
+// call): against 32 entries that also held their decoded columns (55 KB), hmq:width=8 5-10%
+// faster on the rooms' camera and diffuse rays and the same on the scans' (docs/
+// measurements.md, "HMQ's decoded leaves as lanes alone"); with the columns, 128 (220 KB) had
+// gained camera rays and lost diffuse ones ("Entry planes once a ray, and a larger cache of
+// decoded leaves").
 class DecodedLeafCache {
  public:
-  static constexpr std::size_t kEntries = 32;
+  static constexpr std::size_t kEntries = 128;
 
   template <KernelIsa kIsa, typename Probe>
   [[gnu::always_inline]] const LeafTriangles& leaf(const std::byte* record, const GlobalGrid& grid, const Box& box,
                                                    Probe& probe) {
     const std::size_t slot = (reinterpret_cast<std::uintptr_t>(record) >> 4) % kEntries;
     if (record_[slot] != record || Probe::kRecords) {
-      prepare_leaf<kIsa>(record, grid, box, leaves_[slot], probe);
+      prepare_leaf<kIsa>(record, grid, box, leaves_[slot], scratch_, probe);
       record_[slot] = Probe::kRecords ? nullptr : record;
     }
     return leaves_[slot];
@@ -214,6 +231,7 @@ class DecodedLeafCache {
  private:
   const std::byte* record_[kEntries] = {};
   LeafTriangles leaves_[kEntries];
+  DecodedLeaf scratch_;  // the columns a leaf is gathered from
 };
 
 // The leaf record at `record`, whose decoded box is `box`, against one ray (decoded through

@@ -288,6 +288,8 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
     walk_with(kernel_isa(), [&]<KernelIsa kIsa>() {
       NullProbe probe;
       QuantizedWidePacketStack stack;
+      LeafTriangles leaf;   // the packet's leaf of the moment
+      DecodedLeaf scratch;  // and the columns it is gathered from
       const std::byte* leaves = leaf_records();
       for (std::uint32_t begin = range.begin; begin < range.end; begin += kWidePacketRays) {
         const std::uint32_t end = std::min<std::uint32_t>(begin + kWidePacketRays, range.end);
@@ -304,9 +306,8 @@ class WideHmqAccelerator final : public ProbedAccelerator<WideHmqAccelerator> {
         if (live != 0) {
           walk_quantized_wide_packet<kIsa>(nodes_.data(), root_, packet, live, tmax, probe, stack,
                                      [&](std::uint32_t units, const Bounds3& box, unsigned members) {
-                                       LeafTriangles leaf;
                                        prepare_leaf<kIsa>(leaves + std::size_t(units) * kUnit, grid_,
-                                                          Box{box.lower, box.upper}, leaf, probe);
+                                                          Box{box.lower, box.upper}, leaf, scratch, probe);
                                        for (; members != 0; members &= members - 1) {
                                          const int r = std::countr_zero(members);
                                          test_leaf_triangles<false, kIsa>(leaf, packet[r].sheared, packet[r].tmin, tmax[r], best[r]);
